@@ -1,0 +1,1 @@
+"""Motion Playground training package: mocap loaders, datasets, models, training, export, evaluation."""
