@@ -1,0 +1,45 @@
+// Shared helpers for the text parsers: input sanity checks, line splitting, strict number parsing.
+import { MotionFormatError, type MotionFormat } from './types';
+
+/** Hard limits on imported motions; larger inputs are rejected rather than allocated. */
+export const MAX_FRAMES = 1_000_000;
+export const MAX_VALUES = 100_000_000;
+
+const NUMBER = /^[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?$/;
+
+/** Rejects empty and binary input before any parsing. */
+export function checkText(text: string, format: MotionFormat): void {
+  if (typeof text !== 'string') throw new MotionFormatError(format, 'expected text input');
+  if (text.trim().length === 0) throw new MotionFormatError(format, 'file is empty');
+  if (text.includes('\0')) throw new MotionFormatError(format, 'file contains NUL bytes (binary data, not a text file)');
+  // Control characters other than tab/CR/LF, or U+FFFD from failed decoding, mean binary data.
+  const sample = text.length > 65536 ? text.slice(0, 65536) : text;
+  let bad = 0;
+  for (let i = 0; i < sample.length; i++) {
+    const c = sample.charCodeAt(i);
+    if ((c < 32 && c !== 9 && c !== 10 && c !== 13) || c === 127 || c === 0xfffd) bad++;
+  }
+  if (bad > 0.01 * sample.length) {
+    throw new MotionFormatError(format, `file looks binary (${bad} non-printable characters in the first ${sample.length})`);
+  }
+}
+
+/** Lines without terminators; handles \n, \r\n and \r. Line i of the result is file line i + 1. */
+export function splitLines(text: string): string[] {
+  return text.split(/\r\n|\n|\r/);
+}
+
+/** Whitespace-separated tokens of one line. */
+export function tokens(line: string): string[] {
+  const t = line.trim();
+  return t.length === 0 ? [] : t.split(/\s+/);
+}
+
+/** Parses a decimal number strictly (no NaN, Infinity, hex or trailing junk). */
+export function parseNumber(token: string, format: MotionFormat, line: number, what = 'a number'): number {
+  const v = NUMBER.test(token) ? Number(token) : NaN;
+  if (!Number.isFinite(v)) {
+    throw new MotionFormatError(format, `expected ${what}, found "${token.length > 40 ? token.slice(0, 40) + '…' : token}"`, line);
+  }
+  return v;
+}
