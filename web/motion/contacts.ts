@@ -97,11 +97,9 @@ export function detectContacts(motion: Motion): Uint8Array | undefined {
     let on = false;
     for (let f = 0; f < motion.frames; f++) {
       const ha = ankle.height[f], va = ankle.speed[f], ht = toe.height[f], vt = toe.speed[f];
-      if (on) {
-        on = (ha < T.ankleOffHeight && va < T.offSpeed) || (ht < T.toeOffHeight && vt < T.offSpeed);
-      } else {
-        on = (ha < T.ankleOnHeight && va < T.onSpeed) || (ht < T.toeOnHeight && vt < T.onSpeed);
-      }
+      const turnOn = (ha < T.ankleOnHeight && va < T.onSpeed) || (ht < T.toeOnHeight && vt < T.onSpeed);
+      const stayOn = (ha < T.ankleOffHeight && va < T.offSpeed) || (ht < T.toeOffHeight && vt < T.offSpeed);
+      on = turnOn || (on && stayOn);
       contacts[f * 2 + side] = on ? 1 : 0;
     }
   });
