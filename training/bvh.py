@@ -62,7 +62,7 @@ def parse_bvh(text: str, source: str = "<bvh>") -> BvhClip:
     def take(what: str) -> tuple[int, str]:
         nonlocal pos
         if pos >= len(tokens):
-            raise MotionFormatError(source, f"file ends inside HIERARCHY; expected {what}", len(lines))
+            raise MotionFormatError(source, f"file is truncated inside HIERARCHY; expected {what}", len(lines))
         tok = tokens[pos]
         pos += 1
         return tok
