@@ -260,15 +260,16 @@ export function parseAMC(text: string, asf: AsfSkeleton | string, options: AMCOp
   const jointIndex = new Map(skeleton.joints.map((n, j) => [n, j]));
   const frameValues: Float64Array[] = [];
   let current: Float64Array | undefined;
-  let seen: Uint8Array = new Uint8Array(J);
+  const seen = new Uint8Array(J);
   let currentLine = 0;
   let expectedNumber = -1;
 
-  const closeFrame = (lineNo: number) => {
+  const closeFrame = (atEnd: boolean) => {
     if (!current) return;
     for (let j = 0; j < J; j++) {
       if (!seen[j] && kin[j].valueCount > 0) {
-        throw new MotionFormatError('amc', `frame ${expectedNumber - 1} (line ${currentLine}) has no values for "${skeleton.joints[j]}"${lineNo > lines.length ? ' (file truncated?)' : ''}`, lineNo);
+        const hint = atEnd ? ' (file truncated?)' : '';
+        throw new MotionFormatError('amc', `frame ${expectedNumber - 1} has no values for "${skeleton.joints[j]}"${hint}`, currentLine);
       }
     }
     frameValues.push(current);
@@ -291,12 +292,12 @@ export function parseAMC(text: string, asf: AsfSkeleton | string, options: AMCOp
       if (expectedNumber >= 0 && n !== expectedNumber) {
         throw new MotionFormatError('amc', `expected frame number ${expectedNumber}, found ${n}`, lineNo);
       }
-      closeFrame(lineNo);
+      closeFrame(false);
       if (frameValues.length >= MAX_FRAMES) throw new MotionFormatError('amc', `more than ${MAX_FRAMES} frames`, lineNo);
       if ((frameValues.length + 1) * valuesPerFrame > MAX_VALUES) throw new MotionFormatError('amc', `more than ${MAX_VALUES} values`, lineNo);
       expectedNumber = n + 1;
       current = new Float64Array(valuesPerFrame);
-      seen = new Uint8Array(J);
+      seen.fill(0);
       currentLine = lineNo;
       continue;
     }
@@ -311,7 +312,7 @@ export function parseAMC(text: string, asf: AsfSkeleton | string, options: AMCOp
     for (let v = 0; v < k.valueCount; v++) current[k.firstValue + v] = parseNumber(parts[v + 1], 'amc', lineNo);
     seen[j] = 1;
   }
-  closeFrame(lines.length + 1);
+  closeFrame(true);
   if (frameValues.length === 0) throw new MotionFormatError('amc', 'no frames found (expected a frame number followed by bone lines)');
 
   // Axis rotations, in the ASF's own angle unit.

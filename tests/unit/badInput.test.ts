@@ -1,0 +1,239 @@
+// Malformed input: every case must raise a MotionFormatError that names the format, the line where
+// known and what was expected — never hang, never return NaN positions.
+import { describe, expect, it } from 'vitest';
+import { parseBVH } from '../../web/motion/bvh';
+import { parseAMC, parseASF } from '../../web/motion/asfamc';
+import { importMotion } from '../../web/motion/io';
+import { MotionFormatError } from '../../web/motion/types';
+import { readCorpus } from './corpus';
+
+/** Runs fn, expects a MotionFormatError of that format (and line), returns its message. */
+function formatError(fn: () => unknown, format: 'bvh' | 'amc' | 'asf', line?: number): string {
+  let error: unknown;
+  try {
+    fn();
+  } catch (e) {
+    error = e;
+  }
+  expect(error).toBeInstanceOf(MotionFormatError);
+  const e = error as MotionFormatError;
+  expect(e.format).toBe(format);
+  if (line !== undefined) expect(e.line).toBe(line);
+  return e.message;
+}
+
+const BVH = readCorpus('cmu/bvh/07_04.bvh.gz');
+const BVH_LINES = BVH.split('\n');
+const FIRST_FRAME_LINE = 188; // 1-based line of the first frame in 07_04
+const withLine = (lineNo: number, replace: (line: string) => string) =>
+  BVH_LINES.map((l, i) => (i === lineNo - 1 ? replace(l) : l)).join('\n');
+
+const ASF = readCorpus('cmu/asf/16.asf');
+const AMC = readCorpus('cmu/amc/16_11.amc.gz');
+const AMC_LINES = AMC.split('\n');
+const amcWithLine = (lineNo: number, replace: (line: string) => string) =>
+  AMC_LINES.map((l, i) => (i === lineNo - 1 ? replace(l) : l)).join('\n');
+
+describe('bad BVH input', () => {
+  it('rejects an empty file', () => {
+    expect(formatError(() => parseBVH(''), 'bvh')).toBe('BVH: file is empty');
+    expect(formatError(() => parseBVH('  \n\t\n'), 'bvh')).toBe('BVH: file is empty');
+  });
+
+  it('rejects binary junk', () => {
+    expect(formatError(() => parseBVH('HIERARCHY\0\0\u0001ROOT'), 'bvh')).toMatch(/NUL bytes/);
+    let junk = '';
+    for (let i = 0; i < 2000; i++) junk += String.fromCharCode((i * 7919) % 256);
+    expect(formatError(() => parseBVH(junk.replace(/\0/g, '\u0001')), 'bvh')).toMatch(/looks binary/);
+  });
+
+  it('rejects a file truncated inside the hierarchy', () => {
+    const cut = BVH_LINES.slice(0, 100).join('\n');
+    expect(formatError(() => parseBVH(cut), 'bvh', 100)).toMatch(/unexpected end of file, expected .*\(file truncated\?\)/);
+  });
+
+  it('rejects a file truncated inside the motion data', () => {
+    // Cut in the middle of a frame line: that line has too few numbers.
+    const cutMidLine = BVH_LINES.slice(0, 300).join('\n').slice(0, -40);
+    expect(formatError(() => parseBVH(cutMidLine), 'bvh', 300)).toMatch(/^BVH line 300: expected 96 numbers per frame, found \d\d$/);
+    // Cut at a line end: fewer frame lines than "Frames:" declares.
+    const cutAtLine = BVH_LINES.slice(0, 300).join('\n');
+    expect(formatError(() => parseBVH(cutAtLine), 'bvh', 186)).toBe('BVH line 186: "Frames:" declares 450 frames but the file has 113 frame lines (file truncated?)');
+  });
+
+  it('rejects frame lines with too few or too many numbers', () => {
+    const fewer = withLine(212, (l) => l.trim().split(/\s+/).slice(0, 93).join(' '));
+    expect(formatError(() => parseBVH(fewer), 'bvh', 212)).toBe('BVH line 212: expected 96 numbers per frame, found 93');
+    expect(formatError(() => parseBVH(withLine(212, (l) => l + ' 1.5')), 'bvh', 212)).toBe('BVH line 212: expected 96 numbers per frame, found 97');
+  });
+
+  it('rejects NaN, infinities and non-numeric values', () => {
+    for (const bad of ['NaN', 'nan', 'Infinity', '-inf', 'abc', '1.2.3', '0x1F', '1e999', '12,5']) {
+      const text = withLine(FIRST_FRAME_LINE + 3, (l) => l.replace(/^(\S+\s+\S+\s+)\S+/, `$1${bad}`));
+      expect(formatError(() => parseBVH(text), 'bvh', FIRST_FRAME_LINE + 3)).toBe(`BVH line ${FIRST_FRAME_LINE + 3}: expected a number, found "${bad}"`);
+    }
+    expect(formatError(() => parseBVH(BVH.replace('OFFSET 2.36836 -6.50702 0.00000', 'OFFSET 2.36836 NaN 0.00000')), 'bvh', 16)).toMatch(/expected an OFFSET y value, found "NaN"/);
+  });
+
+  it('rejects frame counts that do not match the data or are absurd', () => {
+    expect(formatError(() => parseBVH(BVH.replace('Frames: 450', 'Frames: 449')), 'bvh', 637)).toBe('BVH line 637: more frame lines than the 449 declared by "Frames:" (line 186)');
+    expect(formatError(() => parseBVH(BVH.replace('Frames: 450', 'Frames: 451')), 'bvh', 186)).toMatch(/declares 451 frames but the file has 450 frame lines/);
+    expect(formatError(() => parseBVH(BVH.replace('Frames: 450', 'Frames: 5000000')), 'bvh', 186)).toBe('BVH line 186: declares 5000000 frames; at most 1000000 are supported');
+    expect(formatError(() => parseBVH(BVH.replace('Frames: 450', 'Frames: -3')), 'bvh', 186)).toMatch(/expected a positive whole frame count/);
+    expect(formatError(() => parseBVH(BVH.replace('Frames: 450', 'Frames: 4.5')), 'bvh', 186)).toMatch(/expected a positive whole frame count/);
+    expect(formatError(() => parseBVH(BVH.replace('Frames: 450', 'Frames lots')), 'bvh', 186)).toMatch(/expected "Frames: <number>"/);
+    expect(formatError(() => parseBVH(BVH.replace('Frame Time: .0083333', 'Frame Time: 0')), 'bvh', 187)).toMatch(/expected a positive frame time/);
+  });
+
+  it('rejects more than 100 million values before allocating them', () => {
+    // 40 joints × 3 + 6 = 126 channels × 900,000 frames ≈ 113M values.
+    let hierarchy = 'HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 6 Xposition Yposition Zposition Zrotation Yrotation Xrotation\n';
+    for (let j = 1; j <= 40; j++) hierarchy += `JOINT j${j}\n{\nOFFSET 0 1 0\nCHANNELS 3 Zrotation Yrotation Xrotation\n`;
+    hierarchy += 'End Site\n{\nOFFSET 0 1 0\n}\n' + '}\n'.repeat(41);
+    const text = hierarchy + 'MOTION\nFrames: 900000\nFrame Time: 0.01\n0 0 0\n';
+    expect(formatError(() => parseBVH(text), 'bvh')).toMatch(/declares 900000 frames × 126 channels = 113400000 values; at most 100000000 are supported/);
+  });
+
+  it('rejects files without a usable hierarchy', () => {
+    expect(formatError(() => parseBVH('MOTION\nFrames: 1\nFrame Time: 0.1\n0 0 0\n'), 'bvh', 1)).toBe('BVH line 1: expected "HIERARCHY" at the start, found "MOTION"');
+    expect(formatError(() => parseBVH('HIERARCHY\nMOTION\nFrames: 1\nFrame Time: 0.1\n\n'), 'bvh')).toMatch(/unexpected end of file, expected "ROOT"/);
+    expect(formatError(() => parseBVH('hello world\n'), 'bvh', 1)).toMatch(/expected "HIERARCHY" at the start, found "hello"/);
+    expect(formatError(() => parseBVH(BVH.replace('ROOT Hips', 'ROOT')), 'bvh', 2)).toMatch(/expected a joint name/);
+  });
+
+  it('rejects unknown channels and wrong channel counts in the hierarchy', () => {
+    expect(formatError(() => parseBVH(BVH.replace('CHANNELS 3 Zrotation Yrotation Xrotation', 'CHANNELS 3 Zrotation Wrotation Xrotation')), 'bvh', 9)).toMatch(/"Wrotation" is not a channel name/);
+    expect(formatError(() => parseBVH(BVH.replace('CHANNELS 3 Zrotation Yrotation Xrotation', 'CHANNELS 2 Zrotation Yrotation Xrotation')), 'bvh', 9)).toMatch(/declares 2 channels but lists more/);
+    expect(formatError(() => parseBVH(BVH.replace('CHANNELS 3 Zrotation Yrotation Xrotation', 'CHANNELS 4 Zrotation Yrotation Xrotation')), 'bvh')).toMatch(/"JOINT" is not a channel name/);
+    expect(formatError(() => parseBVH(BVH.replace('CHANNELS 3 Zrotation Yrotation Xrotation', 'CHANNELS 9 Zrotation Yrotation Xrotation')), 'bvh', 9)).toMatch(/expected a channel count from 0 to 6, found 9/);
+  });
+
+  it('rejects a second ROOT and stray tokens', () => {
+    const two = BVH.replace('MOTION', 'ROOT Other\n{\nOFFSET 0 0 0\nCHANNELS 0\n}\nMOTION');
+    expect(formatError(() => parseBVH(two), 'bvh', 185)).toMatch(/expected "MOTION" after the hierarchy, found a second ROOT/);
+    expect(formatError(() => parseBVH(BVH.replace('OFFSET 0 0 0', 'OFSET 0 0 0')), 'bvh', 8)).toMatch(/unexpected "OFSET" in joint "LHipJoint"/);
+  });
+
+  it('rejects values so large that positions overflow, instead of returning non-finite numbers', () => {
+    const text = withLine(FIRST_FRAME_LINE, (l) => l.replace(/^\S+/, '1e300'));
+    expect(formatError(() => parseBVH(text), 'bvh')).toMatch(/overflow/);
+  });
+});
+
+describe('bad ASF input', () => {
+  it('rejects an empty or binary file', () => {
+    expect(formatError(() => parseASF(''), 'asf')).toBe('ASF: file is empty');
+    expect(formatError(() => parseASF('\0\0\0\0'), 'asf')).toMatch(/NUL bytes/);
+  });
+
+  it('rejects a skeleton without :bonedata', () => {
+    const noBones = ASF.slice(0, ASF.indexOf(':bonedata')) + ASF.slice(ASF.indexOf(':hierarchy'));
+    expect(formatError(() => parseASF(noBones), 'asf')).toBe('ASF: missing :bonedata section (expected the bone definitions)');
+  });
+
+  it('rejects a skeleton without :hierarchy, or truncated inside a bone', () => {
+    expect(formatError(() => parseASF(ASF.slice(0, ASF.indexOf(':hierarchy'))), 'asf')).toMatch(/missing :hierarchy section/);
+    const cut = ASF.split('\n').slice(0, 30).join('\n');
+    expect(formatError(() => parseASF(cut), 'asf', 30)).toMatch(/bone starting at line 25 has no "end" \(file truncated\?\)/);
+  });
+
+  it('rejects bones missing fields, unknown dofs and unknown bones in the hierarchy', () => {
+    expect(formatError(() => parseASF(ASF.replace('length 7.03469', '')), 'asf')).toMatch(/bone starting at line \d+ has no length/);
+    expect(formatError(() => parseASF(ASF.replace('lhipjoint lfemur', 'lhipjoint lfemur lwing')), 'asf', 315)).toBe('ASF line 315: :hierarchy names unknown bone "lwing"');
+    expect(formatError(() => parseASF(ASF.replace('dof rx ry rz', 'dof rx rq rz')), 'asf')).toMatch(/unknown dof "rq"/);
+    expect(formatError(() => parseASF(ASF.replace('length 7.03469', 'length seven')), 'asf')).toMatch(/expected a bone length, found "seven"/);
+  });
+});
+
+describe('bad AMC input', () => {
+  it('needs its ASF', () => {
+    expect(formatError(() => importMotion(AMC, 'amc'), 'amc')).toBe('AMC: an AMC motion needs its ASF skeleton file (none given)');
+    expect(formatError(() => importMotion(AMC, 'amc', ''), 'asf')).toBe('ASF: file is empty');
+  });
+
+  it('rejects an empty, header-only or binary file', () => {
+    expect(formatError(() => parseAMC('', ASF), 'amc')).toBe('AMC: file is empty');
+    expect(formatError(() => parseAMC(':FULLY-SPECIFIED\n:DEGREES\n', ASF), 'amc')).toMatch(/no frames found/);
+    expect(formatError(() => parseAMC('1\nroot \0\0\0', ASF), 'amc')).toMatch(/NUL bytes/);
+  });
+
+  it('rejects a bone the ASF lacks', () => {
+    expect(formatError(() => parseAMC(amcWithLine(10, () => 'tail 1 2 3'), ASF), 'amc', 10)).toBe('AMC line 10: unknown bone "tail" (not in the ASF skeleton)');
+  });
+
+  it('rejects lines with the wrong number of values', () => {
+    // Line 30 is "lfemur -18.0782 -1.58962 -24.8838" (dof rx ry rz).
+    expect(AMC_LINES[29]).toMatch(/^lfemur /);
+    expect(formatError(() => parseAMC(amcWithLine(30, () => 'lfemur -18.0782 -1.58962'), ASF), 'amc', 30)).toBe('AMC line 30: expected 3 numbers for "lfemur", found 2');
+    expect(formatError(() => parseAMC(amcWithLine(30, (l) => l + ' 4'), ASF), 'amc', 30)).toBe('AMC line 30: expected 3 numbers for "lfemur", found 4');
+  });
+
+  it('rejects NaN and non-numeric values', () => {
+    expect(formatError(() => parseAMC(amcWithLine(30, () => 'lfemur NaN 0 0'), ASF), 'amc', 30)).toBe('AMC line 30: expected a number, found "NaN"');
+    expect(formatError(() => parseAMC(amcWithLine(30, () => 'lfemur 1 two 3'), ASF), 'amc', 30)).toBe('AMC line 30: expected a number, found "two"');
+  });
+
+  it('rejects a truncated file (last frame incomplete)', () => {
+    // Frames are 30 lines (number + 29 bones) after 3 header lines; keep frame 3's first 10 bones.
+    const cut = AMC_LINES.slice(0, 3 + 30 * 2 + 11).join('\n');
+    expect(formatError(() => parseAMC(cut, ASF), 'amc', 64)).toBe('AMC line 64: frame 3 has no values for "lfemur" (file truncated?)');
+    const midLine = AMC.slice(0, AMC.indexOf('\nlfemur', 5000) + 12);
+    expect(formatError(() => parseAMC(midLine, ASF), 'amc')).toMatch(/expected 3 numbers for "lfemur", found [12]/);
+  });
+
+  it('rejects out-of-sequence frame numbers and duplicated bones', () => {
+    expect(formatError(() => parseAMC(amcWithLine(34, () => '7'), ASF), 'amc', 34)).toBe('AMC line 34: expected frame number 2, found 7');
+    expect(formatError(() => parseAMC(amcWithLine(31, () => AMC_LINES[29]), ASF), 'amc', 31)).toBe('AMC line 31: bone "lfemur" appears twice in frame 1');
+    // A frame missing a bone in the middle of the file.
+    expect(formatError(() => parseAMC(amcWithLine(31, () => ''), ASF), 'amc', 4)).toBe('AMC line 4: frame 1 has no values for "ltibia"');
+    expect(formatError(() => parseAMC('root 0 0 0 0 0 0\n', ASF), 'amc', 1)).toMatch(/expected a frame number before "root"/);
+  });
+
+  it('rejects more than a million frames', () => {
+    // A skeleton whose root has no values, so each frame is just its number.
+    const asf = ':units\n  length 1\n:root\n  order\n:bonedata\n:hierarchy\n  begin\n  end\n';
+    let amc = '';
+    for (let f = 1; f <= 1_000_001; f++) amc += f + '\n';
+    expect(formatError(() => parseAMC(amc, asf), 'amc', 1_000_001)).toBe('AMC line 1000001: more than 1000000 frames');
+  });
+});
+
+describe('fuzzed input never hangs and never yields non-finite positions', () => {
+  let seed = 12345;
+  const random = () => ((seed = (seed * 1664525 + 1013904223) >>> 0) / 2 ** 32);
+  const JUNK = ['{', '}', '\n', ' ', 'JOINT', 'End Site', 'OFFSET', '-', '.', 'e', '9', 'NaN', '#', ':', 'root', '1'];
+  const mutate = (text: string) => {
+    let t = text;
+    for (let k = 0; k < 1 + Math.floor(random() * 4); k++) {
+      const at = Math.floor(random() * t.length);
+      const op = random();
+      if (op < 0.4) t = t.slice(0, at) + t.slice(at + 1 + Math.floor(random() * 20));
+      else if (op < 0.8) t = t.slice(0, at) + JUNK[Math.floor(random() * JUNK.length)] + t.slice(at);
+      else t = t.slice(0, at);
+    }
+    return t;
+  };
+  const check = (parse: () => { positions: Float32Array }, format: RegExp) => {
+    try {
+      const m = parse();
+      for (const v of m.positions) expect(Number.isFinite(v)).toBe(true);
+    } catch (e) {
+      expect(e, String(e)).toBeInstanceOf(MotionFormatError);
+      expect((e as MotionFormatError).message).toMatch(format);
+    }
+  };
+  const SMALL_BVH = BVH_LINES.slice(0, FIRST_FRAME_LINE + 4).join('\n').replace('Frames: 450', 'Frames: 5');
+  const SMALL_AMC = AMC_LINES.slice(0, 3 + 30 * 3).join('\n');
+
+  it('for BVH', () => {
+    for (let n = 0; n < 150; n++) check(() => parseBVH(mutate(SMALL_BVH)), /^BVH/);
+  });
+
+  it('for ASF/AMC', () => {
+    for (let n = 0; n < 100; n++) {
+      const asf = mutate(ASF);
+      check(() => parseAMC(SMALL_AMC, asf), /^(ASF|AMC)/); // a damaged ASF may still parse, then misfit the AMC
+      check(() => parseAMC(mutate(SMALL_AMC), ASF), /^AMC/);
+    }
+  });
+});
