@@ -12,9 +12,13 @@
 //
 // Export (exportBVH): centimetres, y up, "Frame Time" = 1/fps; every joint has channels
 // "Zrotation Yrotation Xrotation" (the root has "Xposition Yposition Zposition" first), written in
-// degrees with 6 decimals. Rotations are solved from joint positions; joints with several children get
-// zero-offset helper joints named `<joint>_to_<child>` and leaf joints a zero-offset End Site, both of
-// which the importer drops again, so parseBVH(exportBVH(m)) gives back m's joints and positions.
+// degrees with 6 decimals. The rest pose (OFFSETs) uses each bone's mean length and its direction in
+// the clip's tallest frame. Rotations are solved from joint positions as minimal swings relative to
+// the parent; joints with several children get zero-offset helper joints named `<joint>_to_<child>`
+// and leaf joints a zero-offset End Site, both of which the importer drops again. So
+// parseBVH(exportBVH(m)) gives back m's joint names, parents and positions (rigid skeletons: exactly,
+// up to 6-decimal rounding) provided the joints are in depth-first order, as every importer returns
+// them, and the figure is over about 1.07 m tall (else pass unitScale: 0.01 to parseBVH).
 import { MotionFormatError, type Motion } from './types';
 import {
   DEG, quatAboutAxis, quatConjugate, quatIdentity, quatMultiply, quatRotate, quatToEulerZYX,
@@ -242,7 +246,7 @@ export function parseBVH(text: string, options: BVHOptions = {}): Motion {
   nodes.forEach((n, k) => {
     const zero = n.offset[0] === 0 && n.offset[1] === 0 && n.offset[2] === 0;
     const hasPosition = n.channels.some((c) => c.endsWith('position'));
-    const keep = n.parent < 0 || !zero || (hasPosition && !n.endSite);
+    const keep = n.parent < 0 || !zero || hasPosition;
     if (keep) {
       keptIndex[k] = joints.length;
       joints.push(n.name);
@@ -253,7 +257,10 @@ export function parseBVH(text: string, options: BVHOptions = {}): Motion {
   });
   const J = joints.length;
 
-  const positions = new Float32Array(frames * J * 3);
+  // Allocate for the frame lines actually present, so a bogus "Frames:" cannot reserve memory.
+  let frameLines = 0;
+  for (let k = i; k < lines.length; k++) if (lines[k].trim() !== '') frameLines++;
+  const positions = new Float32Array(Math.min(frames, frameLines) * J * 3);
   const globals: Quat[] = new Array(nodes.length);
   const world: Vec3[] = new Array(nodes.length);
   const values = new Float64Array(channelCount);
