@@ -128,7 +128,7 @@ MOTION
 Frames: 2
 Frame Time: 0.0333333
 0 0 100 0 0 0   0   0 0 0   0 0 50 0
-90 0 100 0 0 0  90  0 0 90  0 0 20 0
+90 0 100 0 0 0  90  90 0 90  0 0 20 0
 `;
   const m = parseBVH(text, { unitScale: 0.01 });
 
@@ -143,12 +143,12 @@ Frame Time: 0.0333333
   });
 
   it('applies channels in the listed order and replaces OFFSET by position channels', () => {
-    // Root: Rx(90) → local +y becomes +z. Twist: Ry(90). Arm: Rx·Rz·Ry with Ry(90).
-    // Arm = root + Rx90·Ry90·(0,100,0) = (1, 100, 100) cm.
-    // Wrist = Arm + G_arm·(0,20,0) with G_arm = Rx90·Ry90·Ry90 → +y ↦ +z: (1, 100, 120).
-    // End = Wrist + G_arm·(10,0,0): Ry180 takes +x to −x, then Rx90 keeps x: (−9, 100, 120).
+    // Root: Rx(90). Twist: Ry(90). Arm "Xrotation Zrotation Yrotation" = (90, 0, 90) → Rx·Ry.
+    // Arm = root + Rx·Ry·(0,100,0) = (1, 100, 100) cm.
+    // G_arm = Rx·Ry·Rx·Ry: Wrist = Arm + G_arm·(0,20,0) = (21, 100, 100) (Ry·Rx would give (1, 120, 100)).
+    // End = Wrist + G_arm·(10,0,0) = (21, 100, 110).
     const f1 = Array.from(m.positions.slice(12, 24)).map((v) => +(v * 100).toFixed(4));
-    expect(f1).toEqual([1, 100, 0, 1, 100, 100, 1, 100, 120, -9, 100, 120]);
+    expect(f1).toEqual([1, 100, 0, 1, 100, 100, 21, 100, 100, 21, 100, 110]);
   });
 });
 
