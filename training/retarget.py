@@ -31,6 +31,14 @@ CMU_BVH_BONES = {
 }
 
 
+# Canonical segments that keep their rest pose relative to their parent:
+# - pelvis to hip joints: no degrees of freedom in CMU; copying each subject's rest correction would give
+#   every subject a different fixed hip rotation;
+# - hands: CMU hand markers are noisy (the hand bone flips by up to 180 degrees between frames), so the
+#   hand continues the forearm (it still turns with the forearm's twist).
+RIGID_BONES = ("lhipjoint", "rhipjoint", "lhand", "rhand")
+
+
 @dataclass
 class SourceMotion:
     """A CMU clip as world bone rotations, independent of the file format."""
@@ -95,6 +103,9 @@ def retarget(src: SourceMotion, skel: Skeleton | None = None) -> CanonicalClip:
     for j, bones in enumerate(skel.source_bones):
         if not bones:
             world[:, j] = src.rotations["root"]
+            continue
+        if bones[0] in RIGID_BONES:
+            world[:, j] = world[:, skel.parents[j]]
             continue
         owner = bones[0]
         rest = src.rest[owner]

@@ -4,7 +4,7 @@ import pytest
 
 from training.dataset import load_clip, read_index
 from training.resample import resample
-from training.retarget import retarget, source_from_amc
+from training.retarget import RIGID_BONES, retarget, source_from_amc
 from training.skeleton import GROUND_POINTS, canonical_skeleton, forward_kinematics
 from training import asf_amc
 
@@ -45,13 +45,13 @@ def test_every_clip_loads_with_canonical_bone_lengths(all_clips):
 
 
 def test_every_clip_has_its_feet_on_the_floor(all_clips):
-    """Per clip, at least two thirds of its one-second windows have their lowest foot point within 3 cm
-    of y = 0 (a sloped or offset floor fails this), and over the corpus at least 95% do."""
+    """Per clip, most (60%) of its one-second windows have their lowest foot point within 3 cm of y = 0
+    (a sloped or offset floor fails this), and over the corpus at least 95% do (docs/data.md)."""
     total, close = 0, 0
     for info, clip in all_clips:
         lows = window_lows(clip.positions, clip.fps)
         ok = np.abs(lows) < TOLERANCE
-        assert ok.mean() >= 2 / 3, (info.file, np.round(lows, 3))
+        assert ok.mean() >= 0.6, (info.file, np.round(lows, 3))
         total += len(ok)
         close += ok.sum()
     assert close / total >= 0.95
@@ -63,7 +63,7 @@ def test_retarget_keeps_every_bone_direction(mocap):
     names, src = asf_amc.positions(skel_src, motion)
     clip = retarget(source_from_amc(mocap / "cmu/asf/16.asf", mocap / "cmu/amc/16_11.amc.gz"))
     for j, bones in enumerate(SKEL.source_bones):
-        if not bones or bones[0] in ("lhand", "rhand"):  # hand segments merge two CMU bones
+        if not bones or bones[0] in RIGID_BONES:  # kept in their rest pose on purpose
             continue
         b = bones[0]
         parent = skel_src.parent[b]
