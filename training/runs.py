@@ -1,0 +1,46 @@
+"""Shared plumbing for training runs: run directory, log file, timed checkpoints, resume."""
+from __future__ import annotations
+
+import logging
+import time
+from pathlib import Path
+
+import torch
+
+from .paths import REPO_ROOT
+
+RUNS_DIR = REPO_ROOT / "runs"
+
+
+class Run:
+    """A training run living in runs/<name>/: train.log, checkpoint.pt (latest), best.pt."""
+
+    def __init__(self, name: str, checkpoint_minutes: float = 3.0):
+        self.dir = RUNS_DIR / name
+        self.dir.mkdir(parents=True, exist_ok=True)
+        self.checkpoint_path = self.dir / "checkpoint.pt"
+        self.best_path = self.dir / "best.pt"
+        self.log = logging.getLogger(f"run.{name}")
+        self.log.setLevel(logging.INFO)
+        if not self.log.handlers:
+            handler = logging.FileHandler(self.dir / "train.log")
+            handler.setFormatter(logging.Formatter("%(asctime)s %(message)s"))
+            self.log.addHandler(handler)
+        self.interval = checkpoint_minutes * 60
+        self.last_save = time.monotonic()
+
+    def save(self, state: dict, path: Path | None = None) -> None:
+        path = path or self.checkpoint_path
+        tmp = path.with_suffix(".tmp")
+        torch.save(state, tmp)
+        tmp.replace(path)  # never leave a half-written checkpoint behind
+        if path == self.checkpoint_path:
+            self.last_save = time.monotonic()
+
+    def due(self) -> bool:
+        return time.monotonic() - self.last_save >= self.interval
+
+    def load(self) -> dict | None:
+        if not self.checkpoint_path.exists():
+            return None
+        return torch.load(self.checkpoint_path, weights_only=False)
