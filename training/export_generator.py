@@ -1,0 +1,166 @@
+"""Export the trained generator to ONNX plus its JSON, with seed states and a parity check.
+
+    python -m training.export_generator [--checkpoint runs/generator/best.pt]
+
+Writes public/models/generator.onnx (one step: x, h, c -> weights, mu, sigma, h_out, c_out; the batch
+dimension is dynamic) and public/models/generator.json (skeleton, feature layout, normalisation,
+rotation references, seed states estimated as in eq. 26, training and parity numbers).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+import onnxruntime as ort
+import torch
+
+from .features import FIXED_JOINTS, FeatureCodec, feature_names
+from .models.generator import GeneratorStep, MixtureLSTM, mixture_nll
+from .paths import REPO_ROOT
+from .rotations import matrix_to_quat
+from .runs import RUNS_DIR
+from .skeleton import canonical_skeleton
+from .train_generator import load_clips
+
+MODELS_DIR = REPO_ROOT / "public" / "models"
+INPUTS, OUTPUTS = ["x", "h", "c"], ["weights", "mu", "sigma", "h_out", "c_out"]
+PARITY_TOLERANCE = 1e-4
+
+
+def load_generator(checkpoint: Path) -> tuple[MixtureLSTM, dict, dict]:
+    state = torch.load(checkpoint, weights_only=False)
+    meta = state["meta"]
+    model = MixtureLSTM(meta["dim"], meta["hidden"], meta["mixtures"])
+    model.load_state_dict(state["model"])
+    return model.eval(), meta, state
+
+
+def export_onnx(model: MixtureLSTM, path: Path) -> None:
+    step = GeneratorStep(model).eval()
+    x = torch.zeros(1, model.dim)
+    h, c = model.zero_state(1)
+    batch = {0: "batch"}
+    torch.onnx.export(step, (x, h, c), str(path), input_names=INPUTS, output_names=OUTPUTS, opset_version=17,
+                      dynamo=False, dynamic_axes={"x": batch, "h": {1: "batch"}, "c": {1: "batch"}, "weights": batch,
+                                                  "mu": batch, "sigma": batch, "h_out": {1: "batch"}, "c_out": {1: "batch"}})
+
+
+def check_parity(model: MixtureLSTM, path: Path, steps: int = 20) -> dict:
+    """Run torch and onnxruntime side by side for several steps at batch 1 and 7, feeding states back."""
+    session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
+    step = GeneratorStep(model).eval()
+    rng = np.random.default_rng(1)
+    worst = 0.0
+    for batch in (1, 7):
+        h, c = (s.numpy() for s in model.zero_state(batch))
+        for _ in range(steps):
+            x = rng.normal(size=(batch, model.dim)).astype(np.float32)
+            with torch.no_grad():
+                ref = [t.numpy() for t in step(torch.from_numpy(x), torch.from_numpy(h), torch.from_numpy(c))]
+            got = session.run(OUTPUTS, {"x": x, "h": h, "c": c})
+            worst = max(worst, max(float(np.abs(a - b).max()) for a, b in zip(ref, got)))
+            h, c = ref[3], ref[4]
+    if worst > PARITY_TOLERANCE:
+        raise SystemExit(f"error: ONNX parity failed, max |torch - onnxruntime| = {worst:.2e} > {PARITY_TOLERANCE:.0e}")
+    return {"max_abs_diff": worst, "tolerance": PARITY_TOLERANCE, "batches": [1, 7], "steps": steps}
+
+
+def estimate_initial_state(model: MixtureLSTM, x: torch.Tensor, iterations: int = 300) -> tuple[torch.Tensor, torch.Tensor, float, float]:
+    """Eq. 26: find (h, c) for the first frame that make the following real frames likely.
+
+    x holds a few real normalised frames (time, dim). Returns h, c and the NLL of the frames after the
+    first, from a zero state and from the estimated one."""
+    h0, c0 = model.zero_state(1)
+    h = h0.clone().requires_grad_(True)
+    c = c0.clone().requires_grad_(True)
+    inputs, targets = x[:-1].unsqueeze(0), x[1:].unsqueeze(0)
+
+    def nll(h_, c_):
+        logits, mu, log_sigma, _ = model(inputs, (h_, c_))
+        return mixture_nll(logits, mu, log_sigma, targets).mean()
+
+    with torch.no_grad():
+        zero_nll = float(nll(h0, c0))
+    opt = torch.optim.Adam([h, c], lr=0.05)
+    for _ in range(iterations):
+        opt.zero_grad()
+        loss = nll(h, c)
+        loss.backward()
+        opt.step()
+    with torch.no_grad():
+        return h.detach(), c.detach(), zero_nll, float(nll(h, c))
+
+
+def pick_seeds(clips: list[dict], codec: FeatureCodec, mean: np.ndarray, std: np.ndarray, count_per_category=(6, 2)):
+    """Seed frames from held-out and training clips: a spread of walking speeds and some running."""
+    seeds = []
+    for category, count in zip(("walk", "run"), count_per_category):
+        pool = sorted((c for c in clips if c["category"] == category and len(c["root"]) > 12), key=lambda c: c["file"])
+        for k in np.linspace(0, len(pool) - 1, count).round().astype(int):
+            c = pool[k]
+            x = codec.encode(c["root"], c["rotations"], c["contacts"])
+            start = len(x) // 3
+            seeds.append({"name": f"{category} {c['file'].split('/')[-1].split('.')[0]}", "file": c["file"],
+                          "category": category, "frames": ((x[start:start + 6] - mean) / std).astype(np.float32)})
+    return seeds
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--checkpoint", type=Path, default=RUNS_DIR / "generator" / "best.pt")
+    parser.add_argument("--out", type=Path, default=MODELS_DIR)
+    parser.add_argument("--mocap", default=None)
+    args = parser.parse_args(argv)
+    if not args.checkpoint.exists():
+        raise SystemExit(f"error: no checkpoint at {args.checkpoint}; train first with python -m training.train_generator")
+    model, meta, state = load_generator(args.checkpoint)
+    args.out.mkdir(parents=True, exist_ok=True)
+    onnx_path = args.out / "generator.onnx"
+    export_onnx(model, onnx_path)
+    parity = check_parity(model, onnx_path)
+    print(f"parity ok: max |torch - onnxruntime| = {parity['max_abs_diff']:.2e}")
+
+    skel = canonical_skeleton()
+    codec = FeatureCodec(skel, np.array(meta["references"]))
+    mean, std = np.array(meta["mean"]), np.array(meta["std"])
+    seeds = []
+    for seed in pick_seeds(load_clips(args.mocap), codec, mean, std):
+        frames = torch.from_numpy(seed["frames"])
+        h, c, zero_nll, est_nll = estimate_initial_state(model, frames)
+        seeds.append({"name": seed["name"], "file": seed["file"], "category": seed["category"],
+                      "x": [round(float(v), 6) for v in seed["frames"][0]],
+                      "h": [round(float(v), 6) for v in h.reshape(-1)], "c": [round(float(v), 6) for v in c.reshape(-1)],
+                      "nll_zero_state": round(zero_nll, 3), "nll_estimated_state": round(est_nll, 3)})
+        print(f"seed {seed['name']}: NLL of the next frames {zero_nll:.1f} from a zero state, {est_nll:.1f} estimated")
+    fixed = [skel.index(n) for n in FIXED_JOINTS]
+    info = {
+        "id": "generator", "kind": "lstm-gmm", "fps": meta["fps"], "file": "generator.onnx",
+        "bytes": onnx_path.stat().st_size,
+        "description": "Contact-aware LSTM with a 5-component Gaussian mixture over the next frame (Wang, Chai, Xia §4.1), "
+                       "trained on CMU walking and running.",
+        "skeleton": skel.to_json(),
+        "onnx": {"inputs": INPUTS, "outputs": OUTPUTS, "opset": 17, "layers": 2, "hidden": meta["hidden"],
+                 "mixtures": meta["mixtures"], "dim": meta["dim"]},
+        "features": {
+            "names": feature_names(skel), "joints": codec.joints, "fixed_joints": fixed,
+            "layout": "x = [dtx, dtz, dry, ty, root tilt rotvec(3), joint rotvecs (3 per joint in `joints`), contact L, contact R]; "
+                      "dtx/dtz: root step in the previous frame's heading frame (m); dry: heading change (rad, about +y); "
+                      "rotvecs are relative to `references` (local rotation = reference * exp(rotvec)); "
+                      "references[0] is the root tilt's, references[j] joint j's; fixed joints keep their reference.",
+            "references": [[round(float(v), 7) for v in q] for q in matrix_to_quat(codec.references)],
+        },
+        "normalisation": {"mean": [round(float(v), 7) for v in mean], "std": [round(float(v), 7) for v in std]},
+        "seeds": seeds,
+        "training": {"epochs": state.get("epoch"), "valid_nll_per_frame": state.get("valid_nll"),
+                     "valid_files": meta["valid_files"], "train_frames": meta["train_frames"],
+                     "args": meta["args"]},
+        "parity": parity,
+    }
+    (args.out / "generator.json").write_text(json.dumps(info) + "\n")
+    print(f"wrote {onnx_path} ({onnx_path.stat().st_size / 1e6:.2f} MB) and generator.json")
+
+
+if __name__ == "__main__":
+    main()

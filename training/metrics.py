@@ -1,0 +1,71 @@
+"""Motion quality measures shared by the evaluation reports."""
+from __future__ import annotations
+
+import numpy as np
+
+from .skeleton import Skeleton
+
+TOES = ("LeftToeBase", "RightToeBase")
+
+
+def foot_skating(positions: np.ndarray, contacts: np.ndarray, fps: float, skel: Skeleton) -> float:
+    """Mean horizontal speed (m/s) of the toe of a foot while that foot is labelled as planted."""
+    speeds = []
+    for side, name in enumerate(TOES):
+        toe = positions[:, skel.index(name)][:, [0, 2]]
+        v = np.linalg.norm(np.diff(toe, axis=0), axis=-1) * fps
+        planted = (contacts[1:, side] > 0) & (contacts[:-1, side] > 0)
+        speeds.append(v[planted])
+    allv = np.concatenate(speeds)
+    return float(allv.mean()) if len(allv) else float("nan")
+
+
+def root_speed(features: np.ndarray, fps: float) -> np.ndarray:
+    """Horizontal root speed per frame (m/s) from generator features."""
+    return np.hypot(features[:, 0], features[:, 1]) * fps
+
+
+def turning_rate(features: np.ndarray, fps: float) -> np.ndarray:
+    """Signed heading change per frame as a rate (rad/s)."""
+    return features[:, 2] * fps
+
+
+def pose_change_per_second(positions: np.ndarray, fps: float) -> np.ndarray:
+    """Mean joint speed relative to the root (m/s), averaged over each whole second: low values mean a frozen pose."""
+    local = positions - positions[:, :1]
+    speed = np.linalg.norm(np.diff(local, axis=0), axis=-1).mean(axis=1) * fps
+    step = int(round(fps))
+    return np.array([speed[a:a + step].mean() for a in range(0, len(speed) - step + 1, step)])
+
+
+def power_spectra(windows: np.ndarray) -> np.ndarray:
+    """Per-window, per-dimension power spectrum (windows, freq, dims) of mean-removed windows (windows, time, dims)."""
+    w = windows - windows.mean(axis=1, keepdims=True)
+    return np.abs(np.fft.rfft(w, axis=1)) ** 2
+
+
+def npss(real: np.ndarray, generated: np.ndarray) -> float:
+    """Normalized power spectrum similarity (Gopalakrishnan et al. 2019) between two sets of windows
+    (n, time, dims): earth mover's distance between the mean normalised spectra of each dimension,
+    weighted by the real power of that dimension. 0 means identical spectra."""
+    pr, pg = power_spectra(real).mean(axis=0), power_spectra(generated).mean(axis=0)
+    total_r, total_g = pr.sum(axis=0), pg.sum(axis=0)
+    nr, ng = pr / np.maximum(total_r, 1e-12), pg / np.maximum(total_g, 1e-12)
+    emd = np.abs(np.cumsum(nr, axis=0) - np.cumsum(ng, axis=0)).sum(axis=0)
+    return float((emd * total_r).sum() / total_r.sum())
+
+
+def windows_of(seqs: list[np.ndarray], length: int, stride: int) -> np.ndarray:
+    out = [s[a:a + length] for s in seqs for a in range(0, len(s) - length + 1, stride)]
+    return np.stack(out) if out else np.zeros((0, length, seqs[0].shape[1]))
+
+
+def wasserstein_1d(a: np.ndarray, b: np.ndarray) -> float:
+    """Earth mover's distance between two 1-D samples (same units as the samples)."""
+    qs = np.linspace(0, 1, 201)
+    return float(np.abs(np.quantile(a, qs) - np.quantile(b, qs)).mean())
+
+
+def summary(values: np.ndarray) -> dict:
+    return {"mean": float(np.mean(values)), "p10": float(np.percentile(values, 10)),
+            "p50": float(np.percentile(values, 50)), "p90": float(np.percentile(values, 90))}
