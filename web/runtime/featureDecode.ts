@@ -1,0 +1,95 @@
+// Generator feature rows (physical units) → root trajectory, local rotations and joint positions.
+// A port of training/features.py FeatureCodec.decode followed by forward kinematics; keep the two in step.
+import { forwardKinematics } from '../motion/skeleton';
+import { quatMultiply, quatNormalize, type Quat } from '../motion/math';
+import type { Skeleton } from '../motion/types';
+import { JOINT_FEATURES_START, type GeneratorInfo } from './generatorModel';
+
+/** Where the character stands before the first decoded frame (metres, radians; heading 0 faces +z). */
+export interface RootStart {
+  x: number;
+  z: number;
+  heading: number;
+}
+
+export interface DecodedFeatures {
+  /** frames × joints × 3, world metres. */
+  positions: Float32Array;
+  /** frames × 2 (left, right), 1 = planted. */
+  contacts: Uint8Array;
+  /** Heading of each frame (radians, unwrapped). */
+  rootHeading: Float32Array;
+  /** Root state after the last frame, in double precision: pass it as `start` to continue. */
+  end: RootStart;
+}
+
+/** Rotation by `angle` about +y. */
+function yawQuat(angle: number): Quat {
+  return [0, Math.sin(angle / 2), 0, Math.cos(angle / 2)];
+}
+
+/** exp of a rotation vector: rotation by |v| about v/|v|. */
+function rotvecToQuat(x: number, y: number, z: number): Quat {
+  const angle = Math.sqrt(x * x + y * y + z * z);
+  const s = angle > 1e-9 ? Math.sin(angle / 2) / angle : 0.5;
+  return [x * s, y * s, z * s, Math.cos(angle / 2)];
+}
+
+export function generatorSkeleton(info: GeneratorInfo): Skeleton {
+  return {
+    joints: info.skeleton.joints,
+    parents: info.skeleton.parents,
+    offsets: Float32Array.from(info.skeleton.offsets),
+  };
+}
+
+export function decodeFeatures(info: GeneratorInfo, features: Float32Array, start: RootStart = { x: 0, z: 0, heading: 0 }): DecodedFeatures {
+  const D = info.onnx.dim;
+  const skeleton = generatorSkeleton(info);
+  const J = skeleton.parents.length;
+  if (features.length % D !== 0) throw new Error(`decodeFeatures: ${features.length} values is not a whole number of ${D}-value frames`);
+  const frames = features.length / D;
+  const references = info.features.references.map((q) => quatNormalize(q as Quat));
+  const featureJoints = info.features.joints;
+
+  const rootPositions = new Float32Array(frames * 3);
+  const rotations = new Float32Array(frames * J * 4);
+  const contacts = new Uint8Array(frames * 2);
+  const rootHeading = new Float32Array(frames);
+
+  let x = start.x;
+  let z = start.z;
+  let heading = start.heading;
+  for (let f = 0; f < frames; f++) {
+    const row = f * D;
+    const dtx = features[row], dtz = features[row + 1];
+    // The step is expressed in the previous frame's heading frame.
+    const c = Math.cos(heading), s = Math.sin(heading);
+    x += c * dtx + s * dtz;
+    z += -s * dtx + c * dtz;
+    heading += features[row + 2];
+    rootPositions[f * 3] = x;
+    rootPositions[f * 3 + 1] = features[row + 3];
+    rootPositions[f * 3 + 2] = z;
+    rootHeading[f] = heading;
+
+    const base = f * J * 4;
+    for (let j = 0; j < J; j++) rotations.set(references[j], base + j * 4); // fixed joints keep their reference
+    const tilt = quatMultiply(references[0], rotvecToQuat(features[row + 4], features[row + 5], features[row + 6]));
+    rotations.set(quatMultiply(yawQuat(heading), tilt), base);
+    for (let k = 0; k < featureJoints.length; k++) {
+      const j = featureJoints[k];
+      const o = row + JOINT_FEATURES_START + 3 * k;
+      rotations.set(quatMultiply(references[j], rotvecToQuat(features[o], features[o + 1], features[o + 2])), base + j * 4);
+    }
+    contacts[f * 2] = features[row + D - 2] > 0.5 ? 1 : 0;
+    contacts[f * 2 + 1] = features[row + D - 1] > 0.5 ? 1 : 0;
+  }
+
+  return {
+    positions: forwardKinematics(skeleton, rootPositions, rotations),
+    contacts,
+    rootHeading,
+    end: { x, z, heading },
+  };
+}
