@@ -1,0 +1,107 @@
+// Drawing the generator's next frame from its Gaussian mixture output, deterministically from a seed.
+// Mirrors training/generate.py (sample_mixture and the contact snapping in ShippedGenerator.sample).
+
+/** Seeded PRNG: mulberry32 for uniforms, Box–Muller for standard normals. Same seed → same sequence. */
+export class Rng {
+  private state: number;
+  private spareNormal: number | undefined;
+
+  constructor(seed: number) {
+    this.state = seed >>> 0;
+  }
+
+  /** Uniform in [0, 1). */
+  uniform(): number {
+    this.state = (this.state + 0x6d2b79f5) | 0;
+    let t = Math.imul(this.state ^ (this.state >>> 15), 1 | this.state);
+    t = (t + Math.imul(t ^ (t >>> 7), 61 | t)) ^ t;
+    return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
+  }
+
+  /** Standard normal N(0, 1). */
+  normal(): number {
+    if (this.spareNormal !== undefined) {
+      const value = this.spareNormal;
+      this.spareNormal = undefined;
+      return value;
+    }
+    const u1 = 1 - this.uniform(); // (0, 1], so the log is finite
+    const u2 = this.uniform();
+    const radius = Math.sqrt(-2 * Math.log(u1));
+    this.spareNormal = radius * Math.sin(2 * Math.PI * u2);
+    return radius * Math.cos(2 * Math.PI * u2);
+  }
+}
+
+/** One ONNX step's mixture output for a batch: weights (B×M), mu and sigma (B×M×D). */
+export interface MixtureBatch {
+  weights: Float32Array;
+  mu: Float32Array;
+  sigma: Float32Array;
+  batch: number;
+  mixtures: number;
+  dim: number;
+}
+
+/**
+ * One draw per batch row: component k with probability ∝ w_k^(1/τ), then mu_k + sigma_k·τ·N(0, 1) per
+ * dimension. τ ≤ 0 takes the heaviest component's mean and uses no random numbers.
+ */
+export function sampleMixture(m: MixtureBatch, temperature: number, rng: Rng, out = new Float32Array(m.batch * m.dim)): Float32Array {
+  const { batch, mixtures: M, dim: D } = m;
+  if (m.weights.length !== batch * M || m.mu.length !== batch * M * D || m.sigma.length !== batch * M * D) {
+    throw new Error(`sampleMixture: output sizes (${m.weights.length}, ${m.mu.length}, ${m.sigma.length}) do not fit batch ${batch}, ${M} mixtures, dim ${D}`);
+  }
+  if (out.length !== batch * D) throw new Error(`sampleMixture: out has ${out.length} values, expected ${batch * D}`);
+  const p = new Float64Array(M);
+  for (let b = 0; b < batch; b++) {
+    const w = m.weights.subarray(b * M, (b + 1) * M);
+    let k = 0;
+    if (temperature <= 0) {
+      for (let i = 1; i < M; i++) if (w[i] > w[k]) k = i;
+    } else {
+      // w^(1/τ) through logs, shifted by the largest, so small τ cannot underflow every weight to 0.
+      let largest = -Infinity;
+      for (let i = 0; i < M; i++) {
+        p[i] = Math.log(Math.max(w[i], 1e-12)) / temperature;
+        largest = Math.max(largest, p[i]);
+      }
+      let total = 0;
+      for (let i = 0; i < M; i++) total += p[i] = Math.exp(p[i] - largest);
+      let u = rng.uniform() * total;
+      k = M - 1;
+      for (let i = 0; i < M; i++) {
+        u -= p[i];
+        if (u < 0) {
+          k = i;
+          break;
+        }
+      }
+    }
+    const src = (b * M + k) * D;
+    for (let d = 0; d < D; d++) {
+      out[b * D + d] = temperature <= 0 ? m.mu[src + d] : m.mu[src + d] + m.sigma[src + d] * temperature * rng.normal();
+    }
+  }
+  return out;
+}
+
+/**
+ * Contacts are bits: sets the last two (normalised) dimensions of each row to the normalised value of
+ * exactly 0 or 1, whichever the de-normalised value is nearer to (threshold 0.5).
+ */
+export function snapContacts(x: Float32Array, dim: number, mean: ArrayLike<number>, std: ArrayLike<number>): void {
+  for (let row = 0; row < x.length; row += dim) {
+    for (let d = dim - 2; d < dim; d++) {
+      const on = x[row + d] * std[d] + mean[d] > 0.5;
+      x[row + d] = ((on ? 1 : 0) - mean[d]) / std[d];
+    }
+  }
+}
+
+/** Physical units from normalised features: x·std + mean, per dimension. */
+export function denormalise(x: Float32Array, mean: ArrayLike<number>, std: ArrayLike<number>, out = new Float32Array(x.length)): Float32Array {
+  const D = mean.length;
+  for (let i = 0; i < x.length; i++) out[i] = x[i] * std[i % D] + mean[i % D];
+  return out;
+}
