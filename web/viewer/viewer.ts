@@ -1,0 +1,287 @@
+// The three.js viewer: scene, orbit camera (optionally following the root), time-based playback with
+// interpolation between frames, and the ground decorations (trail, footprints, blob shadow).
+
+import * as THREE from 'three';
+import './palette'; // first: sets up colour handling
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+import type { Motion } from '../motion/types';
+import { Figure } from './figure';
+import { BACKGROUND, BlobShadow, Floor, FloorGlow, Footprints, Trail } from './ground';
+import { Playback, type PlaybackState } from './playback';
+import { chooseQuality, DynamicResolution, probeGL, type GLInfo, type Quality } from './quality';
+
+export interface ViewerLayers {
+  follow: boolean;
+  trail: boolean;
+  footprints: boolean;
+}
+
+export interface RenderStats {
+  /** Smoothed display frame rate. */
+  fps: number;
+  /** Device pixels per CSS pixel currently rendered (dynamic resolution). */
+  pixelRatio: number;
+  quality: Quality;
+  /** WebGL renderer string, e.g. "ANGLE (Google, Vulkan 1.3.0 (SwiftShader Device …))". */
+  renderer: string;
+  software: boolean;
+}
+
+export class Viewer {
+  readonly renderer: THREE.WebGLRenderer;
+  readonly scene = new THREE.Scene();
+  readonly camera = new THREE.PerspectiveCamera(38, 1, 0.1, 200);
+  readonly controls: OrbitControls;
+  readonly playback = new Playback();
+  /** Called after every rendered frame (for the UI's time display). */
+  onFrame: ((s: PlaybackState) => void) | null = null;
+  /** Smoothed display frame rate, for the UI. */
+  displayFps = 0;
+
+  private readonly floor = new Floor();
+  private readonly glow = new FloorGlow();
+  private readonly shadow = new BlobShadow();
+  private readonly trail = new Trail();
+  private readonly footprints = new Footprints();
+  private figure: Figure | null = null;
+  private motion: Motion | null = null;
+  private pose = new Float32Array(0);
+  private root = 0;
+  private targetY = 0.9;
+  private figureHeight = 1.7;
+  private follow = true;
+  private snap = true;
+  private last = 0;
+  private readonly tmp = new THREE.Vector3();
+  private readonly gl: GLInfo;
+  private readonly quality: Quality;
+  private readonly basePixelRatio: number;
+  private readonly resolution: DynamicResolution;
+
+  constructor(private readonly container: HTMLElement) {
+    this.gl = probeGL();
+    this.quality = chooseQuality(this.gl);
+    const high = this.quality === 'high';
+    this.renderer = new THREE.WebGLRenderer({ antialias: high, alpha: false, powerPreference: 'high-performance' });
+    this.basePixelRatio = high ? Math.min(window.devicePixelRatio || 1, 2) : 1;
+    this.resolution = new DynamicResolution(high ? 0.5 : 0.4, 1, high ? 1 : 0.75);
+    this.renderer.setPixelRatio(this.basePixelRatio * this.resolution.scale);
+    this.scene.background = BACKGROUND;
+    this.scene.fog = new THREE.Fog(BACKGROUND, 8, 26);
+    this.renderer.outputColorSpace = THREE.LinearSRGBColorSpace; // colours are used as given (see palette.ts)
+    this.renderer.domElement.classList.add('viewer-canvas');
+    container.appendChild(this.renderer.domElement);
+
+    // No lights: the figure shades itself (figure.ts) and the ground layers are unlit.
+    this.scene.add(this.glow.mesh, this.floor.group, this.shadow.mesh, this.trail.group, this.footprints.group);
+    this.shadow.mesh.visible = false;
+
+    this.camera.position.set(3.2, 1.9, 4.6);
+    this.controls = new OrbitControls(this.camera, this.renderer.domElement);
+    this.controls.target.set(0, 0.9, 0);
+    this.controls.enableDamping = true;
+    this.controls.dampingFactor = 0.12;
+    this.controls.minDistance = 0.5;
+    this.controls.maxDistance = 60;
+    this.controls.maxPolarAngle = Math.PI * 0.495; // stay above the floor
+    this.controls.update();
+
+    new ResizeObserver(() => this.resize()).observe(container);
+    this.resize();
+    this.last = performance.now();
+    this.renderer.setAnimationLoop((t) => this.tick(t));
+  }
+
+  get current(): Motion | null {
+    return this.motion;
+  }
+
+  /** Shows a motion (already validated) from its first frame, playing. */
+  setMotion(motion: Motion, contacts: Uint8Array | undefined): void {
+    const J = motion.joints.length;
+    const figure = new Figure(motion);
+    if (this.figure) {
+      this.scene.remove(this.figure.mesh);
+      this.figure.dispose();
+    }
+    this.figure = figure;
+    this.scene.add(figure.mesh);
+    this.motion = motion;
+    this.pose = new Float32Array(J * 3);
+    this.root = Math.max(0, motion.parents.indexOf(-1));
+
+    // Camera height: around the hips, from the clip's mean root height; figure size from frame 0.
+    let sumY = 0;
+    for (let f = 0; f < motion.frames; f++) sumY += motion.positions[(f * J + this.root) * 3 + 1];
+    const meanRootY = sumY / motion.frames;
+    let minY = Infinity, maxY = -Infinity;
+    for (let j = 0; j < J; j++) {
+      const y = motion.positions[j * 3 + 1];
+      minY = Math.min(minY, y);
+      maxY = Math.max(maxY, y);
+    }
+    this.figureHeight = Math.min(Math.max(maxY - minY, 0.5), 3);
+    this.targetY = Math.min(Math.max(meanRootY * 0.72, 0.25), 2); // a bit low: the figure sits above the playback bar
+
+    this.trail.build(motion, this.root);
+    this.footprints.build(motion, contacts);
+    this.shadow.mesh.visible = true;
+    this.playback.reset(motion.frames, motion.fps);
+    this.playback.playing = true;
+    this.applyPose();
+    this.frameCharacter();
+  }
+
+  play(): void { if (this.motion) this.playback.playing = true; }
+  pause(): void { this.playback.playing = false; }
+  toggle(): void { if (this.playback.playing) this.pause(); else this.play(); }
+
+  seek(frame: number): void {
+    if (!this.motion) return;
+    this.playback.seek(frame);
+    this.applyPose();
+    this.snap = true;
+  }
+
+  /** Pauses and moves by whole frames. */
+  step(delta: number): void {
+    if (!this.motion) return;
+    this.pause();
+    this.seek(Math.round(this.playback.frameFloat) + delta);
+  }
+
+  setSpeed(x: number): number { return this.playback.setSpeed(x); }
+
+  state(): PlaybackState { return this.playback.state(); }
+
+  stats(): RenderStats {
+    return {
+      fps: this.displayFps,
+      pixelRatio: this.renderer.getPixelRatio(),
+      quality: this.quality,
+      renderer: this.gl.renderer,
+      software: this.gl.software,
+    };
+  }
+
+  layers(): ViewerLayers {
+    return { follow: this.follow, trail: this.trail.group.visible, footprints: this.footprints.group.visible };
+  }
+
+  setLayers(l: Partial<ViewerLayers>): void {
+    if (l.follow !== undefined) { this.follow = l.follow; if (l.follow) this.snap = false; }
+    if (l.trail !== undefined) this.trail.group.visible = l.trail;
+    if (l.footprints !== undefined) this.footprints.group.visible = l.footprints;
+  }
+
+  /** Number of footprints placed for the shown motion. */
+  get footprintCount(): number { return this.footprints.count; }
+
+  /** Puts the camera at a three-quarter view of the figure, looking across its direction of travel. */
+  frameCharacter(): void {
+    if (!this.motion) return;
+    const m = this.motion;
+    const J = m.joints.length;
+    const P = m.positions;
+    // Direction of travel around the current frame (±1 s), else over the whole clip, else +z.
+    const f = this.playback.frame, w = Math.round(m.fps);
+    const dir = (a: number, b: number) => {
+      const r0 = (a * J + this.root) * 3, r1 = (b * J + this.root) * 3;
+      return [P[r1] - P[r0], P[r1 + 2] - P[r0 + 2]];
+    };
+    let [dx, dz] = dir(Math.max(0, f - w), Math.min(m.frames - 1, f + w));
+    if (Math.hypot(dx, dz) < 0.3) [dx, dz] = dir(0, m.frames - 1);
+    const l = Math.hypot(dx, dz);
+    if (l < 0.3) { dx = 0; dz = 1; } else { dx /= l; dz /= l; }
+    // Look across the direction of travel, a little from the front: the walk crosses the screen with
+    // its trail and footprints on either side of the figure.
+    const a = (62 * Math.PI) / 180;
+    const cx = dx * Math.cos(a) + dz * Math.sin(a), cz = -dx * Math.sin(a) + dz * Math.cos(a);
+    const dist = this.figureHeight * 3.1;
+    const root = this.rootNow();
+    this.controls.target.set(root.x, this.targetY, root.z);
+    this.camera.position.set(root.x + cx * dist, this.targetY + dist * 0.42, root.z + cz * dist);
+    this.snap = true;
+    this.controls.update();
+  }
+
+  /** Fits the whole root trajectory in view (and stops following the root). */
+  frameAll(): void {
+    if (!this.motion) return;
+    const m = this.motion, J = m.joints.length;
+    const box = new THREE.Box3();
+    for (let f = 0; f < m.frames; f++) {
+      const o = (f * J + this.root) * 3;
+      box.expandByPoint(this.tmp.set(m.positions[o], 0, m.positions[o + 2]));
+    }
+    box.expandByScalar(0.6);
+    box.max.y = this.figureHeight;
+    const center = box.getCenter(new THREE.Vector3());
+    const radius = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 1.5);
+    const dist = radius / Math.sin(THREE.MathUtils.degToRad(this.camera.fov / 2)) * 0.9;
+    const dir = this.camera.position.clone().sub(this.controls.target).normalize();
+    if (dir.y < 0.35) { dir.y = 0.35; dir.normalize(); }
+    this.follow = false;
+    this.controls.target.copy(center).setY(this.targetY * 0.6);
+    this.camera.position.copy(this.controls.target).addScaledVector(dir, dist);
+    this.controls.update();
+  }
+
+  private rootNow(): THREE.Vector3 {
+    const r = this.root * 3;
+    return this.tmp.set(this.pose[r], this.pose[r + 1], this.pose[r + 2]);
+  }
+
+  private applyPose(): void {
+    const m = this.motion;
+    if (!m || !this.figure) return;
+    const n = m.joints.length * 3;
+    const ff = this.playback.frameFloat;
+    const i0 = Math.floor(ff), i1 = Math.min(i0 + 1, m.frames - 1), a = ff - i0;
+    const P = m.positions, o0 = i0 * n, o1 = i1 * n;
+    for (let k = 0; k < n; k++) this.pose[k] = P[o0 + k] + (P[o1 + k] - P[o0 + k]) * a;
+    this.figure.update(this.pose);
+    const root = this.rootNow();
+    this.shadow.update(root.x, root.z, this.figureHeight * 0.55);
+    this.glow.setCenter(root.x, root.z);
+    this.trail.setProgress(ff);
+    this.footprints.setProgress(this.playback.frame);
+  }
+
+  private tick(now: number): void {
+    const dt = Math.min(Math.max((now - this.last) / 1000, 0), 0.1);
+    this.last = now;
+    if (dt > 0) this.displayFps = this.displayFps ? this.displayFps * 0.95 + (1 / dt) * 0.05 : 1 / dt;
+    if (this.resolution.sample(dt, now)) {
+      this.renderer.setPixelRatio(this.basePixelRatio * this.resolution.scale);
+      this.resize();
+    }
+    if (this.motion) {
+      if (this.playback.playing) {
+        this.playback.advance(dt);
+        this.applyPose();
+      }
+      if (this.follow) {
+        const root = this.rootNow();
+        const k = this.snap ? 1 : 1 - Math.exp(-dt * 5);
+        const dx = (root.x - this.controls.target.x) * k;
+        const dy = (this.targetY - this.controls.target.y) * k;
+        const dz = (root.z - this.controls.target.z) * k;
+        this.controls.target.x += dx; this.controls.target.y += dy; this.controls.target.z += dz;
+        this.camera.position.x += dx; this.camera.position.y += dy; this.camera.position.z += dz;
+      }
+    }
+    this.snap = false;
+    this.controls.update();
+    this.floor.setCenter(this.controls.target.x, this.controls.target.z);
+    this.renderer.render(this.scene, this.camera);
+    this.onFrame?.(this.playback.state());
+  }
+
+  private resize(): void {
+    const w = Math.max(this.container.clientWidth, 1), h = Math.max(this.container.clientHeight, 1);
+    this.renderer.setSize(w, h, false);
+    this.camera.aspect = w / h;
+    this.camera.updateProjectionMatrix();
+  }
+}
