@@ -1,0 +1,187 @@
+// The public automation API, installed as `window.playground`. Documented in docs/api.md: keep the two
+// in step. Every method that takes user data checks it, and on bad input throws / rejects with an Error
+// whose message says what is wrong, shows the same message on the page, and leaves the scene as it was.
+
+import { exportBVH as exportBVHText } from '../motion/bvh';
+import { importMotion as importMotionText, validateMotion } from '../motion/io';
+import type { Motion } from '../motion/types';
+import type { PlaybackState } from '../viewer/playback';
+import type { RenderStats } from '../viewer/viewer';
+import { errorMessage, type App } from '../ui/app';
+
+declare const __APP_VERSION__: string;
+
+/** A model listed in public/models/index.json (the manifest's `file` is internal and not exposed). */
+export interface ModelInfo {
+  id: string;
+  kind: string;
+  skeleton: string;
+  fps: number;
+  styles?: string[];
+  bytes: number;
+}
+
+export type ImportFormat = 'bvh' | 'amc';
+
+export interface ViewOptions {
+  follow?: boolean;
+  trail?: boolean;
+  footprints?: boolean;
+  framing?: 'character' | 'all';
+}
+
+export interface Playground {
+  /** Package version of the page, e.g. "0.1.0". */
+  readonly version: string;
+  /** Resolves once the page is set up and the model manifest is loaded. */
+  readonly ready: Promise<void>;
+  /** Models from the manifest (empty until models ship). */
+  models(): ModelInfo[];
+  /** Parses a BVH, or an AMC with its ASF skeleton text. Does not show it. */
+  importMotion(text: string, format: ImportFormat, asfText?: string): Promise<Motion>;
+  /** BVH text of a motion (centimetres, y up, ZYX Euler channels, Frame Time = 1/fps). */
+  exportBVH(motion: Motion): string;
+  /** Shows a motion in the viewer from its first frame, playing. `name` labels it on the page. */
+  show(motion: Motion, name?: string): void;
+  play(): void;
+  pause(): void;
+  /** Moves to a frame (fractional allowed; clamped to the clip). */
+  seek(frame: number): void;
+  /** Sets the playback speed, clamped to 0.25–2; returns the speed used. */
+  setSpeed(x: number): number;
+  state(): PlaybackState;
+  /** The motion being shown, or null. */
+  current(): Motion | null;
+  /** The last error message shown on the page, or null. */
+  lastError(): string | null;
+  /**
+   * View options: camera following the root, the trail and footprint layers, and a one-off camera
+   * framing ("character": three-quarter view of the figure now; "all": the whole trajectory).
+   */
+  setView(options: ViewOptions): void;
+  /** Rendering diagnostics: display fps, current pixel ratio, quality tier, WebGL renderer. */
+  stats(): RenderStats;
+}
+
+declare global {
+  interface Window {
+    playground: Playground;
+  }
+}
+
+interface ManifestEntry extends ModelInfo {
+  file: string;
+}
+
+function parseManifest(json: unknown): ModelInfo[] {
+  const models = (json as { models?: unknown })?.models;
+  if (!Array.isArray(models)) throw new Error('models/index.json: expected { "models": [...] }');
+  return models.map((m: ManifestEntry, i) => {
+    if (typeof m?.id !== 'string' || typeof m.kind !== 'string' || typeof m.skeleton !== 'string' || typeof m.fps !== 'number' || typeof m.bytes !== 'number') {
+      throw new Error(`models/index.json: entry ${i} needs id, kind, skeleton, fps and bytes`);
+    }
+    const info: ModelInfo = { id: m.id, kind: m.kind, skeleton: m.skeleton, fps: m.fps, bytes: m.bytes };
+    if (Array.isArray(m.styles)) info.styles = m.styles.map(String);
+    return info;
+  });
+}
+
+async function loadManifest(): Promise<ModelInfo[]> {
+  const res = await fetch(`${import.meta.env.BASE_URL}models/index.json`, { cache: 'no-cache' });
+  if (!res.ok) throw new Error(`models/index.json: HTTP ${res.status}`);
+  return parseManifest(await res.json());
+}
+
+export function createPlayground(app: App): Playground {
+  let models: ModelInfo[] = [];
+
+  /** Runs `fn`; on failure shows `context: message` on the page and throws an Error with that message. */
+  function guarded<T>(context: string, fn: () => T): T {
+    try {
+      return fn();
+    } catch (e) {
+      const message = `${context}: ${errorMessage(e)}`;
+      app.reportError(message);
+      const err = new Error(message, { cause: e });
+      if (e instanceof Error) err.name = e.name;
+      throw err;
+    }
+  }
+
+  const ready = loadManifest().then(
+    (m) => {
+      models = m;
+    },
+    (e) => {
+      // The page still works without models; say so rather than failing `ready`.
+      app.reportError(`Model list unavailable: ${errorMessage(e)}`);
+    },
+  );
+
+  const api: Playground = {
+    version: __APP_VERSION__,
+    ready,
+    models: () => models.map((m) => ({ ...m, ...(m.styles ? { styles: [...m.styles] } : {}) })),
+
+    importMotion(text, format, asfText) {
+      return new Promise<Motion>((resolve) => {
+        resolve(
+          guarded('importMotion', () => {
+            if (typeof text !== 'string') throw new TypeError(`text must be a string, got ${text === null ? 'null' : typeof text}`);
+            if (format !== 'bvh' && format !== 'amc') throw new TypeError(`format must be "bvh" or "amc", got ${JSON.stringify(format)}`);
+            if (format === 'amc' && typeof asfText !== 'string') throw new TypeError('an AMC motion needs its skeleton: pass the ASF file text as asfText');
+            return importMotionText(text, format, asfText);
+          }),
+        );
+      });
+    },
+
+    exportBVH(motion) {
+      return guarded('exportBVH', () => exportBVHText(validateMotion(motion)));
+    },
+
+    show(motion, name = 'motion') {
+      guarded('show', () => {
+        if (typeof name !== 'string') throw new TypeError('name must be a string');
+        app.show(validateMotion(motion), name);
+      });
+    },
+
+    play: () => app.viewer.play(),
+    pause: () => app.viewer.pause(),
+    seek(frame) {
+      guarded('seek', () => {
+        if (typeof frame !== 'number' || !Number.isFinite(frame)) throw new TypeError(`frame must be a finite number, got ${String(frame)}`);
+        app.viewer.seek(frame);
+      });
+    },
+    setSpeed(x) {
+      return guarded('setSpeed', () => {
+        if (typeof x !== 'number' || !Number.isFinite(x) || x <= 0) throw new TypeError(`speed must be a positive number, got ${String(x)}`);
+        return app.viewer.setSpeed(x);
+      });
+    },
+    state: () => app.viewer.state(),
+    current: () => app.current,
+    lastError: () => app.lastError,
+    setView(options) {
+      guarded('setView', () => {
+        if (typeof options !== 'object' || options === null) throw new TypeError('options must be an object');
+        const known = ['follow', 'trail', 'footprints', 'framing'];
+        for (const [k, v] of Object.entries(options)) {
+          if (!known.includes(k)) throw new TypeError(`unknown option "${k}" (known: ${known.join(', ')})`);
+          if (k === 'framing' ? v !== 'character' && v !== 'all' : typeof v !== 'boolean') {
+            throw new TypeError(k === 'framing' ? 'framing must be "character" or "all"' : `${k} must be true or false`);
+          }
+        }
+        const { framing, ...layers } = options;
+        app.viewer.setLayers(layers);
+        if (framing === 'character') app.viewer.frameCharacter();
+        if (framing === 'all') app.viewer.frameAll();
+        app.panel.syncLayers();
+      });
+    },
+    stats: () => app.viewer.stats(),
+  };
+  return Object.freeze(api);
+}

@@ -1,0 +1,174 @@
+// Page controller: owns the viewer, the panel and the messages; imports dropped/picked files and
+// exports the shown motion. The automation API (web/api/playground.ts) drives the same methods.
+
+import { detectContacts } from '../motion/contacts';
+import { exportBVH } from '../motion/bvh';
+import { importMotion } from '../motion/io';
+import type { Motion } from '../motion/types';
+import { Viewer } from '../viewer/viewer';
+import { downloadText } from './download';
+import { baseName, readTextFile, type TextFile } from './files';
+import { Panel } from './panel';
+import { Toasts } from './toast';
+
+function $(id: string): HTMLElement {
+  const el = document.getElementById(id);
+  if (!el) throw new Error(`missing #${id} in index.html`);
+  return el;
+}
+
+export function errorMessage(e: unknown): string {
+  if (e instanceof Error) return e.message || e.name;
+  return String(e);
+}
+
+export class App {
+  readonly viewer: Viewer;
+  readonly panel: Panel;
+  readonly toasts: Toasts;
+  private name = '';
+  private lastAsf: TextFile | null = null;
+  private lastErrorMessage: string | null = null;
+  private readonly exportBtn = $('export-btn') as HTMLButtonElement;
+
+  constructor() {
+    this.viewer = new Viewer($('stage'));
+    this.panel = new Panel(this.viewer);
+    this.toasts = new Toasts($('toasts'));
+    this.viewer.onFrame = (s) => this.panel.update(s);
+
+    const input = $('file-input') as HTMLInputElement;
+    for (const id of ['open-btn', 'empty-open']) $(id).addEventListener('click', () => input.click());
+    input.addEventListener('change', () => {
+      const files = [...(input.files ?? [])];
+      input.value = '';
+      if (files.length) void this.handleFiles(files);
+    });
+    this.exportBtn.addEventListener('click', () => this.exportCurrent());
+    this.installDropZone();
+  }
+
+  get current(): Motion | null {
+    return this.viewer.current;
+  }
+
+  get lastError(): string | null {
+    return this.lastErrorMessage;
+  }
+
+  /** Shows an error to the user and remembers it for `playground.lastError()`. */
+  reportError(message: string): void {
+    this.lastErrorMessage = message;
+    this.toasts.show(message, 'error');
+  }
+
+  note(message: string): void {
+    this.toasts.show(message, 'info');
+  }
+
+  /** Shows an already validated motion. Contacts are detected when the motion has none. */
+  show(motion: Motion, name = 'motion'): void {
+    let contacts = motion.contacts;
+    if (!contacts) {
+      try {
+        contacts = detectContacts(motion);
+      } catch {
+        contacts = undefined; // footprints are decoration: a motion without feet just has none
+      }
+    }
+    this.viewer.setMotion(motion, contacts);
+    this.name = name;
+    this.exportBtn.disabled = false;
+    document.body.classList.add('has-motion');
+    const secs = (motion.frames - 1) / motion.fps;
+    $('clip-name').textContent = name;
+    $('clip-meta').textContent =
+      `${motion.joints.length} joints · ${motion.frames} frames · ${+motion.fps.toFixed(2)} fps · ${secs.toFixed(1)} s` +
+      (this.viewer.footprintCount ? ` · ${this.viewer.footprintCount} steps` : '');
+  }
+
+  exportCurrent(): void {
+    const m = this.current;
+    if (!m) return;
+    try {
+      downloadText(`${baseName(this.name) || 'motion'}.bvh`, exportBVH(m), 'text/plain');
+    } catch (e) {
+      this.reportError(`Export failed: ${errorMessage(e)}`);
+    }
+  }
+
+  /** Imports dropped or picked files: one .bvh, or an .amc with its .asf (dropped together or the .asf first). */
+  async handleFiles(files: File[]): Promise<void> {
+    let read: TextFile[];
+    try {
+      read = await Promise.all(files.map((f) => readTextFile(f)));
+    } catch (e) {
+      this.reportError(errorMessage(e));
+      return;
+    }
+    const unknown = read.filter((f) => f.kind === null);
+    const asfs = read.filter((f) => f.kind === 'asf');
+    const motions = read.filter((f) => f.kind === 'bvh' || f.kind === 'amc');
+    if (unknown.length && !motions.length && !asfs.length) {
+      this.reportError(`Unsupported file ${unknown.map((f) => `"${f.name}"`).join(', ')}: drop a .bvh, or an .asf with an .amc (gzipped .gz files are fine).`);
+      return;
+    }
+    if (!motions.length) {
+      this.lastAsf = asfs[asfs.length - 1];
+      this.note(`Skeleton ${this.lastAsf.name} loaded: now drop an .amc motion for it.`);
+      return;
+    }
+    const file = motions[0];
+    let asf: TextFile | null = null;
+    if (file.kind === 'amc') {
+      // Prefer the subject's skeleton by CMU naming (16_11.amc ↔ 16.asf), else the last one dropped.
+      const subject = baseName(file.name).split('_')[0];
+      asf = asfs.find((a) => baseName(a.name) === subject) ?? asfs[asfs.length - 1] ?? this.lastAsf;
+      if (!asf) {
+        this.reportError(`${file.name} needs its skeleton: drop the subject's .asf file together with the .amc (or before it).`);
+        return;
+      }
+    }
+    if (asfs.length) this.lastAsf = asf && asfs.includes(asf) ? asf : asfs[asfs.length - 1];
+    let motion: Motion;
+    try {
+      motion = importMotion(file.text, file.kind as 'bvh' | 'amc', asf?.text);
+    } catch (e) {
+      this.reportError(`Could not import ${file.name}${asf ? ` (skeleton ${asf.name})` : ''}: ${errorMessage(e)}`);
+      return;
+    }
+    this.show(motion, file.name);
+    const ignored = [...motions.slice(1), ...unknown].map((f) => f.name);
+    if (ignored.length) this.note(`Showing ${file.name}; ignored ${ignored.join(', ')}.`);
+  }
+
+  private installDropZone(): void {
+    const overlay = $('drop-overlay');
+    let depth = 0;
+    const hasFiles = (e: DragEvent) => !!e.dataTransfer && [...e.dataTransfer.types].includes('Files');
+    window.addEventListener('dragenter', (e) => {
+      if (!hasFiles(e)) return;
+      e.preventDefault();
+      depth++;
+      overlay.classList.add('visible');
+    });
+    window.addEventListener('dragover', (e) => {
+      if (!hasFiles(e)) return;
+      e.preventDefault();
+      e.dataTransfer!.dropEffect = 'copy';
+    });
+    window.addEventListener('dragleave', (e) => {
+      if (!hasFiles(e)) return;
+      depth = Math.max(0, depth - 1);
+      if (depth === 0) overlay.classList.remove('visible');
+    });
+    window.addEventListener('drop', (e) => {
+      if (!e.dataTransfer) return;
+      e.preventDefault();
+      depth = 0;
+      overlay.classList.remove('visible');
+      const files = [...e.dataTransfer.files];
+      if (files.length) void this.handleFiles(files);
+    });
+  }
+}
