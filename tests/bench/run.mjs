@@ -1,0 +1,137 @@
+// Benchmarks of the page in headless Chromium (software GL here). Not a pass/fail test: each benchmark
+// prints one JSON line (machine-readable) and the run ends with a human summary.
+//
+//   npm run bench                    # all benchmarks
+//   npm run bench -- playback-auto   # only the named ones
+//   BENCH_SECONDS=10 npm run bench   # longer measuring windows
+//
+// Add a benchmark by appending { name, description, run(ctx) } to BENCHMARKS; run() returns an object
+// of metrics. ctx gives the browser, the served URL and corpus access.
+import { corpusText, launchBrowser, openPlayground, startServer } from '../e2e/harness.mjs';
+
+const SECONDS = Number(process.env.BENCH_SECONDS ?? 5);
+const WARMUP_SECONDS = Number(process.env.BENCH_WARMUP ?? 4);
+const VIEWPORT = { width: 1280, height: 720 };
+
+/** Display frame timing in the page: rAF intervals over `seconds`. */
+async function measureFrames(page, seconds) {
+  const t = await page.evaluate(
+    (ms) =>
+      new Promise((resolve) => {
+        const stamps = [];
+        const start = performance.now();
+        const step = (now) => {
+          stamps.push(now);
+          if (now - start < ms) requestAnimationFrame(step);
+          else resolve(stamps);
+        };
+        requestAnimationFrame(step);
+      }),
+    seconds * 1000,
+  );
+  const dts = [];
+  for (let i = 1; i < t.length; i++) dts.push(t[i] - t[i - 1]);
+  const sorted = [...dts].sort((a, b) => a - b);
+  const pct = (p) => sorted[Math.min(sorted.length - 1, Math.floor((p / 100) * sorted.length))];
+  const span = t[t.length - 1] - t[0];
+  return {
+    frames: dts.length,
+    mean_fps: +(dts.length / (span / 1000)).toFixed(2),
+    mean_frame_ms: +(span / dts.length).toFixed(2),
+    p50_frame_ms: +pct(50).toFixed(2),
+    p95_frame_ms: +pct(95).toFixed(2),
+    p99_frame_ms: +pct(99).toFixed(2),
+    max_frame_ms: +sorted[sorted.length - 1].toFixed(2),
+    long_frames: dts.filter((d) => d > 25).length, // > 1.5 refresh intervals at 60 Hz
+  };
+}
+
+/** Shows a real clip playing, warms up (shaders, dynamic resolution), then measures. */
+async function playbackBenchmark(ctx, query) {
+  const { context, page, problems } = await openPlayground(ctx.browser, ctx.url + query, VIEWPORT);
+  try {
+    const amc = corpusText('cmu/amc/16_11.amc.gz');
+    const asf = corpusText('cmu/asf/16.asf');
+    await page.evaluate(
+      async ({ amc, asf }) => {
+        const m = await window.playground.importMotion(amc, 'amc', asf);
+        window.playground.show(m, '16_11.amc');
+      },
+      { amc, asf },
+    );
+    await page.waitForTimeout(WARMUP_SECONDS * 1000);
+    const frames = await measureFrames(page, SECONDS);
+    const state = await page.evaluate(() => window.playground.state());
+    const stats = await page.evaluate(() => window.playground.stats());
+    if (!state.playing) throw new Error('clip stopped playing during the benchmark');
+    return {
+      clip: 'cmu/amc/16_11 (31 joints, 120 fps)',
+      viewport: `${VIEWPORT.width}x${VIEWPORT.height}`,
+      ...frames,
+      pixel_ratio: +stats.pixelRatio.toFixed(3),
+      quality: stats.quality,
+      renderer: stats.renderer,
+      page_errors: problems.length,
+    };
+  } finally {
+    await context.close();
+  }
+}
+
+export const BENCHMARKS = [
+  {
+    name: 'playback-auto',
+    description: 'one character playing, default quality (software GL → no MSAA, dynamic resolution)',
+    run: (ctx) => playbackBenchmark(ctx, ''),
+  },
+  {
+    name: 'playback-high',
+    description: 'one character playing, ?quality=high (MSAA, full resolution unless too slow)',
+    run: (ctx) => playbackBenchmark(ctx, '?quality=high'),
+  },
+];
+
+async function main() {
+  const wanted = process.argv.slice(2);
+  const unknown = wanted.filter((w) => !BENCHMARKS.some((b) => b.name === w));
+  if (unknown.length) {
+    console.error(`unknown benchmark(s): ${unknown.join(', ')}; known: ${BENCHMARKS.map((b) => b.name).join(', ')}`);
+    process.exit(2);
+  }
+  const chosen = wanted.length ? BENCHMARKS.filter((b) => wanted.includes(b.name)) : BENCHMARKS;
+  const { server, url } = await startServer();
+  const browser = await launchBrowser();
+  const results = [];
+  try {
+    for (const b of chosen) {
+      const started = Date.now();
+      let result;
+      try {
+        result = { bench: b.name, ok: true, ...(await b.run({ browser, url })) };
+      } catch (e) {
+        result = { bench: b.name, ok: false, error: String(e?.message ?? e) };
+      }
+      result.seconds = +((Date.now() - started) / 1000).toFixed(1);
+      console.log(JSON.stringify(result));
+      results.push({ b, result });
+    }
+  } finally {
+    await browser.close();
+    await server.close();
+  }
+  console.log('\nSummary');
+  for (const { b, result: r } of results) {
+    if (!r.ok) {
+      console.log(`  ${b.name}: FAILED — ${r.error}`);
+      continue;
+    }
+    console.log(
+      `  ${b.name}: ${r.mean_fps} fps mean, p95 frame ${r.p95_frame_ms} ms, ${r.long_frames}/${r.frames} frames > 25 ms` +
+        ` — ${r.quality} quality at pixel ratio ${r.pixel_ratio}, ${r.viewport}\n    ${b.description}`,
+    );
+  }
+  const renderer = results.find((x) => x.result.renderer)?.result.renderer;
+  if (renderer) console.log(`  WebGL: ${renderer}`);
+}
+
+await main();
