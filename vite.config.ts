@@ -39,5 +39,6 @@ export default defineConfig({
     emptyOutDir: true,
     target: 'es2022',
     sourcemap: true,
+    chunkSizeWarningLimit: 1024, // three.js alone is ~600 kB minified
   },
 });

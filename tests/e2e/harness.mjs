@@ -35,7 +35,7 @@ export function corpusText(rel) {
 }
 
 /** A TCP port that was free a moment ago. */
-function freePort() {
+export function freePort() {
   return new Promise((resolve, reject) => {
     const srv = net.createServer();
     srv.unref();

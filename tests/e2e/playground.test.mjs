@@ -3,7 +3,7 @@
 // the shared corpus at ../shared/mocap (or MOCAP_DIR).
 import assert from 'node:assert/strict';
 import { gzipSync } from 'node:zlib';
-import { writeFileSync } from 'node:fs';
+import { readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
 import { after, before, describe, test } from 'node:test';
 import { corpusText, launchBrowser, nextFrames, openPlayground, ROOT, startServer } from './harness.mjs';
@@ -72,7 +72,9 @@ describe('motion playground page', { timeout: 150_000 }, () => {
     });
     assert.equal(info.isolated, true, 'COOP/COEP headers should make the page cross-origin isolated');
     assert.match(info.version, /^\d+\.\d+\.\d+/);
-    assert.deepEqual(info.models, []);
+    // models() lists the manifest's entries without their internal `file`.
+    const manifest = JSON.parse(readFileSync(path.join(ROOT, 'public', 'models', 'index.json'), 'utf8'));
+    assert.deepEqual(info.models, manifest.models.map(({ file, ...rest }) => rest));
     assert.equal(info.current, null);
     assert.equal(info.lastError, null);
     assert.equal(info.state.frames, 0);
@@ -223,7 +225,6 @@ describe('motion playground page', { timeout: 150_000 }, () => {
     const [download] = await Promise.all([page.waitForEvent('download'), page.locator('#export-btn').click()]);
     assert.equal(download.suggestedFilename(), '16_11.bvh');
     const file = await download.path();
-    const { readFileSync } = await import('node:fs');
     const bvh = readFileSync(file, 'utf8');
     assert.match(bvh, /^HIERARCHY/);
     assert.match(bvh, /Frames:\s*534/);

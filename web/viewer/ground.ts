@@ -19,14 +19,15 @@ export class Floor {
   readonly group = new THREE.Group();
   private readonly grid: THREE.LineSegments;
 
-  constructor(private readonly half = 24) {
+  constructor(private readonly half = 16) {
     const minor = PALETTE.gridMinor, major = PALETTE.gridMajor;
     const pos: number[] = [], col: number[] = [];
-    // Lines are cut into 1 m pieces: software GL drops long lines that cross the camera's near plane.
+    // Lines are cut into 4 m pieces: software GL drops long lines that cross the camera's near plane
+    // (and every piece costs, so not shorter).
     for (let i = -half; i <= half; i++) {
       const c = i % 5 === 0 ? major : minor;
-      for (let k = -half; k < half; k++) {
-        pos.push(i, 0, k, i, 0, k + 1, k, 0, i, k + 1, 0, i);
+      for (let k = -half; k < half; k += 4) {
+        pos.push(i, 0, k, i, 0, k + 4, k, 0, i, k + 4, 0, i);
         for (let v = 0; v < 4; v++) col.push(c.r, c.g, c.b);
       }
     }
@@ -53,7 +54,7 @@ export class Floor {
 export class FloorGlow {
   readonly mesh: THREE.Mesh;
 
-  constructor(radius = 5.5, rings = 8, segments = 48) {
+  constructor(radius = 4, rings = 4, segments = 32) {
     const pos: number[] = [0, 0, 0];
     const col: number[] = [];
     const c = new THREE.Color();

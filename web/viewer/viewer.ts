@@ -64,10 +64,10 @@ export class Viewer {
     const high = this.quality === 'high';
     this.renderer = new THREE.WebGLRenderer({ antialias: high, alpha: false, powerPreference: 'high-performance' });
     this.basePixelRatio = high ? Math.min(window.devicePixelRatio || 1, 2) : 1;
-    this.resolution = new DynamicResolution(high ? 0.5 : 0.4, 1, high ? 1 : 0.75);
+    this.resolution = new DynamicResolution(0.5, 1, high ? 1 : 0.75);
     this.renderer.setPixelRatio(this.basePixelRatio * this.resolution.scale);
     this.scene.background = BACKGROUND;
-    this.scene.fog = new THREE.Fog(BACKGROUND, 8, 26);
+    this.scene.fog = new THREE.Fog(BACKGROUND, 6, 19);
     this.renderer.outputColorSpace = THREE.LinearSRGBColorSpace; // colours are used as given (see palette.ts)
     this.renderer.domElement.classList.add('viewer-canvas');
     container.appendChild(this.renderer.domElement);
