@@ -107,6 +107,30 @@ def pick_seeds(clips: list[dict], codec: FeatureCodec, mean: np.ndarray, std: np
     return seeds
 
 
+FIXTURE = REPO_ROOT / "tests" / "fixtures" / "generator_reference.json"
+
+
+def write_reference_fixture(onnx_path: Path, info: dict, codec: FeatureCodec) -> None:
+    """Numbers the browser tests compare against: one ONNX step at batch 2 (onnxruntime-web parity) and
+    the decoding of a few real feature frames into joint positions (TypeScript decoder parity)."""
+    session = ort.InferenceSession(str(onnx_path), providers=["CPUExecutionProvider"])
+    dim, hidden = info["onnx"]["dim"], info["onnx"]["hidden"]
+    s0, s1 = info["seeds"][0], info["seeds"][-1]
+    x = np.array([s0["x"], s1["x"]], np.float32)
+    h = np.stack([np.array(s["h"], np.float32).reshape(2, hidden) for s in (s0, s1)], axis=1)
+    c = np.stack([np.array(s["c"], np.float32).reshape(2, hidden) for s in (s0, s1)], axis=1)
+    outs = session.run(OUTPUTS, {"x": x, "h": h, "c": c})
+    mean, std = np.array(info["normalisation"]["mean"]), np.array(info["normalisation"]["std"])
+    frames = np.array([s["x"] for s in info["seeds"]]) * std + mean  # physical units, one real frame per seed
+    frames[:, 0] += 0.01  # keep the character moving so the decoder's integration is exercised
+    positions = codec.positions(frames)
+    step = {"inputs": {"x": x.ravel().tolist(), "h": h.ravel().tolist(), "c": c.ravel().tolist(), "batch": 2},
+            "outputs": {name: np.asarray(o).ravel().tolist() for name, o in zip(OUTPUTS, outs)}}
+    decode = {"features": frames.ravel().tolist(), "frames": len(frames), "positions": positions.ravel().tolist()}
+    FIXTURE.write_text(json.dumps({"model": info["file"], "step": step, "decode": decode}) + "\n")
+    print(f"wrote {FIXTURE}")
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--checkpoint", type=Path, default=RUNS_DIR / "generator" / "best.pt")
@@ -159,6 +183,7 @@ def main(argv: list[str] | None = None) -> None:
         "parity": parity,
     }
     (args.out / "generator.json").write_text(json.dumps(info) + "\n")
+    write_reference_fixture(onnx_path, info, codec)
     print(f"wrote {onnx_path} ({onnx_path.stat().st_size / 1e6:.2f} MB) and generator.json")
 
 

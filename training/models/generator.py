@@ -15,12 +15,13 @@ LOG_SIGMA_MIN = -7.0  # keeps exp(log sigma) away from zero so the NLL cannot ru
 
 
 class MixtureLSTM(nn.Module):
-    def __init__(self, dim: int, hidden: int = 256, mixtures: int = 5):
+    def __init__(self, dim: int, hidden: int = 256, mixtures: int = 5, dropout: float = 0.0):
         super().__init__()
         self.dim, self.hidden, self.mixtures = dim, hidden, mixtures
         self.fc1 = nn.Linear(dim, hidden)
         self.fc2 = nn.Linear(hidden, hidden)
-        self.lstm = nn.LSTM(hidden, hidden, num_layers=2, batch_first=True)
+        self.lstm = nn.LSTM(hidden, hidden, num_layers=2, batch_first=True, dropout=dropout)
+        self.drop = nn.Dropout(dropout)  # active in training only; the exported step runs in eval mode
         self.fc3 = nn.Linear(hidden, mixtures * (1 + 2 * dim))
 
     def zero_state(self, batch: int) -> tuple[torch.Tensor, torch.Tensor]:
@@ -30,9 +31,9 @@ class MixtureLSTM(nn.Module):
     def forward(self, x: torch.Tensor, state=None):
         """x (batch, time, dim) -> logits (b, t, M), mu (b, t, M, dim), log_sigma (b, t, M, dim), (h, c)."""
         b, t, _ = x.shape
-        y = torch.relu(self.fc2(torch.relu(self.fc1(x))))
+        y = self.drop(torch.relu(self.fc2(self.drop(torch.relu(self.fc1(x))))))
         y, state = self.lstm(y, state)
-        out = self.fc3(y)
+        out = self.fc3(self.drop(y))
         m, d = self.mixtures, self.dim
         logits = out[..., :m]
         mu = out[..., m:m + m * d].reshape(b, t, m, d)
