@@ -69,6 +69,8 @@ export class Panel {
     if (e.defaultPrevented || e.altKey || e.ctrlKey || e.metaKey) return;
     const t = e.target as HTMLElement | null;
     if (t && (t.tagName === 'TEXTAREA' || (t.tagName === 'INPUT' && (t as HTMLInputElement).type !== 'range'))) return;
+    // Arrow keys on the focused speed slider adjust the speed, as a slider should.
+    if (t === this.speed && e.key.startsWith('Arrow')) return;
     const v = this.viewer;
     switch (e.key) {
       case ' ':

@@ -52,6 +52,9 @@ export class Viewer {
   private follow = true;
   private snap = true;
   private last = 0;
+  /** Something changed since the last render. */
+  private dirty = true;
+  private renderedLast = false;
   private readonly tmp = new THREE.Vector3();
   private readonly gl: GLInfo;
   private readonly quality: Quality;
@@ -73,7 +76,9 @@ export class Viewer {
     container.appendChild(this.renderer.domElement);
 
     // No lights: the figure shades itself (figure.ts) and the ground layers are unlit.
-    this.scene.add(this.glow.mesh, this.floor.group, this.shadow.mesh, this.trail.group, this.footprints.group);
+    // The floor glow is a large filled area: only worth its pixels with a GPU.
+    if (high) this.scene.add(this.glow.mesh);
+    this.scene.add(this.floor.group, this.shadow.mesh, this.trail.group, this.footprints.group);
     this.shadow.mesh.visible = false;
 
     this.camera.position.set(3.2, 1.9, 4.6);
@@ -172,6 +177,7 @@ export class Viewer {
     if (l.follow !== undefined) { this.follow = l.follow; if (l.follow) this.snap = false; }
     if (l.trail !== undefined) this.trail.group.visible = l.trail;
     if (l.footprints !== undefined) this.footprints.group.visible = l.footprints;
+    this.dirty = true;
   }
 
   /** Number of footprints placed for the shown motion. */
@@ -203,6 +209,7 @@ export class Viewer {
     this.camera.position.set(root.x + cx * dist, this.targetY + dist * 0.42, root.z + cz * dist);
     this.snap = true;
     this.controls.update();
+    this.dirty = true;
   }
 
   /** Fits the whole root trajectory in view (and stops following the root). */
@@ -225,6 +232,7 @@ export class Viewer {
     this.controls.target.copy(center).setY(this.targetY * 0.6);
     this.camera.position.copy(this.controls.target).addScaledVector(dir, dist);
     this.controls.update();
+    this.dirty = true;
   }
 
   private rootNow(): THREE.Vector3 {
@@ -246,15 +254,19 @@ export class Viewer {
     this.glow.setCenter(root.x, root.z);
     this.trail.setProgress(ff);
     this.footprints.setProgress(this.playback.frame);
+    this.dirty = true;
   }
 
   private tick(now: number): void {
     const dt = Math.min(Math.max((now - this.last) / 1000, 0), 0.1);
     this.last = now;
-    if (dt > 0) this.displayFps = this.displayFps ? this.displayFps * 0.95 + (1 / dt) * 0.05 : 1 / dt;
-    if (this.resolution.sample(dt, now)) {
-      this.renderer.setPixelRatio(this.basePixelRatio * this.resolution.scale);
-      this.resize();
+    // Frame-rate figures only mean something while frames are being drawn back to back.
+    if (this.renderedLast && dt > 0) {
+      this.displayFps = this.displayFps ? this.displayFps * 0.95 + (1 / dt) * 0.05 : 1 / dt;
+      if (this.resolution.sample(dt, now)) {
+        this.renderer.setPixelRatio(this.basePixelRatio * this.resolution.scale);
+        this.resize();
+      }
     }
     if (this.motion) {
       if (this.playback.playing) {
@@ -267,14 +279,22 @@ export class Viewer {
         const dx = (root.x - this.controls.target.x) * k;
         const dy = (this.targetY - this.controls.target.y) * k;
         const dz = (root.z - this.controls.target.z) * k;
-        this.controls.target.x += dx; this.controls.target.y += dy; this.controls.target.z += dz;
-        this.camera.position.x += dx; this.camera.position.y += dy; this.camera.position.z += dz;
+        if (Math.abs(dx) + Math.abs(dy) + Math.abs(dz) > 1e-7) {
+          this.controls.target.x += dx; this.controls.target.y += dy; this.controls.target.z += dz;
+          this.camera.position.x += dx; this.camera.position.y += dy; this.camera.position.z += dz;
+          this.dirty = true;
+        }
       }
     }
     this.snap = false;
-    this.controls.update();
-    this.floor.setCenter(this.controls.target.x, this.controls.target.z);
-    this.renderer.render(this.scene, this.camera);
+    if (this.controls.update()) this.dirty = true;
+    // Render on demand: a paused, still scene costs nothing.
+    this.renderedLast = this.dirty;
+    if (this.dirty) {
+      this.dirty = false;
+      this.floor.setCenter(this.controls.target.x, this.controls.target.z);
+      this.renderer.render(this.scene, this.camera);
+    }
     this.onFrame?.(this.playback.state());
   }
 
@@ -283,5 +303,6 @@ export class Viewer {
     this.renderer.setSize(w, h, false);
     this.camera.aspect = w / h;
     this.camera.updateProjectionMatrix();
+    this.dirty = true;
   }
 }
