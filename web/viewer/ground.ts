@@ -19,7 +19,7 @@ export class Floor {
   readonly group = new THREE.Group();
   private readonly grid: THREE.LineSegments;
 
-  constructor(private readonly half = 16) {
+  constructor(private readonly half = 12) {
     const minor = PALETTE.gridMinor, major = PALETTE.gridMajor;
     const pos: number[] = [], col: number[] = [];
     // Lines are cut into 4 m pieces: software GL drops long lines that cross the camera's near plane
@@ -69,19 +69,10 @@ export class FloorGlow {
         col.push(c.r, c.g, c.b);
       }
     }
-    const index: number[] = [];
-    for (let i = 0; i < segments; i++) index.push(0, 1 + ((i + 1) % segments), 1 + i);
-    for (let k = 1; k < rings; k++) {
-      const a0 = 1 + (k - 1) * segments, b0 = 1 + k * segments;
-      for (let i = 0; i < segments; i++) {
-        const i1 = (i + 1) % segments;
-        index.push(a0 + i, a0 + i1, b0 + i, a0 + i1, b0 + i1, b0 + i);
-      }
-    }
     const geo = new THREE.BufferGeometry();
     geo.setAttribute('position', new THREE.Float32BufferAttribute(pos, 3));
     geo.setAttribute('color', new THREE.Float32BufferAttribute(col, 3));
-    geo.setIndex(index);
+    geo.setIndex(discIndex(rings, segments));
     this.mesh = new THREE.Mesh(geo, new THREE.MeshBasicMaterial({ vertexColors: true, depthWrite: false, fog: false }));
     this.mesh.renderOrder = -2; // drawn first and without depth, so nothing on the ground z-fights with it
   }
@@ -106,31 +97,35 @@ function soleTexture(): THREE.Texture {
   g.ellipse(33, 116, 18, 23, 0, 0, Math.PI * 2); // heel
   g.fill();
   const t = new THREE.CanvasTexture(c);
-  t.anisotropy = 4;
+  // Bilinear, no mipmaps: the marks are small, and mipmapped sampling is costly under software GL.
+  t.generateMipmaps = false;
+  t.minFilter = THREE.LinearFilter;
   return t;
 }
 
-function radialTexture(): THREE.Texture {
-  const c = document.createElement('canvas');
-  c.width = c.height = 64;
-  const g = c.getContext('2d')!;
-  const grad = g.createRadialGradient(32, 32, 0, 32, 32, 32);
-  grad.addColorStop(0, 'rgba(0,0,0,1)');
-  grad.addColorStop(0.5, 'rgba(0,0,0,0.5)');
-  grad.addColorStop(1, 'rgba(0,0,0,0)');
-  g.fillStyle = grad;
-  g.fillRect(0, 0, 64, 64);
-  const t = new THREE.CanvasTexture(c);
-  return t;
-}
-
-/** A soft dark disc under the figure (cheaper than real shadows under software GL). */
+/**
+ * A soft dark disc under the figure (cheaper than real shadows under software GL): darkness falls off
+ * through per-vertex alpha, so no texture is sampled.
+ */
 export class BlobShadow {
   readonly mesh: THREE.Mesh;
-  constructor() {
-    const geo = new THREE.PlaneGeometry(1, 1);
-    geo.rotateX(-Math.PI / 2);
-    const mat = new THREE.MeshBasicMaterial({ map: radialTexture(), transparent: true, opacity: 0.45, depthWrite: false, color: 0x000000 });
+  constructor(rings = 4, segments = 24) {
+    const pos: number[] = [0, 0, 0];
+    const col: number[] = [0, 0, 0, 0.5];
+    for (let k = 1; k <= rings; k++) {
+      const t = k / rings;
+      const alpha = 0.5 * (1 - t) * (1 - t);
+      for (let i = 0; i < segments; i++) {
+        const a = (i / segments) * Math.PI * 2;
+        pos.push(Math.cos(a) * 0.5 * t, 0, Math.sin(a) * 0.5 * t);
+        col.push(0, 0, 0, alpha);
+      }
+    }
+    const geo = new THREE.BufferGeometry();
+    geo.setAttribute('position', new THREE.Float32BufferAttribute(pos, 3));
+    geo.setAttribute('color', new THREE.Float32BufferAttribute(col, 4));
+    geo.setIndex(discIndex(rings, segments));
+    const mat = new THREE.MeshBasicMaterial({ vertexColors: true, transparent: true, depthWrite: false });
     this.mesh = new THREE.Mesh(geo, mat);
     this.mesh.position.y = 0.004;
     this.mesh.renderOrder = 3;
@@ -140,6 +135,20 @@ export class BlobShadow {
     this.mesh.position.z = z;
     this.mesh.scale.setScalar(size);
   }
+}
+
+/** Triangle indices of a disc: a centre vertex, then `rings` rings of `segments` vertices. */
+function discIndex(rings: number, segments: number): number[] {
+  const index: number[] = [];
+  for (let i = 0; i < segments; i++) index.push(0, 1 + ((i + 1) % segments), 1 + i);
+  for (let k = 1; k < rings; k++) {
+    const a0 = 1 + (k - 1) * segments, b0 = 1 + k * segments;
+    for (let i = 0; i < segments; i++) {
+      const i1 = (i + 1) % segments;
+      index.push(a0 + i, a0 + i1, b0 + i, a0 + i1, b0 + i1, b0 + i);
+    }
+  }
+  return index;
 }
 
 const TRAIL_WIDTH = 0.028;

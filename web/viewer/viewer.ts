@@ -70,7 +70,7 @@ export class Viewer {
     this.resolution = new DynamicResolution(0.5, 1, high ? 1 : 0.75);
     this.renderer.setPixelRatio(this.basePixelRatio * this.resolution.scale);
     this.scene.background = BACKGROUND;
-    this.scene.fog = new THREE.Fog(BACKGROUND, 6, 19);
+    this.scene.fog = new THREE.Fog(BACKGROUND, 5, 14);
     this.renderer.outputColorSpace = THREE.LinearSRGBColorSpace; // colours are used as given (see palette.ts)
     this.renderer.domElement.classList.add('viewer-canvas');
     container.appendChild(this.renderer.domElement);
