@@ -403,12 +403,12 @@ describe('motion playground page', { timeout: 150_000 }, () => {
   });
 
   test('screenshot for the docs: mid-walk with footprints and trail', async () => {
-    // A sharper still: same page, high quality (MSAA, full resolution).
+    // A sharper still: same page, high quality (MSAA) at a pinned full resolution.
     const shot = await browser.newPage({ viewport: { width: 1280, height: 720 }, deviceScaleFactor: 1 });
     const shotProblems = [];
     shot.on('console', (m) => m.type() === 'error' && shotProblems.push(m.text()));
     shot.on('pageerror', (e) => shotProblems.push(e.message));
-    await shot.goto(`${url}?quality=high`);
+    await shot.goto(`${url}?quality=high&resolution=full`);
     await shot.waitForFunction(() => window.playground !== undefined);
     await shot.evaluate(() => window.playground.ready);
     await shot.evaluate(

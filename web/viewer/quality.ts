@@ -3,7 +3,8 @@
 // Under software GL (SwiftShader in headless Chromium, llvmpipe on GPU-less Linux) every pixel is
 // expensive: the viewer turns MSAA off there and lets the render resolution float so the display keeps
 // its refresh rate. With a GPU it renders with MSAA at up to 2× device pixels, still scaling down if a
-// weak GPU cannot keep up. `?quality=high|low|auto` in the page URL overrides the choice.
+// weak GPU cannot keep up. `?quality=high|low|auto` in the page URL overrides the choice, and
+// `?resolution=full` turns the dynamic resolution off.
 
 export type Quality = 'high' | 'low';
 
@@ -30,6 +31,11 @@ export function probeGL(): GLInfo {
   return { renderer, software: SOFTWARE.test(renderer) };
 }
 
+/** `?resolution=full` pins the render resolution (reproducible screenshots); otherwise it floats. */
+export function fixedResolution(search = location.search): boolean {
+  return new URLSearchParams(search).get('resolution') === 'full';
+}
+
 export function chooseQuality(gl: GLInfo, search = location.search): Quality {
   const q = new URLSearchParams(search).get('quality');
   if (q === 'high' || q === 'low') return q;
@@ -50,13 +56,13 @@ export class DynamicResolution {
   private ceiling = Infinity;
   private ceilingUntil = 0;
 
-  constructor(readonly min: number, readonly max: number, start: number) {
-    this.scale = Math.min(Math.max(start, min), max);
+  constructor(readonly min: number, readonly max: number, start: number, private readonly fixed = false) {
+    this.scale = fixed ? max : Math.min(Math.max(start, min), max);
   }
 
   /** Feeds one frame interval (seconds) at time `now` (ms); returns true when the scale changed. */
   sample(dt: number, now: number): boolean {
-    if (!(dt > 0) || dt > 0.25) return false; // stalls (hidden tab, loading) say nothing about rendering
+    if (this.fixed || !(dt > 0) || dt > 0.25) return false; // stalls (hidden tab, loading) say nothing about rendering
     this.acc += dt;
     this.frames++;
     if (this.acc < 1) return false;

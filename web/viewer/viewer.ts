@@ -8,7 +8,7 @@ import type { Motion } from '../motion/types';
 import { Figure } from './figure';
 import { BACKGROUND, BlobShadow, Floor, FloorGlow, Footprints, Trail } from './ground';
 import { Playback, type PlaybackState } from './playback';
-import { chooseQuality, DynamicResolution, probeGL, type GLInfo, type Quality } from './quality';
+import { chooseQuality, DynamicResolution, fixedResolution, probeGL, type GLInfo, type Quality } from './quality';
 
 export interface ViewerLayers {
   follow: boolean;
@@ -38,7 +38,7 @@ export class Viewer {
   /** Smoothed display frame rate, for the UI. */
   displayFps = 0;
 
-  private readonly floor = new Floor();
+  private readonly floor: Floor;
   private readonly glow = new FloorGlow();
   private readonly shadow = new BlobShadow();
   private readonly trail = new Trail();
@@ -67,10 +67,12 @@ export class Viewer {
     const high = this.quality === 'high';
     this.renderer = new THREE.WebGLRenderer({ antialias: high, alpha: false, powerPreference: 'high-performance' });
     this.basePixelRatio = high ? Math.min(window.devicePixelRatio || 1, 2) : 1;
-    this.resolution = new DynamicResolution(0.5, 1, high ? 1 : 0.75);
+    this.resolution = new DynamicResolution(0.5, 1, high ? 1 : 0.75, fixedResolution());
     this.renderer.setPixelRatio(this.basePixelRatio * this.resolution.scale);
     this.scene.background = BACKGROUND;
-    this.scene.fog = new THREE.Fog(BACKGROUND, 5, 14);
+    // A GPU can afford a wider grid reaching further before the fog; software GL gets a smaller stage.
+    this.floor = new Floor(high ? 24 : 12);
+    this.scene.fog = high ? new THREE.Fog(BACKGROUND, 8, 26) : new THREE.Fog(BACKGROUND, 5, 14);
     this.renderer.outputColorSpace = THREE.LinearSRGBColorSpace; // colours are used as given (see palette.ts)
     this.renderer.domElement.classList.add('viewer-canvas');
     container.appendChild(this.renderer.domElement);
@@ -203,7 +205,7 @@ export class Viewer {
     // its trail and footprints on either side of the figure.
     const a = (62 * Math.PI) / 180;
     const cx = dx * Math.cos(a) + dz * Math.sin(a), cz = -dx * Math.sin(a) + dz * Math.cos(a);
-    const dist = this.figureHeight * 3.1;
+    const dist = this.figureHeight * 2.8;
     const root = this.rootNow();
     this.controls.target.set(root.x, this.targetY, root.z);
     this.camera.position.set(root.x + cx * dist, this.targetY + dist * 0.42, root.z + cz * dist);
