@@ -1,8 +1,8 @@
 // Capsule-and-sphere figure for any joint set, in one draw call. Every joint is a sphere and every bone
 // a capsule; both are drawn as ray-cast impostors: each instance is a small box around its capsule
 // (a sphere is a capsule of zero length) and the fragment shader intersects the view ray with the exact
-// capsule, writes its depth and shades it with a matcap. That is a few hundred triangles for a whole
-// figure with perfectly round silhouettes, which matters under software GL where every triangle costs.
+// capsule, writes its depth and shades it. That is a few hundred triangles for a whole figure with
+// perfectly round silhouettes, which matters under software GL where every triangle costs.
 
 import * as THREE from 'three';
 import { PALETTE } from './palette';
@@ -107,10 +107,14 @@ const fragmentShader = /* glsl */ `
 
 export class Figure {
   readonly mesh: THREE.Mesh;
-  private readonly geometry: THREE.InstancedBufferGeometry;
+  private readonly geometry: THREE.BufferGeometry;
   private readonly material: THREE.ShaderMaterial;
-  private readonly attrA: THREE.InstancedBufferAttribute;
-  private readonly attrB: THREE.InstancedBufferAttribute;
+  private readonly attrA: THREE.BufferAttribute;
+  private readonly attrB: THREE.BufferAttribute;
+  /** Vertices per box, and per-item end points before they are copied to every vertex of its box. */
+  private readonly boxVerts: number;
+  private readonly itemA: Float32Array;
+  private readonly itemB: Float32Array;
   private readonly parents: number[];
   private readonly joints: number;
   /** Child joint index of each bone (its parent is parents[child]). */
@@ -161,17 +165,35 @@ export class Figure {
     }
     if (this.head >= 0) radius[this.head] = 0.1 * s;
 
+    // One plain (non-instanced) mesh of boxes: software GL runs instanced draws instance by instance,
+    // which costs far more than a few hundred extra vertices. Each box's vertices carry its capsule.
     const box = new THREE.BoxGeometry(1, 1, 1);
-    this.geometry = new THREE.InstancedBufferGeometry();
-    this.geometry.index = box.index;
-    this.geometry.setAttribute('position', box.getAttribute('position'));
-    this.attrA = new THREE.InstancedBufferAttribute(new Float32Array(n * 3), 3).setUsage(THREE.DynamicDrawUsage);
-    this.attrB = new THREE.InstancedBufferAttribute(new Float32Array(n * 3), 3).setUsage(THREE.DynamicDrawUsage);
+    const boxPos = box.getAttribute('position').array as Float32Array;
+    const boxIndex = box.index!.array;
+    const V = boxPos.length / 3;
+    this.boxVerts = V;
+    const corner = new Float32Array(n * V * 3);
+    const r = new Float32Array(n * V);
+    const rgb = new Float32Array(n * V * 3);
+    const index: number[] = [];
+    for (let i = 0; i < n; i++) {
+      corner.set(boxPos, i * V * 3);
+      r.fill(radius[i], i * V, (i + 1) * V);
+      for (let v = 0; v < V; v++) rgb.set(color.subarray(i * 3, i * 3 + 3), (i * V + v) * 3);
+      for (let k = 0; k < boxIndex.length; k++) index.push(i * V + boxIndex[k]);
+    }
+    box.dispose();
+    this.itemA = new Float32Array(n * 3);
+    this.itemB = new Float32Array(n * 3);
+    this.geometry = new THREE.BufferGeometry();
+    this.geometry.setIndex(index);
+    this.geometry.setAttribute('position', new THREE.BufferAttribute(corner, 3));
+    this.attrA = new THREE.BufferAttribute(new Float32Array(n * V * 3), 3).setUsage(THREE.DynamicDrawUsage);
+    this.attrB = new THREE.BufferAttribute(new Float32Array(n * V * 3), 3).setUsage(THREE.DynamicDrawUsage);
     this.geometry.setAttribute('aA', this.attrA);
     this.geometry.setAttribute('aB', this.attrB);
-    this.geometry.setAttribute('aR', new THREE.InstancedBufferAttribute(radius, 1));
-    this.geometry.setAttribute('aColor', new THREE.InstancedBufferAttribute(color, 3));
-    this.geometry.instanceCount = n;
+    this.geometry.setAttribute('aR', new THREE.BufferAttribute(r, 1));
+    this.geometry.setAttribute('aColor', new THREE.BufferAttribute(rgb, 3));
 
     this.material = new THREE.ShaderMaterial({
       uniforms: THREE.UniformsUtils.clone(THREE.UniformsLib.fog),
@@ -187,7 +209,7 @@ export class Figure {
 
   /** Poses the figure from one frame of world positions (joints × 3). */
   update(pose: ArrayLike<number>): void {
-    const A = this.attrA.array as Float32Array, B = this.attrB.array as Float32Array;
+    const A = this.itemA, B = this.itemB;
     const J = this.joints;
     for (let k = 0; k < J * 3; k++) A[k] = B[k] = pose[k];
     if (this.headSeg) {
@@ -202,6 +224,17 @@ export class Figure {
         B[o + k] = pose[c * 3 + k];
       }
     });
+    // Copy each item's end points to all vertices of its box.
+    const VA = this.attrA.array as Float32Array, VB = this.attrB.array as Float32Array;
+    const V = this.boxVerts, n = A.length / 3;
+    for (let i = 0; i < n; i++) {
+      const ax = A[i * 3], ay = A[i * 3 + 1], az = A[i * 3 + 2];
+      const bx = B[i * 3], by = B[i * 3 + 1], bz = B[i * 3 + 2];
+      for (let v = 0, o = i * V * 3; v < V; v++, o += 3) {
+        VA[o] = ax; VA[o + 1] = ay; VA[o + 2] = az;
+        VB[o] = bx; VB[o + 1] = by; VB[o + 2] = bz;
+      }
+    }
     this.attrA.needsUpdate = true;
     this.attrB.needsUpdate = true;
   }

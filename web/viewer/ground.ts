@@ -4,7 +4,6 @@
 import * as THREE from 'three';
 import { PALETTE } from './palette';
 import type { Motion } from '../motion/types';
-import { COLORS } from './figure';
 import { findFootJoints } from '../motion/contacts';
 
 export const BACKGROUND = PALETTE.background;
@@ -83,60 +82,6 @@ export class FloorGlow {
   }
 }
 
-/** A stylised sole (forefoot pad and heel pad) in white on transparent, pointing up the texture. */
-function soleTexture(): THREE.Texture {
-  const c = document.createElement('canvas');
-  c.width = 64;
-  c.height = 144;
-  const g = c.getContext('2d')!;
-  g.fillStyle = '#fff';
-  g.beginPath();
-  g.ellipse(32, 46, 24, 40, 0, 0, Math.PI * 2); // forefoot (top of the texture = toes)
-  g.fill();
-  g.beginPath();
-  g.ellipse(33, 116, 18, 23, 0, 0, Math.PI * 2); // heel
-  g.fill();
-  const t = new THREE.CanvasTexture(c);
-  // Bilinear, no mipmaps: the marks are small, and mipmapped sampling is costly under software GL.
-  t.generateMipmaps = false;
-  t.minFilter = THREE.LinearFilter;
-  return t;
-}
-
-/**
- * A soft dark disc under the figure (cheaper than real shadows under software GL): darkness falls off
- * through per-vertex alpha, so no texture is sampled.
- */
-export class BlobShadow {
-  readonly mesh: THREE.Mesh;
-  constructor(rings = 4, segments = 24) {
-    const pos: number[] = [0, 0, 0];
-    const col: number[] = [0, 0, 0, 0.5];
-    for (let k = 1; k <= rings; k++) {
-      const t = k / rings;
-      const alpha = 0.5 * (1 - t) * (1 - t);
-      for (let i = 0; i < segments; i++) {
-        const a = (i / segments) * Math.PI * 2;
-        pos.push(Math.cos(a) * 0.5 * t, 0, Math.sin(a) * 0.5 * t);
-        col.push(0, 0, 0, alpha);
-      }
-    }
-    const geo = new THREE.BufferGeometry();
-    geo.setAttribute('position', new THREE.Float32BufferAttribute(pos, 3));
-    geo.setAttribute('color', new THREE.Float32BufferAttribute(col, 4));
-    geo.setIndex(discIndex(rings, segments));
-    const mat = new THREE.MeshBasicMaterial({ vertexColors: true, transparent: true, depthWrite: false });
-    this.mesh = new THREE.Mesh(geo, mat);
-    this.mesh.position.y = 0.004;
-    this.mesh.renderOrder = 3;
-  }
-  update(x: number, z: number, size: number): void {
-    this.mesh.position.x = x;
-    this.mesh.position.z = z;
-    this.mesh.scale.setScalar(size);
-  }
-}
-
 /** Triangle indices of a disc: a centre vertex, then `rings` rings of `segments` vertices. */
 function discIndex(rings: number, segments: number): number[] {
   const index: number[] = [];
@@ -152,158 +97,223 @@ function discIndex(rings: number, segments: number): number[] {
 }
 
 const TRAIL_WIDTH = 0.028;
+const SHADOW_RINGS = 4;
+const SHADOW_SEGMENTS = 24;
 
-/** The root's ground track as a flat ribbon: faint for the whole clip, bright up to the current frame. */
-export class Trail {
-  readonly group = new THREE.Group();
-  private readonly full: THREE.Mesh;
-  private readonly done: THREE.Mesh;
-  private step = 1;
-  private segments = 0;
+/** One flat sole mark, +y forward: a forefoot pad and a heel pad (x lateral, y forward, metres). */
+const SOLE_PADS: ReadonlyArray<{ cx: number; cy: number; rx: number; ry: number; n: number }> = [
+  { cx: 0, cy: 0.045, rx: 0.042, ry: 0.068, n: 12 },
+  { cx: 0.004, cy: -0.078, rx: 0.032, ry: 0.04, n: 10 },
+];
+const SOLE_VERTS = SOLE_PADS.reduce((a, p) => a + p.n + 1, 0);
 
-  constructor() {
-    const color = PALETTE.trail;
-    const mk = (opacity: number, order: number) => {
-      const m = new THREE.Mesh(
-        new THREE.BufferGeometry(),
-        new THREE.MeshBasicMaterial({ color, transparent: true, opacity, depthWrite: false, side: THREE.DoubleSide }),
-      );
-      m.renderOrder = order;
-      m.frustumCulled = false;
-      this.group.add(m);
-      return m;
-    };
-    this.full = mk(0.28, 1);
-    this.done = mk(0.95, 2);
-  }
-
-  build(motion: Motion, root = 0): void {
-    const { frames, positions } = motion;
-    const J = motion.joints.length;
-    this.step = Math.max(1, Math.round(motion.fps / 15)); // ~15 samples a second: smooth enough, few triangles
-    const idx: number[] = [];
-    for (let f = 0; f < frames; f += this.step) idx.push(f);
-    if (idx[idx.length - 1] !== frames - 1) idx.push(frames - 1);
-    const n = idx.length;
-    const verts = new Float32Array(n * 2 * 3);
-    let nx = 1, nz = 0; // last good normal
-    for (let i = 0; i < n; i++) {
-      const f = idx[i];
-      const o = (f * J + root) * 3;
-      const x = positions[o], z = positions[o + 2];
-      const fa = idx[Math.max(i - 1, 0)], fb = idx[Math.min(i + 1, n - 1)];
-      const tx = positions[(fb * J + root) * 3] - positions[(fa * J + root) * 3];
-      const tz = positions[(fb * J + root) * 3 + 2] - positions[(fa * J + root) * 3 + 2];
-      const tl = Math.hypot(tx, tz);
-      if (tl > 1e-5) { nx = -tz / tl; nz = tx / tl; }
-      const h = TRAIL_WIDTH / 2;
-      verts.set([x + nx * h, 0.003, z + nz * h, x - nx * h, 0.003, z - nz * h], i * 6);
-    }
-    const index: number[] = [];
-    for (let i = 0; i < n - 1; i++) {
-      const a = 2 * i;
-      index.push(a, a + 1, a + 2, a + 1, a + 3, a + 2);
-    }
-    const attr = new THREE.BufferAttribute(verts, 3);
-    const indexAttr = new THREE.Uint32BufferAttribute(index, 1);
-    for (const m of [this.full, this.done]) {
-      m.geometry.dispose();
-      const g = new THREE.BufferGeometry();
-      g.setAttribute('position', attr);
-      g.setIndex(indexAttr);
-      m.geometry = g;
-    }
-    this.segments = n - 1;
-    this.setProgress(0);
-  }
-
-  setProgress(frameFloat: number): void {
-    const k = Math.min(Math.floor(frameFloat / this.step), this.segments);
-    this.done.geometry.setDrawRange(0, k * 6);
-  }
+interface Footprint {
+  frame: number;
+  side: 0 | 1;
 }
 
-/** Footprints: a flat sole mark at the foot joint's x–z at each contact onset; left and right coloured apart. */
-export class Footprints {
-  readonly group = new THREE.Group();
-  private mesh: THREE.InstancedMesh | null = null;
-  private onsets: { frame: number; side: 0 | 1 }[] = [];
-  private shown = -1;
-  private readonly past = [COLORS.left.clone(), COLORS.right.clone()];
-  private readonly future = [
-    COLORS.left.clone().lerp(FLOOR_COLOR, 0.72),
-    COLORS.right.clone().lerp(FLOOR_COLOR, 0.72),
-  ];
-  private readonly geometry: THREE.PlaneGeometry;
-  private readonly material = new THREE.MeshBasicMaterial({ map: soleTexture(), transparent: true, opacity: 0.92, depthWrite: false });
+/**
+ * Everything drawn flat on the ground for the shown motion, in ONE mesh and draw call (software GL
+ * pays a fixed price per draw): a soft blob shadow under the figure, the root trajectory as a ribbon
+ * (bright up to the current frame, faint after), and footprints: a sole mark at the foot joint's x–z
+ * at each contact onset, blue for the left foot and orange for the right, faded until reached.
+ * Colours are per vertex with alpha; nothing is textured.
+ */
+export class GroundMarks {
+  readonly mesh: THREE.Mesh;
+  private readonly geometry = new THREE.BufferGeometry();
+  private pos = new Float32Array(0);
+  private col = new Float32Array(0);
+  private shadowUnit = new Float32Array(0);
+  /** Index ranges of each layer, to rebuild the index when layers are hidden. */
+  private sections: Record<'shadow' | 'trail' | 'footprints', number[]> = { shadow: [], trail: [], footprints: [] };
+  private visibleLayers = { trail: true, footprints: true };
+  private trailStart = 0;
+  private trailPoints = 0;
+  private trailStep = 1;
+  private trailDone = -1;
+  private printStart = 0;
+  private prints: Footprint[] = [];
+  private printsShown = -1;
+  private readonly trailColor = PALETTE.trail;
+  private readonly past = [PALETTE.left, PALETTE.right];
+  private readonly future = [PALETTE.left.clone().lerp(PALETTE.background, 0.7), PALETTE.right.clone().lerp(PALETTE.background, 0.7)];
 
   constructor() {
-    // One textured quad per footprint (two triangles), 25 cm long, +y forward before laying it flat.
-    this.geometry = new THREE.PlaneGeometry(0.11, 0.25);
-    this.geometry.rotateX(-Math.PI / 2); // +y → world −z; instances rotate it to face the foot
+    this.mesh = new THREE.Mesh(
+      this.geometry,
+      new THREE.MeshBasicMaterial({ vertexColors: true, transparent: true, depthWrite: false, side: THREE.DoubleSide }),
+    );
+    this.mesh.renderOrder = 1;
+    this.mesh.frustumCulled = false;
+    this.mesh.visible = false;
   }
 
-  /** Number of footprints placed for the current motion. */
-  get count(): number {
-    return this.onsets.length;
+  get footprintCount(): number {
+    return this.prints.length;
   }
 
-  build(motion: Motion, contacts: Uint8Array | undefined): void {
-    if (this.mesh) {
-      this.group.remove(this.mesh);
-      this.mesh.dispose();
-      this.mesh = null;
-    }
-    this.onsets = [];
-    this.shown = -1;
-    if (!contacts || contacts.length < motion.frames * 2) return;
+  build(motion: Motion, contacts: Uint8Array | undefined, root: number): void {
     const J = motion.joints.length;
-    const feet = [findFootJoints(motion.joints, 'left'), findFootJoints(motion.joints, 'right')];
     const P = motion.positions;
-    const items: { frame: number; side: 0 | 1; x: number; z: number; dx: number; dz: number }[] = [];
-    for (const side of [0, 1] as const) {
-      const ft = feet[side];
-      if (!ft) continue;
-      const foot = ft.ankle, toe = ft.toe;
-      for (let f = 0; f < motion.frames; f++) {
-        if (!contacts[f * 2 + side] || (f > 0 && contacts[(f - 1) * 2 + side])) continue;
-        const o = (f * J + foot) * 3;
-        let dx = 0, dz = 1;
-        if (toe >= 0) {
-          const t = (f * J + toe) * 3;
-          const l = Math.hypot(P[t] - P[o], P[t + 2] - P[o + 2]);
-          if (l > 1e-4) { dx = (P[t] - P[o]) / l; dz = (P[t + 2] - P[o + 2]) / l; }
+
+    // Trail samples: ~15 a second is smooth enough and keeps the vertex count low.
+    this.trailStep = Math.max(1, Math.round(motion.fps / 15));
+    const idx: number[] = [];
+    for (let f = 0; f < motion.frames; f += this.trailStep) idx.push(f);
+    if (idx[idx.length - 1] !== motion.frames - 1) idx.push(motion.frames - 1);
+
+    // Footprints at contact onsets.
+    const items: (Footprint & { x: number; z: number; dx: number; dz: number })[] = [];
+    if (contacts && contacts.length >= motion.frames * 2) {
+      const feet = [findFootJoints(motion.joints, 'left'), findFootJoints(motion.joints, 'right')];
+      for (const side of [0, 1] as const) {
+        const ft = feet[side];
+        if (!ft) continue;
+        for (let f = 0; f < motion.frames; f++) {
+          if (!contacts[f * 2 + side] || (f > 0 && contacts[(f - 1) * 2 + side])) continue;
+          const o = (f * J + ft.ankle) * 3, t = (f * J + ft.toe) * 3;
+          let dx = P[t] - P[o], dz = P[t + 2] - P[o + 2];
+          const l = Math.hypot(dx, dz);
+          if (l > 1e-4) { dx /= l; dz /= l; } else { dx = 0; dz = 1; }
+          // The sole is centred a little ahead of the ankle, so its heel lands under the ankle.
+          items.push({ frame: f, side, x: P[o] + 0.05 * dx, z: P[o + 2] + 0.05 * dz, dx, dz });
         }
-        // Centre the sole a little ahead of the ankle so the heel lands under it.
-        items.push({ frame: f, side, x: P[o] + 0.05 * dx, z: P[o + 2] + 0.05 * dz, dx, dz });
       }
     }
     items.sort((a, b) => a.frame - b.frame);
-    if (items.length === 0) return;
-    const mesh = new THREE.InstancedMesh(this.geometry, this.material, items.length);
-    const m = new THREE.Matrix4();
-    items.forEach((it, i) => {
-      m.makeRotationY(Math.atan2(-it.dx, -it.dz));
-      m.setPosition(it.x, 0.005, it.z);
-      mesh.setMatrixAt(i, m);
-      mesh.setColorAt(i, this.future[it.side]);
+
+    const shadowVerts = 1 + SHADOW_RINGS * SHADOW_SEGMENTS;
+    const n = shadowVerts + idx.length * 2 + items.length * SOLE_VERTS;
+    this.pos = new Float32Array(n * 3);
+    this.col = new Float32Array(n * 4);
+
+    // Shadow: a unit disc (radius 0.5), placed every frame; black with alpha falling off outwards.
+    this.shadowUnit = new Float32Array(shadowVerts * 3);
+    this.col[3] = 0.5;
+    for (let k = 1, v = 1; k <= SHADOW_RINGS; k++) {
+      const t = k / SHADOW_RINGS;
+      for (let i = 0; i < SHADOW_SEGMENTS; i++, v++) {
+        const a = (i / SHADOW_SEGMENTS) * Math.PI * 2;
+        this.shadowUnit[v * 3] = Math.cos(a) * 0.5 * t;
+        this.shadowUnit[v * 3 + 2] = Math.sin(a) * 0.5 * t;
+        this.col[v * 4 + 3] = 0.5 * (1 - t) * (1 - t);
+      }
+    }
+    this.sections.shadow = discIndex(SHADOW_RINGS, SHADOW_SEGMENTS);
+
+    // Trail ribbon.
+    this.trailStart = shadowVerts;
+    this.trailPoints = idx.length;
+    let nx = 1, nz = 0; // last good normal, for standing still
+    const trail: number[] = [];
+    for (let i = 0; i < idx.length; i++) {
+      const o = (idx[i] * J + root) * 3;
+      const a = (idx[Math.max(i - 1, 0)] * J + root) * 3, b = (idx[Math.min(i + 1, idx.length - 1)] * J + root) * 3;
+      const tx = P[b] - P[a], tz = P[b + 2] - P[a + 2], tl = Math.hypot(tx, tz);
+      if (tl > 1e-5) { nx = -tz / tl; nz = tx / tl; }
+      const h = TRAIL_WIDTH / 2, v = this.trailStart + i * 2;
+      this.pos.set([P[o] + nx * h, 0.003, P[o + 2] + nz * h, P[o] - nx * h, 0.003, P[o + 2] - nz * h], v * 3);
+      for (const w of [v, v + 1]) this.trailColor.toArray(this.col, w * 4);
+      if (i < idx.length - 1) trail.push(v, v + 1, v + 2, v + 1, v + 3, v + 2);
+    }
+    this.sections.trail = trail;
+
+    // Footprints.
+    this.printStart = this.trailStart + idx.length * 2;
+    const prints: number[] = [];
+    items.forEach((it, k) => {
+      let v = this.printStart + k * SOLE_VERTS;
+      const px = it.dz, pz = -it.dx; // lateral direction
+      for (const pad of SOLE_PADS) {
+        const c = v;
+        this.pos.set([it.x + px * pad.cx + it.dx * pad.cy, 0.005, it.z + pz * pad.cx + it.dz * pad.cy], c * 3);
+        for (let i = 0; i < pad.n; i++) {
+          const a = (i / pad.n) * Math.PI * 2;
+          const lx = pad.cx + Math.cos(a) * pad.rx, ly = pad.cy + Math.sin(a) * pad.ry;
+          this.pos.set([it.x + px * lx + it.dx * ly, 0.005, it.z + pz * lx + it.dz * ly], (c + 1 + i) * 3);
+          prints.push(c, c + 1 + i, c + 1 + ((i + 1) % pad.n));
+        }
+        v += pad.n + 1;
+      }
     });
-    mesh.renderOrder = 2;
-    mesh.frustumCulled = false;
-    this.mesh = mesh;
-    this.onsets = items.map(({ frame, side }) => ({ frame, side }));
-    this.group.add(mesh);
-    this.setProgress(0);
+    this.sections.footprints = prints;
+    this.prints = items.map(({ frame, side }) => ({ frame, side }));
+
+    this.geometry.setAttribute('position', new THREE.BufferAttribute(this.pos, 3).setUsage(THREE.DynamicDrawUsage));
+    this.geometry.setAttribute('color', new THREE.BufferAttribute(this.col, 4).setUsage(THREE.DynamicDrawUsage));
+    this.trailDone = -1;
+    this.printsShown = -1;
+    this.updateIndex();
+    this.setProgress(0, 0);
+    this.mesh.visible = true;
   }
 
-  /** Footprints up to the current frame are drawn in full colour, later ones faded. */
-  setProgress(frame: number): void {
-    if (!this.mesh) return;
-    let n = 0;
-    while (n < this.onsets.length && this.onsets[n].frame <= frame) n++;
-    if (n === this.shown) return;
-    this.onsets.forEach((o, i) => this.mesh!.setColorAt(i, i < n ? this.past[o.side] : this.future[o.side]));
-    this.mesh.instanceColor!.needsUpdate = true;
-    this.shown = n;
+  setLayers(l: { trail?: boolean; footprints?: boolean }): void {
+    if (l.trail !== undefined) this.visibleLayers.trail = l.trail;
+    if (l.footprints !== undefined) this.visibleLayers.footprints = l.footprints;
+    this.updateIndex();
+  }
+
+  layers(): { trail: boolean; footprints: boolean } {
+    return { ...this.visibleLayers };
+  }
+
+  /** Places the blob shadow (centre on the ground, diameter in metres). */
+  setShadow(x: number, z: number, size: number): void {
+    const U = this.shadowUnit, p = this.pos;
+    for (let v = 0; v < U.length; v += 3) {
+      p[v] = x + U[v] * size;
+      p[v + 1] = 0.004;
+      p[v + 2] = z + U[v + 2] * size;
+    }
+    const attr = this.geometry.getAttribute('position') as THREE.BufferAttribute | undefined;
+    if (attr) {
+      attr.clearUpdateRanges();
+      attr.addUpdateRange(0, U.length);
+      attr.needsUpdate = true;
+    }
+  }
+
+  /** Trail bright up to `frameFloat`; footprints whose onset is at or before `frame` in full colour. */
+  setProgress(frameFloat: number, frame: number): void {
+    const col = this.geometry.getAttribute('color') as THREE.BufferAttribute | undefined;
+    if (!col) return;
+    let changed = false;
+    const done = Math.min(Math.floor(frameFloat / this.trailStep), this.trailPoints - 1);
+    if (done !== this.trailDone) {
+      const from = this.trailDone < 0 ? 0 : Math.min(done, this.trailDone);
+      const to = this.trailDone < 0 ? this.trailPoints - 1 : Math.max(done, this.trailDone);
+      for (let i = from; i <= to; i++) {
+        const a = i <= done ? 0.95 : 0.28, v = this.trailStart + i * 2;
+        this.col[v * 4 + 3] = a;
+        this.col[v * 4 + 7] = a;
+      }
+      this.trailDone = done;
+      changed = true;
+    }
+    let shown = 0;
+    while (shown < this.prints.length && this.prints[shown].frame <= frame) shown++;
+    if (shown !== this.printsShown) {
+      this.prints.forEach((p, k) => {
+        const c = k < shown ? this.past[p.side] : this.future[p.side];
+        for (let v = this.printStart + k * SOLE_VERTS, e = v + SOLE_VERTS; v < e; v++) {
+          c.toArray(this.col, v * 4);
+          this.col[v * 4 + 3] = 0.92;
+        }
+      });
+      this.printsShown = shown;
+      changed = true;
+    }
+    if (changed) col.needsUpdate = true;
+  }
+
+  private updateIndex(): void {
+    const index = [
+      ...this.sections.shadow,
+      ...(this.visibleLayers.trail ? this.sections.trail : []),
+      ...(this.visibleLayers.footprints ? this.sections.footprints : []),
+    ];
+    this.geometry.setIndex(index);
   }
 }

@@ -6,7 +6,7 @@ import './palette'; // first: sets up colour handling
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import type { Motion } from '../motion/types';
 import { Figure } from './figure';
-import { BACKGROUND, BlobShadow, Floor, FloorGlow, Footprints, Trail } from './ground';
+import { BACKGROUND, Floor, FloorGlow, GroundMarks } from './ground';
 import { Playback, type PlaybackState } from './playback';
 import { chooseQuality, DynamicResolution, fixedResolution, probeGL, type GLInfo, type Quality } from './quality';
 
@@ -40,9 +40,7 @@ export class Viewer {
 
   private readonly floor: Floor;
   private readonly glow = new FloorGlow();
-  private readonly shadow = new BlobShadow();
-  private readonly trail = new Trail();
-  private readonly footprints = new Footprints();
+  private readonly marks = new GroundMarks();
   private figure: Figure | null = null;
   private motion: Motion | null = null;
   private pose = new Float32Array(0);
@@ -80,8 +78,7 @@ export class Viewer {
     // No lights: the figure shades itself (figure.ts) and the ground layers are unlit.
     // The floor glow is a large filled area: only worth its pixels with a GPU.
     if (high) this.scene.add(this.glow.mesh);
-    this.scene.add(this.floor.group, this.shadow.mesh, this.trail.group, this.footprints.group);
-    this.shadow.mesh.visible = false;
+    this.scene.add(this.floor.group, this.marks.mesh);
 
     this.camera.position.set(3.2, 1.9, 4.6);
     this.controls = new OrbitControls(this.camera, this.renderer.domElement);
@@ -130,9 +127,7 @@ export class Viewer {
     this.figureHeight = Math.min(Math.max(maxY - minY, 0.5), 3);
     this.targetY = Math.min(Math.max(meanRootY * 0.72, 0.25), 2); // a bit low: the figure sits above the playback bar
 
-    this.trail.build(motion, this.root);
-    this.footprints.build(motion, contacts);
-    this.shadow.mesh.visible = true;
+    this.marks.build(motion, contacts, this.root);
     this.playback.reset(motion.frames, motion.fps);
     this.playback.playing = true;
     this.applyPose();
@@ -172,18 +167,17 @@ export class Viewer {
   }
 
   layers(): ViewerLayers {
-    return { follow: this.follow, trail: this.trail.group.visible, footprints: this.footprints.group.visible };
+    return { follow: this.follow, ...this.marks.layers() };
   }
 
   setLayers(l: Partial<ViewerLayers>): void {
     if (l.follow !== undefined) { this.follow = l.follow; if (l.follow) this.snap = false; }
-    if (l.trail !== undefined) this.trail.group.visible = l.trail;
-    if (l.footprints !== undefined) this.footprints.group.visible = l.footprints;
+    this.marks.setLayers(l);
     this.dirty = true;
   }
 
   /** Number of footprints placed for the shown motion. */
-  get footprintCount(): number { return this.footprints.count; }
+  get footprintCount(): number { return this.marks.footprintCount; }
 
   /** Puts the camera at a three-quarter view of the figure, looking across its direction of travel. */
   frameCharacter(): void {
@@ -252,10 +246,9 @@ export class Viewer {
     for (let k = 0; k < n; k++) this.pose[k] = P[o0 + k] + (P[o1 + k] - P[o0 + k]) * a;
     this.figure.update(this.pose);
     const root = this.rootNow();
-    this.shadow.update(root.x, root.z, this.figureHeight * 0.55);
+    this.marks.setShadow(root.x, root.z, this.figureHeight * 0.55);
     this.glow.setCenter(root.x, root.z);
-    this.trail.setProgress(ff);
-    this.footprints.setProgress(this.playback.frame);
+    this.marks.setProgress(ff, this.playback.frame);
     this.dirty = true;
   }
 
