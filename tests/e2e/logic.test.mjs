@@ -110,7 +110,7 @@ describe('page logic', () => {
 
   test('joint sides across naming schemes', () => {
     const left = ['LeftUpLeg', 'LHipJoint', 'lfemur', 'ltibia', 'lThigh', 'LThumb_end', 'hand_l', 'Foot.L', 'left_foot'];
-    const right = ['RightFoot', 'RHipJoint', 'rhumerus', 'rShin', 'RThumb_end', 'hand_r', 'right_hand'];
+    const right = ['RightFoot', 'RHipJoint', 'rhumerus', 'rShin', 'RThumb_end', 'hand_r', 'right_hand', 'rMid1', 'rIndex2_end'];
     const centre = ['Hips', 'root', 'lowerback', 'LowerBack', 'Spine1', 'head', 'Head_end', 'Neck1', 'thorax', 'rib'];
     for (const n of left) assert.equal(naming.sideOf(n), 'left', n);
     for (const n of right) assert.equal(naming.sideOf(n), 'right', n);

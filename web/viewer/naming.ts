@@ -8,7 +8,7 @@ const PARTS = [
   'hip', 'femur', 'tibia', 'foot', 'toe', 'clavicle', 'humerus', 'radius', 'wrist', 'hand', 'finger',
   'thumb', 'upleg', 'leg', 'arm', 'shoulder', 'shldr', 'forearm', 'collar', 'thigh', 'shin', 'knee',
   'ankle', 'elbow', 'ball', 'buttock', 'uparm', 'lowarm', 'lowleg', 'upperarm', 'lowerarm', 'heel', 'index',
-  'pinky', 'ring', 'middle', 'eye', 'ear',
+  'pinky', 'ring', 'mid', 'eye', 'ear',
 ];
 
 export function sideOf(name: string): Side {
