@@ -1,5 +1,5 @@
-// Things drawn on the ground plane (x–z): the floor with its grid, a soft blob shadow under the
-// figure, the root trajectory as a flat ribbon, and footprints at each foot-contact onset.
+// Things drawn on the ground plane (x–z): the grid, a glow on the floor around the figure (GPU tier
+// only), and in one mesh the blob shadow, the root trajectory ribbon and the footprints.
 
 import * as THREE from 'three';
 import { PALETTE } from './palette';
@@ -10,9 +10,9 @@ export const BACKGROUND = PALETTE.background;
 export const FLOOR_COLOR = PALETTE.floor;
 
 /**
- * The floor: an opaque plane a shade lighter than the background plus a 1 m line grid (brighter every
- * 5 m). Both use the scene fog, which fades them into the background with distance. Deliberately
- * cheap per pixel: software GL (headless Chromium) spends most of its time filling the floor.
+ * The floor grid: 1 m lines, brighter every 5 m, faded into the background by the scene fog. There is
+ * no filled floor plane: under software GL (headless Chromium) every filled pixel costs, so the floor
+ * is the background colour itself, lit around the figure by FloorGlow when a GPU can afford it.
  */
 export class Floor {
   readonly group = new THREE.Group();
