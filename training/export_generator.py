@@ -60,11 +60,13 @@ def check_parity(model: MixtureLSTM, path: Path, steps: int = 20) -> dict:
             with torch.no_grad():
                 ref = [t.numpy() for t in step(torch.from_numpy(x), torch.from_numpy(h), torch.from_numpy(c))]
             got = session.run(OUTPUTS, {"x": x, "h": h, "c": c})
-            worst = max(worst, max(float(np.abs(a - b).max()) for a, b in zip(ref, got)))
+            # Absolute below magnitude 1, relative above: unused mixture components can have sigmas in the
+            # hundreds, where float32 rounding alone exceeds an absolute 1e-4.
+            worst = max(worst, max(float((np.abs(a - b) / np.maximum(1.0, np.abs(a))).max()) for a, b in zip(ref, got)))
             h, c = ref[3], ref[4]
     if worst > PARITY_TOLERANCE:
-        raise SystemExit(f"error: ONNX parity failed, max |torch - onnxruntime| = {worst:.2e} > {PARITY_TOLERANCE:.0e}")
-    return {"max_abs_diff": worst, "tolerance": PARITY_TOLERANCE, "batches": [1, 7], "steps": steps}
+        raise SystemExit(f"error: ONNX parity failed, max scaled |torch - onnxruntime| = {worst:.2e} > {PARITY_TOLERANCE:.0e}")
+    return {"max_abs_diff": worst, "measure": "|a - b| / max(1, |a|)", "tolerance": PARITY_TOLERANCE, "batches": [1, 7], "steps": steps}
 
 
 def estimate_initial_state(model: MixtureLSTM, x: torch.Tensor, iterations: int = 300) -> tuple[torch.Tensor, torch.Tensor, float, float]:
