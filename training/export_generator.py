@@ -18,6 +18,7 @@ import torch
 
 from .features import FIXED_JOINTS, FeatureCodec, feature_names
 from .models.generator import GeneratorStep, MixtureLSTM, mixture_nll
+from .manifest import register_model
 from .paths import REPO_ROOT
 from .rotations import matrix_to_quat
 from .runs import RUNS_DIR
@@ -186,6 +187,9 @@ def main(argv: list[str] | None = None) -> None:
     }
     (args.out / "generator.json").write_text(json.dumps(info) + "\n")
     write_reference_fixture(onnx_path, info, codec)
+    if args.out == MODELS_DIR:
+        register_model({"id": "generator", "kind": info["kind"], "skeleton": "cmu-canonical", "fps": info["fps"],
+                        "bytes": info["bytes"], "file": info["file"]})
     print(f"wrote {onnx_path} ({onnx_path.stat().st_size / 1e6:.2f} MB) and generator.json")
 
 
