@@ -154,3 +154,15 @@ def test_asf_errors(asf16):
         asf_amc.parse_asf(asf16[: asf16.index("name lfemur") + 20])
     with pytest.raises(MotionFormatError, match="unknown bone"):
         asf_amc.parse_asf(asf16.replace("root lhipjoint", "root lhipjoint wing"))
+
+
+def test_every_aclstm_dance_file_loads(mocap):
+    """The acLSTM dance set (its own standard skeleton, centimetres): every file parses and FK stays sane."""
+    files = sorted((mocap / "aclstm").rglob("*.bvh.gz"))
+    assert len(files) == 44  # 28 salsa + 7 indian + 8 martial + standard.bvh
+    for path in files:
+        clip = bvh.load_bvh(path)
+        _, pos = bvh.global_transforms(clip)
+        assert np.isfinite(pos).all(), path.name
+        height = pos[0, :, 1].max() - pos[0, :, 1].min()
+        assert 100 < height < 200, (path.name, height)  # centimetres
