@@ -30,6 +30,22 @@ export interface ViewOptions {
   framing?: 'character' | 'all';
 }
 
+export interface GenerateOptions {
+  /** A model id from `models()` of kind "lstm-gmm" (today: "generator"). */
+  model: string;
+  /** Number of frames, an integer 1…100000. */
+  frames: number;
+  /** Integer 0…2³²−1: picks the seed state (seed mod the number of seed states) and seeds the random stream. */
+  seed: number;
+  /** Sampling temperature 0…2 (default 0.5): 0 = each step's most likely mixture mean, 1 = the trained distribution. */
+  temperature?: number;
+  /** Clean-up by the refiner model: not available yet (only `false` is accepted). */
+  refine?: boolean;
+}
+
+export const GENERATE_DEFAULT_TEMPERATURE = 0.5;
+export const GENERATE_MAX_FRAMES = 100_000;
+
 export interface Playground {
   /** Package version of the page, e.g. "0.1.0". */
   readonly version: string;
@@ -61,6 +77,11 @@ export interface Playground {
   setView(options: ViewOptions): void;
   /** Rendering diagnostics: display fps, current pixel ratio, quality tier, WebGL renderer. */
   stats(): RenderStats;
+  /**
+   * Samples a new motion from a generator model (loaded on first use). Same arguments → bit-identical
+   * motion. Does not show it (call `show`).
+   */
+  generate(options: GenerateOptions): Promise<Motion>;
 }
 
 declare global {
@@ -106,6 +127,48 @@ export function createPlayground(app: App): Playground {
       if (e instanceof Error) err.name = e.name;
       throw err;
     }
+  }
+
+  /** Like `guarded` for promises: a rejection is reported on the page and rethrown with the context. */
+  async function guardedAsync<T>(context: string, fn: () => Promise<T>): Promise<T> {
+    try {
+      return await fn();
+    } catch (e) {
+      const message = `${context}: ${errorMessage(e)}`;
+      app.reportError(message);
+      const err = new Error(message, { cause: e });
+      if (e instanceof Error) err.name = e.name;
+      throw err;
+    }
+  }
+
+  function checkGenerate(options: unknown): Required<Omit<GenerateOptions, 'refine'>> {
+    if (typeof options !== 'object' || options === null || Array.isArray(options)) {
+      throw new TypeError('options must be an object: { model, frames, seed, temperature? }');
+    }
+    const known = ['model', 'frames', 'seed', 'temperature', 'refine'];
+    for (const k of Object.keys(options)) {
+      if (!known.includes(k)) throw new TypeError(`unknown option "${k}" (known: ${known.join(', ')})`);
+    }
+    const o = options as Partial<Record<keyof GenerateOptions, unknown>>;
+    const generators = models.filter((m) => m.kind === 'lstm-gmm').map((m) => m.id);
+    if (typeof o.model !== 'string') throw new TypeError(`model must be a model id string (available: ${generators.join(', ') || 'none'})`);
+    if (!generators.includes(o.model)) {
+      throw new Error(`unknown model "${o.model}" (available: ${generators.join(', ') || 'none — the model list did not load'})`);
+    }
+    if (typeof o.frames !== 'number' || !Number.isInteger(o.frames) || o.frames < 1 || o.frames > GENERATE_MAX_FRAMES) {
+      throw new RangeError(`frames must be an integer from 1 to ${GENERATE_MAX_FRAMES}, got ${String(o.frames)}`);
+    }
+    if (typeof o.seed !== 'number' || !Number.isInteger(o.seed) || o.seed < 0 || o.seed > 0xffffffff) {
+      throw new RangeError(`seed must be an integer from 0 to 4294967295, got ${String(o.seed)}`);
+    }
+    const temperature = o.temperature ?? GENERATE_DEFAULT_TEMPERATURE;
+    if (typeof temperature !== 'number' || !Number.isFinite(temperature) || temperature < 0 || temperature > 2) {
+      throw new RangeError(`temperature must be a number from 0 to 2, got ${String(o.temperature)}`);
+    }
+    if (o.refine === true) throw new Error('refine: the refiner is not available yet (pass refine: false or leave it out)');
+    if (o.refine !== undefined && o.refine !== false) throw new TypeError(`refine must be true or false, got ${String(o.refine)}`);
+    return { model: o.model, frames: o.frames, seed: o.seed, temperature };
   }
 
   const ready = loadManifest().then(
@@ -182,6 +245,24 @@ export function createPlayground(app: App): Playground {
       });
     },
     stats: () => app.viewer.stats(),
+
+    generate(options) {
+      return guardedAsync('generate', async () => {
+        await ready;
+        const o = checkGenerate(options);
+        const { client } = await app.generator.load();
+        const m = await client.generate({ frames: o.frames, seed: o.seed, temperature: o.temperature });
+        const motion: Motion = {
+          fps: m.fps,
+          frames: m.frames,
+          joints: [...m.joints],
+          parents: [...m.parents],
+          positions: m.positions,
+          contacts: m.contacts,
+        };
+        return motion;
+      });
+    },
   };
   return Object.freeze(api);
 }
