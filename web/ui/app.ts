@@ -8,7 +8,9 @@ import type { Motion } from '../motion/types';
 import { Viewer } from '../viewer/viewer';
 import { downloadText } from './download';
 import { baseName, readTextFile, type TextFile } from './files';
+import { GeneratorHost } from './generatorHost';
 import { Panel } from './panel';
+import { RandomWalk } from './randomWalk';
 import { Toasts } from './toast';
 
 function $(id: string): HTMLElement {
@@ -26,10 +28,16 @@ export class App {
   readonly viewer: Viewer;
   readonly panel: Panel;
   readonly toasts: Toasts;
+  /** The generator model, loaded on first use (playground.generate, Random walk). */
+  readonly generator = new GeneratorHost(document.getElementById('model-status'));
   private name = '';
   private lastAsf: TextFile | null = null;
   private lastErrorMessage: string | null = null;
   private readonly exportBtn = $('export-btn') as HTMLButtonElement;
+  readonly walk: RandomWalk;
+  private mode: 'clip' | 'walk' = 'clip';
+  /** The clip shown before Random walk mode, restored when switching back. */
+  private clip: { motion: Motion; name: string } | null = null;
 
   constructor() {
     this.viewer = new Viewer($('stage'));
@@ -46,6 +54,56 @@ export class App {
     });
     this.exportBtn.addEventListener('click', () => this.exportCurrent());
     this.installDropZone();
+
+    this.walk = new RandomWalk(this);
+    this.walk.onFailed = () => this.setMode('clip');
+    $('mode-clip').addEventListener('click', () => this.setMode('clip'));
+    $('mode-walk').addEventListener('click', () => this.setMode('walk'));
+  }
+
+  get currentMode(): 'clip' | 'walk' {
+    return this.mode;
+  }
+
+  /** Clip mode shows the imported clip; Random walk mode streams from the generator (loaded on first use). */
+  setMode(mode: 'clip' | 'walk'): void {
+    if (mode === this.mode) return;
+    this.mode = mode;
+    $('mode-clip').setAttribute('aria-pressed', String(mode === 'clip'));
+    $('mode-walk').setAttribute('aria-pressed', String(mode === 'walk'));
+    document.body.classList.toggle('walk-mode', mode === 'walk');
+    if (mode === 'walk') {
+      const m = this.viewer.current;
+      this.clip = m ? { motion: m, name: this.name } : null;
+      $('clip-name').textContent = 'Random walk';
+      $('clip-meta').textContent = ' generator · 30 fps · live';
+      this.exportBtn.title = 'Download the last 20 s of the walk as BVH';
+      void this.walk.begin();
+    } else {
+      this.walk.stop();
+      this.exportBtn.title = 'Download the shown motion as BVH';
+      const clip = this.clip;
+      this.clip = null;
+      if (clip) this.show(clip.motion, clip.name);
+      else this.clearMotion();
+    }
+  }
+
+  /** Random walk: shows the current window of streamed frames (`dropped` < 0: a new stream). */
+  showLive(motion: Motion, dropped: number): void {
+    this.viewer.setLive(motion, motion.contacts, dropped);
+    this.name = 'random-walk';
+    this.exportBtn.disabled = false;
+    document.body.classList.add('has-motion');
+  }
+
+  private clearMotion(): void {
+    this.viewer.clear();
+    this.name = '';
+    this.exportBtn.disabled = true;
+    document.body.classList.remove('has-motion');
+    $('clip-name').textContent = 'No motion';
+    $('clip-meta').textContent = '';
   }
 
   get current(): Motion | null {
@@ -68,6 +126,11 @@ export class App {
 
   /** Shows an already validated motion. Contacts are detected when the motion has none. */
   show(motion: Motion, name = 'motion'): void {
+    if (this.mode === 'walk') {
+      // Showing a clip ends the walk; the new clip replaces the one remembered from before it.
+      this.clip = null;
+      this.setMode('clip');
+    }
     let contacts = motion.contacts;
     if (!contacts) {
       try {

@@ -21,6 +21,8 @@ export class Playback {
   speed = 1;
   playing = false;
   loop = true;
+  /** Live data: at the end, wait (still playing) for more frames instead of looping or stopping. */
+  hold = false;
 
   get duration(): number {
     return this.frames > 1 ? (this.frames - 1) / this.fps : 0;
@@ -47,7 +49,8 @@ export class Playback {
     this.time += dt * this.speed;
     const d = this.duration;
     if (this.time > d) {
-      if (this.loop) this.time = d > 0 ? this.time % d : 0;
+      if (this.hold) this.time = d;
+      else if (this.loop) this.time = d > 0 ? this.time % d : 0;
       else { this.time = d; this.playing = false; }
     }
   }

@@ -48,6 +48,8 @@ export class Viewer {
   private targetY = 0.9;
   private figureHeight = 1.7;
   private follow = true;
+  /** Showing a live window of streamed frames (setLive) rather than a clip. */
+  private live = false;
   private snap = true;
   private last = 0;
   /** Something changed since the last render. */
@@ -128,10 +130,50 @@ export class Viewer {
     this.targetY = Math.min(Math.max(meanRootY * 0.72, 0.25), 2); // a bit low: the figure sits above the playback bar
 
     this.marks.build(motion, contacts, this.root);
+    this.live = false;
+    this.playback.hold = false;
     this.playback.reset(motion.frames, motion.fps);
     this.playback.playing = true;
     this.applyPose();
     this.frameCharacter();
+  }
+
+  /**
+   * Shows a live window of a streamed motion: the first call starts it like `setMotion`; later calls
+   * replace the window without moving the camera, where `dropped` frames were removed from its start
+   * (the playhead stays on the same frame); `dropped` < 0 starts a new stream. Playback waits at the newest frame instead of looping.
+   */
+  setLive(motion: Motion, contacts: Uint8Array | undefined, dropped: number): void {
+    const same = dropped >= 0 && this.live && this.motion !== null && this.motion.joints.length === motion.joints.length;
+    if (!same) {
+      this.setMotion(motion, contacts);
+      this.live = true;
+      this.playback.hold = true;
+      return;
+    }
+    const time = this.playback.time - dropped / this.playback.fps;
+    this.motion = motion;
+    this.marks.build(motion, contacts, this.root);
+    this.playback.frames = motion.frames;
+    this.playback.fps = motion.fps;
+    this.playback.time = Math.min(Math.max(time, 0), this.playback.duration);
+    this.applyPose();
+  }
+
+  /** Removes the motion: an empty stage. */
+  clear(): void {
+    if (this.figure) {
+      this.scene.remove(this.figure.mesh);
+      this.figure.dispose();
+    }
+    this.figure = null;
+    this.motion = null;
+    this.live = false;
+    this.playback.hold = false;
+    this.playback.reset(0, 30);
+    this.playback.playing = false;
+    this.marks.mesh.visible = false;
+    this.dirty = true;
   }
 
   play(): void { if (this.motion) this.playback.playing = true; }
