@@ -78,6 +78,85 @@ async function playbackBenchmark(ctx, query) {
   }
 }
 
+/** Raw generator throughput via GeneratorClient.benchmark, in a page opened with `?threads=N`. */
+async function generatorBenchmark(ctx, threads, batch, steps) {
+  const { context, page, problems } = await openPlayground(ctx.browser, `${ctx.url}?threads=${threads}`, VIEWPORT);
+  try {
+    const r = await page.evaluate(
+      async ({ threads, batch, steps }) => {
+        const { GeneratorClient } = await import('/runtime/generatorClient.ts');
+        const client = new GeneratorClient({ threads });
+        try {
+          const info = await client.init();
+          await client.benchmark(batch, Math.min(100, steps)); // warm-up
+          const b = await client.benchmark(batch, steps);
+          return { ...b, loadMs: info.loadMs, isolated: globalThis.crossOriginIsolated };
+        } finally {
+          client.dispose();
+        }
+      },
+      { threads, batch, steps },
+    );
+    const target = batch === 1 ? { target_steps_per_s: 1000 } : { target_particle_steps_per_s: 20000 };
+    return {
+      threads: r.threads,
+      threads_requested: threads,
+      isolated: r.isolated,
+      batch: r.batch,
+      steps: r.steps,
+      steps_per_s: Math.round(r.stepsPerSecond),
+      ms_per_call: +r.msPerCall.toFixed(3),
+      particle_steps_per_s: Math.round(r.particleStepsPerSecond),
+      ...target,
+      load_ms: Math.round(r.loadMs),
+      page_errors: problems.length,
+    };
+  } finally {
+    await context.close();
+  }
+}
+
+/** Display frame rate while Random walk mode streams (default threads), plus how far the walk got. */
+async function randomWalkBenchmark(ctx) {
+  const { context, page, problems } = await openPlayground(ctx.browser, ctx.url, VIEWPORT);
+  try {
+    await page.click('#mode-walk');
+    await page.waitForFunction(() => Number(document.getElementById('walk-status').dataset.frame) > 0, null, { timeout: 60_000 });
+    await page.waitForTimeout(WARMUP_SECONDS * 1000);
+    const f0 = await page.evaluate(() => Number(document.getElementById('walk-status').dataset.frame));
+    const frames = await measureFrames(page, SECONDS);
+    const f1 = await page.evaluate(() => Number(document.getElementById('walk-status').dataset.frame));
+    const stats = await page.evaluate(() => window.playground.stats());
+    return {
+      viewport: `${VIEWPORT.width}x${VIEWPORT.height}`,
+      ...frames,
+      target_fps: 60,
+      walk_frames_per_s: +((f1 - f0) / SECONDS).toFixed(1),
+      pixel_ratio: +stats.pixelRatio.toFixed(3),
+      quality: stats.quality,
+      renderer: stats.renderer,
+      page_errors: problems.length,
+    };
+  } finally {
+    await context.close();
+  }
+}
+
+const GENERATOR_BENCHMARKS = [1, 2].flatMap((threads) => [
+  {
+    name: `generator-single-t${threads}`,
+    description: `generator, one stream (batch 1, 2000 steps), ${threads} thread(s) requested — target ≥ 1,000 steps/s`,
+    generator: true,
+    run: (ctx) => generatorBenchmark(ctx, threads, 1, 2000),
+  },
+  {
+    name: `generator-batch64-t${threads}`,
+    description: `generator, batch 64 (300 steps), ${threads} thread(s) requested — target ≥ 20,000 particle-steps/s`,
+    generator: true,
+    run: (ctx) => generatorBenchmark(ctx, threads, 64, 300),
+  },
+]);
+
 export const BENCHMARKS = [
   {
     name: 'playback-auto',
@@ -88,6 +167,12 @@ export const BENCHMARKS = [
     name: 'playback-high',
     description: 'one character playing, ?quality=high (MSAA, full resolution unless too slow)',
     run: (ctx) => playbackBenchmark(ctx, '?quality=high'),
+  },
+  ...GENERATOR_BENCHMARKS,
+  {
+    name: 'random-walk',
+    description: 'Random walk mode streaming from the generator (default threads), default quality — target 60 fps',
+    run: (ctx) => randomWalkBenchmark(ctx),
   },
 ];
 
@@ -123,6 +208,18 @@ async function main() {
   for (const { b, result: r } of results) {
     if (!r.ok) {
       console.log(`  ${b.name}: FAILED — ${r.error}`);
+      continue;
+    }
+    if (b.generator) {
+      const target = r.batch === 1 ? `${r.steps_per_s} steps/s (target ≥ 1,000)` : `${r.particle_steps_per_s} particle-steps/s (target ≥ 20,000)`;
+      console.log(`  ${b.name}: ${target}, ${r.ms_per_call} ms/call, ${r.threads} thread(s)${r.isolated ? '' : ' (not isolated)'}\n    ${b.description}`);
+      continue;
+    }
+    if (b.name === 'random-walk') {
+      console.log(
+        `  ${b.name}: ${r.mean_fps} fps mean (target 60), p95 frame ${r.p95_frame_ms} ms, ${r.long_frames}/${r.frames} frames > 25 ms,` +
+          ` walk ${r.walk_frames_per_s} frames/s — ${r.quality} quality at pixel ratio ${r.pixel_ratio}\n    ${b.description}`,
+      );
       continue;
     }
     console.log(
