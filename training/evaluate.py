@@ -106,11 +106,17 @@ def evaluate_generator(frames: int, n_seeds: int, temperature: float, mocap: str
     if plot:
         plot_generator(report, real_speed, real_turn, gen_speed, gen_turn)
         report["model_info"] = dict(gen.info["onnx"], train_frames=gen.info["training"]["train_frames"],
-                                    parameters=count_parameters(gen.info["onnx"]), seeds=gen.info["seeds"])
+                                    parameters=count_parameters(gen.info["onnx"]), seeds=gen.info["seeds"],
+                                    stop_note=stop_note(REPORTS / "generator-train.log"))
         clips = [c for c in load_clips(mocap) if c["category"] in ("walk", "run")]
         starts = np.cumsum([0] + [len(c["rotations"]) for c in clips])[:-1].tolist()
         report["wraparound"] = wraparound_report(np.concatenate([c["rotations"] for c in clips]), starts)
     return report
+
+
+def stop_note(log: Path) -> str:
+    text = log.read_text() if log.exists() else ""
+    return " (stopped by hand once validation NLL flattened; see the log)" if "stopped by hand" in text else ""
 
 
 def count_parameters(onnx: dict) -> int:
@@ -188,7 +194,8 @@ def write_markdown(report: dict) -> None:
         f"The width was chosen for the browser budget: in onnxruntime (1 thread) a step costs about 0.3 ms at batch 1 "
         f"(widths 128/192/256 gave 10.9k/3.7k/2.8k steps/s at batch 1 and 83k/51k/31k particle-steps/s at batch 64). "
         f"Trained on {m['train_frames']:,} frames (walk and run clips, mirrored, and 0.9×/1.1× speed copies), "
-        f"{report['training']['epochs']} epochs (stopped by hand once validation NLL flattened, learning rate below 3e-5), dropout 0.25; the training log is copied to [generator-train.log](generator-train.log).",
+        f"{report['training']['epochs']} epochs{m['stop_note']}, dropout 0.25; the training log is copied to "
+        "[generator-train.log](generator-train.log).",
         "",
         "**Rotation parameterisation.** Joint rotations are rotation vectors relative to each joint's mean rotation. "
         f"Measured over {report['wraparound']['pairs_checked']:,} consecutive joint-frame pairs of the walking and running "
