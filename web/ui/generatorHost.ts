@@ -4,8 +4,10 @@
 import { GeneratorClient, type InitResult } from '../runtime/generatorClient';
 
 /**
- * onnxruntime-web threads: `?threads=N` in the page URL, else min(2, cores) when cross-origin isolated,
- * else 1. (On a 2-core machine 1 thread measured 2–3× faster than 2 under load: override to compare.)
+ * onnxruntime-web threads: `?threads=N` in the page URL; else, when cross-origin isolated, half the cores
+ * (at most 4) so the worker's threads leave the page's own thread a core; else 1. On this project's
+ * 2-core test machine that means 1: two threads measured 2× slower there (npm run bench), because the
+ * second thread fights the renderer for the same cores.
  */
 export function pageThreads(): number {
   const param = new URLSearchParams(location.search).get('threads');
@@ -13,7 +15,8 @@ export function pageThreads(): number {
     const n = Number(param);
     if (Number.isInteger(n) && n >= 1 && n <= 64) return n;
   }
-  return globalThis.crossOriginIsolated ? Math.min(2, navigator.hardwareConcurrency || 1) : 1;
+  if (!globalThis.crossOriginIsolated) return 1;
+  return Math.max(1, Math.min(4, Math.floor((navigator.hardwareConcurrency || 1) / 2)));
 }
 
 export interface LoadedGenerator {
