@@ -116,29 +116,30 @@ async function loadManifest(): Promise<ModelInfo[]> {
 export function createPlayground(app: App): Playground {
   let models: ModelInfo[] = [];
 
-  /** Runs `fn`; on failure shows `context: message` on the page and throws an Error with that message. */
+  /** Shows `context: message` on the page and returns an Error with that message (the original as cause). */
+  function reported(context: string, e: unknown): Error {
+    const message = `${context}: ${errorMessage(e)}`;
+    app.reportError(message);
+    const err = new Error(message, { cause: e });
+    if (e instanceof Error) err.name = e.name;
+    return err;
+  }
+
+  /** Runs `fn`; on failure reports it on the page and throws with the context. */
   function guarded<T>(context: string, fn: () => T): T {
     try {
       return fn();
     } catch (e) {
-      const message = `${context}: ${errorMessage(e)}`;
-      app.reportError(message);
-      const err = new Error(message, { cause: e });
-      if (e instanceof Error) err.name = e.name;
-      throw err;
+      throw reported(context, e);
     }
   }
 
-  /** Like `guarded` for promises: a rejection is reported on the page and rethrown with the context. */
+  /** Like `guarded` for promises. */
   async function guardedAsync<T>(context: string, fn: () => Promise<T>): Promise<T> {
     try {
       return await fn();
     } catch (e) {
-      const message = `${context}: ${errorMessage(e)}`;
-      app.reportError(message);
-      const err = new Error(message, { cause: e });
-      if (e instanceof Error) err.name = e.name;
-      throw err;
+      throw reported(context, e);
     }
   }
 
