@@ -117,7 +117,7 @@ def write_reference_fixture(onnx_path: Path, info: dict, codec: FeatureCodec) ->
     """Numbers the browser tests compare against: one ONNX step at batch 2 (onnxruntime-web parity) and
     the decoding of a few real feature frames into joint positions (TypeScript decoder parity)."""
     session = ort.InferenceSession(str(onnx_path), providers=["CPUExecutionProvider"])
-    dim, hidden = info["onnx"]["dim"], info["onnx"]["hidden"]
+    hidden = info["onnx"]["hidden"]
     s0, s1 = info["seeds"][0], info["seeds"][-1]
     x = np.array([s0["x"], s1["x"]], np.float32)
     h = np.stack([np.array(s["h"], np.float32).reshape(2, hidden) for s in (s0, s1)], axis=1)

@@ -10,7 +10,7 @@ from tqdm import tqdm
 
 from .features import FeatureCodec
 from .rotations import quat_to_matrix
-from .skeleton import Skeleton, canonical_skeleton
+from .skeleton import canonical_skeleton
 
 
 class ShippedGenerator:

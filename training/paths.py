@@ -3,17 +3,12 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 from pathlib import Path
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_MOCAP = REPO_ROOT.parent / "shared" / "mocap"
 DEFAULT_CACHE = REPO_ROOT / "cache"
 ENV_VAR = "MOCAP_DIR"
-
-
-class CorpusNotFound(SystemExit):
-    pass
 
 
 def add_mocap_argument(parser: argparse.ArgumentParser) -> None:
@@ -30,12 +25,7 @@ def resolve_mocap_dir(flag: str | None = None) -> Path:
     else:
         path, how = DEFAULT_MOCAP, "the default location"
     if not (path / "cmu" / "index.tsv").is_file():
-        raise CorpusNotFound(
+        raise SystemExit(
             f"error: no mocap corpus at {path.resolve()} (from {how}; expected cmu/index.tsv there); "
             f"pass --mocap DIR or set {ENV_VAR}=DIR")
     return path
-
-
-def die(message: str) -> None:
-    print(message, file=sys.stderr)
-    raise SystemExit(2)

@@ -68,10 +68,7 @@ async function playbackBenchmark(ctx, query) {
       clip: 'cmu/amc/16_11 (31 joints, 120 fps)',
       viewport: `${VIEWPORT.width}x${VIEWPORT.height}`,
       ...frames,
-      pixel_ratio: +stats.pixelRatio.toFixed(3),
-      quality: stats.quality,
-      renderer: stats.renderer,
-      page_errors: problems.length,
+      ...displayFields(stats, problems),
     };
   } finally {
     await context.close();
@@ -132,14 +129,21 @@ async function randomWalkBenchmark(ctx) {
       ...frames,
       target_fps: 60,
       walk_frames_per_s: +((f1 - f0) / SECONDS).toFixed(1),
-      pixel_ratio: +stats.pixelRatio.toFixed(3),
-      quality: stats.quality,
-      renderer: stats.renderer,
-      page_errors: problems.length,
+      ...displayFields(stats, problems),
     };
   } finally {
     await context.close();
   }
+}
+
+/** What every display benchmark reports about the renderer and page health. */
+function displayFields(stats, problems) {
+  return {
+    pixel_ratio: +stats.pixelRatio.toFixed(3),
+    quality: stats.quality,
+    renderer: stats.renderer,
+    page_errors: problems.length,
+  };
 }
 
 const GENERATOR_BENCHMARKS = [1, 2].flatMap((threads) => [
