@@ -1,0 +1,169 @@
+"""The acLSTM dance set as joint positions, and the acLSTM feature layout (Zhou et al., "Data Representation").
+
+    python -m training.aclstm_data          # builds cache/aclstm_positions.npz and prints a summary
+
+Every file in ../shared/mocap/aclstm/{salsa,indian,martial} is on one standard 57-point skeleton
+(43 joints + 14 end sites). The BVH headers all say 120 fps, but the set's readme gives salsa at 60 fps
+(28 files, 15 minutes, which only adds up at 60), so the readme's rate is used.
+
+Features of frame t (model rate 60 fps, metres, y up):
+    [r_x(t) - r_x(t-1), r_y(t), r_z(t) - r_z(t-1), p_j(t) - r(t) for the 56 other points]
+The paper uses the root displacement in all three axes; here the root height is absolute, because an
+integrated height drifts without bound over a 20,000-frame run. Joint offsets are in world axes (not the
+body's heading frame), as in the paper, so training rotates every window about the vertical axis.
+"""
+from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from .bvh import global_transforms, load_bvh
+from .paths import DEFAULT_CACHE, add_mocap_argument, resolve_mocap_dir
+
+STYLES = ("salsa", "indian", "martial")
+SOURCE_FPS = {"salsa": 60.0, "indian": 120.0, "martial": 120.0}  # from aclstm/readme.txt
+MODEL_FPS = 60.0
+CM = 0.01  # the set's BVH units are centimetres
+CACHE = DEFAULT_CACHE / "aclstm_positions.npz"
+# Held out per style for validation, the evaluation report and the browser's seed motions.
+HELD_OUT = {"salsa": ("10", "20", "30"), "indian": ("15",), "martial": ("10",)}
+
+
+@dataclass
+class DanceSkeleton:
+    names: list[str]
+    parents: list[int]
+    offsets: np.ndarray  # (points, 3) metres, from each point's parent in the rest pose
+
+    def bone_lengths(self) -> np.ndarray:
+        return np.linalg.norm(self.offsets, axis=1)
+
+    def to_json(self) -> dict:
+        return {"joints": self.names, "parents": self.parents,
+                "offsets": [round(float(v), 6) for v in self.offsets.ravel()]}
+
+
+def point_names(clip) -> list[str]:
+    """Joint names, with end sites named after their parent (e.g. 'rThumb2_end')."""
+    return [f"{clip.joints[j.parent].name}_end" if j.end_site else j.name for j in clip.joints]
+
+
+def load_skeleton(mocap: Path) -> DanceSkeleton:
+    clip = load_bvh(mocap / "aclstm" / "standard.bvh.gz")
+    return DanceSkeleton(point_names(clip), [j.parent for j in clip.joints],
+                         np.array([j.offset for j in clip.joints], dtype=np.float64) * CM)
+
+
+def dance_files(mocap: Path) -> list[tuple[str, Path]]:
+    files = [(s, p) for s in STYLES for p in sorted((mocap / "aclstm" / s).glob("*.bvh*"))]
+    if not files:
+        raise SystemExit(f"error: no acLSTM dance files under {mocap / 'aclstm'}")
+    return files
+
+
+def is_held_out(style: str, path: Path | str) -> bool:
+    return Path(path).name.split(".")[0] in HELD_OUT[style]
+
+
+def build_cache(mocap: Path, out: Path = CACHE) -> Path:
+    """World positions (metres) of every point of every clip at its source rate, feet on the floor."""
+    positions, table = [], []
+    skel = load_skeleton(mocap)
+    for style, path in tqdm(dance_files(mocap), desc="acLSTM dance files", unit="file"):
+        clip = load_bvh(path)
+        if point_names(clip) != skel.names:
+            raise SystemExit(f"error: {path} is not on the standard acLSTM skeleton")
+        _, pos = global_transforms(clip)
+        pos = pos * CM
+        # The floor: the 10th percentile of the lowest point over the clip. Lower percentiles follow glitches:
+        # in indian/07 the feet dip 14 cm below their usual level in 3% of the frames.
+        pos[..., 1] -= np.percentile(pos[..., 1].min(axis=1), 10)
+        table.append((style, f"aclstm/{style}/{path.name}", sum(len(p) for p in positions), len(pos)))
+        positions.append(pos.astype(np.float32))
+    out.parent.mkdir(parents=True, exist_ok=True)
+    np.savez_compressed(out, positions=np.concatenate(positions), style=[t[0] for t in table],
+                        files=[t[1] for t in table], start=[t[2] for t in table], frames=[t[3] for t in table],
+                        names=skel.names, parents=skel.parents, offsets=skel.offsets)
+    return out
+
+
+def load_clips(mocap_flag: str | None = None) -> tuple[DanceSkeleton, list[dict]]:
+    """The skeleton and every clip: {style, file, fps, positions (frames, 57, 3), held_out}."""
+    if not CACHE.exists():
+        build_cache(resolve_mocap_dir(mocap_flag))
+    d = np.load(CACHE)
+    skel = DanceSkeleton([str(n) for n in d["names"]], [int(p) for p in d["parents"]], d["offsets"])
+    clips = []
+    for style, file, start, frames in zip(d["style"], d["files"], d["start"], d["frames"]):
+        style = str(style)
+        clips.append({"style": style, "file": str(file), "fps": SOURCE_FPS[style],
+                      "positions": d["positions"][start:start + frames].astype(np.float64),
+                      "held_out": is_held_out(style, str(file))})
+    return skel, clips
+
+
+def resample_positions(pos: np.ndarray, src_fps: float, start: float, count: int, speed: float = 1.0) -> np.ndarray:
+    """`count` frames at MODEL_FPS from source time `start` (s), played `speed` times as fast (linear interpolation)."""
+    t = (start + np.arange(count) * speed / MODEL_FPS) * src_fps
+    i = np.clip(np.floor(t).astype(int), 0, len(pos) - 2)
+    w = np.clip(t - i, 0.0, 1.0)[:, None, None]
+    return pos[i] * (1 - w) + pos[i + 1] * w
+
+
+def rotate_y(pos: np.ndarray, angle: float) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    out = pos.copy()
+    out[..., 0] = c * pos[..., 0] + s * pos[..., 2]
+    out[..., 2] = -s * pos[..., 0] + c * pos[..., 2]
+    return out
+
+
+def encode(pos: np.ndarray) -> np.ndarray:
+    """Positions (frames, points, 3) -> features (frames - 1, 3 * points); frame k of the output is frame k + 1."""
+    root = pos[:, 0]
+    step = root[1:] - root[:-1]
+    first = np.stack([step[:, 0], root[1:, 1], step[:, 2]], axis=1)
+    rel = (pos[1:, 1:] - root[1:, None]).reshape(len(pos) - 1, -1)
+    return np.concatenate([first, rel], axis=1)
+
+
+def decode(feats: np.ndarray, start_xz=(0.0, 0.0)) -> np.ndarray:
+    """Features (frames, 3 * points) -> world positions (frames, points, 3); the root starts at start_xz."""
+    n = len(feats)
+    root = np.zeros((n, 3))
+    root[:, 0] = start_xz[0] + np.cumsum(feats[:, 0])
+    root[:, 1] = feats[:, 1]
+    root[:, 2] = start_xz[1] + np.cumsum(feats[:, 2])
+    rel = feats[:, 3:].reshape(n, -1, 3)
+    return np.concatenate([root[:, None], root[:, None] + rel], axis=1)
+
+
+def bone_length_error(pos: np.ndarray, skel: DanceSkeleton) -> np.ndarray:
+    """Per frame: mean |predicted bone length / true length - 1| over bones longer than 2 cm."""
+    lengths = skel.bone_lengths()
+    bones = [j for j in range(1, len(skel.parents)) if lengths[j] > 0.02]
+    parents = [skel.parents[j] for j in bones]
+    got = np.linalg.norm(pos[:, bones] - pos[:, parents], axis=-1)
+    return np.abs(got / lengths[bones] - 1).mean(axis=1)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_mocap_argument(parser)
+    args = parser.parse_args(argv)
+    out = build_cache(resolve_mocap_dir(args.mocap))
+    skel, clips = load_clips(args.mocap)
+    print(f"wrote {out}: {len(skel.names)} points")
+    for style in STYLES:
+        mine = [c for c in clips if c["style"] == style]
+        secs = sum(len(c["positions"]) / c["fps"] for c in mine)
+        held = [c["file"] for c in mine if c["held_out"]]
+        print(f"  {style}: {len(mine)} clips, {secs / 60:.1f} min at {SOURCE_FPS[style]:.0f} fps; held out {held}")
+
+
+if __name__ == "__main__":
+    main()
