@@ -1,6 +1,7 @@
 """Evaluate a shipped model against held-out real clips and write a report under docs/models/.
 
     python -m training.evaluate generator [--frames 10000] [--seeds 5]
+    python -m training.evaluate aclstm [--frames 20000] [--seeds 5]     (see training/evaluate_aclstm.py)
 
 The generator report compares sampled motion with the generator's held-out validation clips:
 foot skating, root speed and turning-rate distributions, NPSS, and a long stability run.
@@ -236,8 +237,8 @@ def write_markdown(report: dict) -> None:
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("model", choices=["generator"])
-    parser.add_argument("--frames", type=int, default=10000)
+    parser.add_argument("model", choices=["generator", "aclstm"])
+    parser.add_argument("--frames", type=int, default=None, help="frames per seed (generator 10000, aclstm 20000)")
     parser.add_argument("--seeds", type=int, default=5)
     parser.add_argument("--temperature", type=float, default=0.5, help="the playground's default")
     parser.add_argument("--sweep", default="1.0,0.5,0.25", help="temperatures for the comparison table ('' to skip)")
@@ -245,6 +246,11 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--mocap", default=None)
     parser.add_argument("--models", type=Path, default=MODELS_DIR, help="directory with the exported model")
     args = parser.parse_args(argv)
+    if args.model == "aclstm":
+        from . import evaluate_aclstm
+        evaluate_aclstm.run(args.frames or 20000, args.seeds, args.mocap, args.models)
+        return
+    args.frames = args.frames or 10000
     REPORTS.mkdir(parents=True, exist_ok=True)
     report = evaluate_generator(args.frames, args.seeds, args.temperature, args.mocap, args.models)
     report["sweep"] = [evaluate_generator(args.sweep_frames, args.seeds, float(t), args.mocap, args.models, plot=False)

@@ -1,0 +1,40 @@
+"""Running an exported dance model (acLSTM or its vanilla baseline) with onnxruntime: the artefact the browser runs."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import onnxruntime as ort
+from tqdm import tqdm
+
+
+class ShippedDance:
+    def __init__(self, models_dir: Path, model_id: str = "aclstm"):
+        self.info = json.loads((models_dir / f"{model_id}.json").read_text())
+        options = ort.SessionOptions()
+        options.intra_op_num_threads = 1
+        self.session = ort.InferenceSession(str(models_dir / self.info["file"]), options, providers=["CPUExecutionProvider"])
+        self.mean = np.array(self.info["normalisation"]["mean"], np.float32)
+        self.std = np.array(self.info["normalisation"]["std"], np.float32)
+        self.styles = self.info["styles"]
+        self.layers, self.hidden = self.info["onnx"]["layers"], self.info["onnx"]["hidden"]
+
+    def seeds_of(self, style: str) -> list[dict]:
+        return [s for s in self.info["seeds"] if s["style"] == style]
+
+    def generate(self, seed_frames: np.ndarray, styles: list[str], frames: int, progress: bool = False) -> np.ndarray:
+        """Warm up on seed_frames (batch, seed, dim; physical units), then feed outputs back for `frames` steps.
+        Returns the generated features (batch, frames, dim) in physical units."""
+        b = len(seed_frames)
+        style = np.eye(len(self.styles), dtype=np.float32)[[self.styles.index(s) for s in styles]]
+        h = np.zeros((self.layers, b, self.hidden), np.float32)
+        c = np.zeros_like(h)
+        seed = ((np.asarray(seed_frames) - self.mean) / self.std).astype(np.float32)
+        for t in range(seed.shape[1]):
+            y, h, c = self.session.run(None, {"x": seed[:, t], "style": style, "h": h, "c": c})
+        out = np.zeros((b, frames, len(self.mean)), np.float32)
+        for t in tqdm(range(frames), desc="dance", unit="frame", disable=not progress):
+            out[:, t] = y
+            y, h, c = self.session.run(None, {"x": y, "style": style, "h": h, "c": c})
+        return out * self.std + self.mean

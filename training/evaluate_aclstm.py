@@ -1,0 +1,207 @@
+"""Evaluate the shipped dance models, acLSTM against its vanilla baseline, and write docs/models/aclstm.{md,json,png}.
+
+    python -m training.evaluate aclstm [--frames 20000] [--seeds 5]
+
+- Long runs: for each style and seed (real 10-frame seeds from held-out clips), `frames` generated frames.
+  A run freezes when any second's pose change falls below 20% of the real median for that style; it
+  diverges on NaN, when a second's mean bone-length error passes 25%, or when the root leaves 0.2–1.6 m.
+- Prediction error in the form of the paper's Table 1: 20 held-out windows per style, 10 seed frames,
+  then the mean joint position error at 80–640 ms.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from . import metrics
+from .aclstm_data import MODEL_FPS, STYLES, bone_length_error, decode, encode, load_clips, resample_positions
+from .dance import ShippedDance
+from .paths import REPO_ROOT
+
+REPORTS = REPO_ROOT / "docs" / "models"
+FREEZE_FRACTION = 0.2
+BONE_ERROR_LIMIT = 0.25
+HEIGHT_BAND = (0.2, 1.6)
+HORIZONS_MS = (80, 160, 240, 320, 400, 480, 560, 640)
+MODELS = {"acLSTM": "aclstm", "vanilla": "aclstm-vanilla"}
+
+
+def real_pose_change(clips: list[dict]) -> dict:
+    out = {}
+    for style in STYLES:
+        changes = [metrics.pose_change_per_second(resample_positions(c["positions"], c["fps"], 0.0, int(len(c["positions"]) / c["fps"] * MODEL_FPS) - 1), MODEL_FPS)
+                   for c in clips if c["style"] == style and c["held_out"]]
+        out[style] = float(np.median(np.concatenate(changes)))
+    return out
+
+
+def per_second(values: np.ndarray) -> np.ndarray:
+    step = int(MODEL_FPS)
+    return values[: len(values) // step * step].reshape(-1, step).mean(axis=1)
+
+
+def long_runs(model: ShippedDance, skel, frames: int, n_seeds: int, real_change: dict) -> list[dict]:
+    chosen = [(style, s) for style in STYLES for s in model.seeds_of(style)[:n_seeds]]
+    seeds = np.array([s["frames"] for _, s in chosen], np.float32)
+    feats = model.generate(seeds, [style for style, _ in chosen], frames, progress=True)
+    runs = []
+    for (style, seed), f in zip(chosen, feats):
+        finite = bool(np.isfinite(f).all())
+        pos = decode(np.nan_to_num(f.astype(np.float64), nan=0.0, posinf=0.0, neginf=0.0))
+        change = metrics.pose_change_per_second(pos, MODEL_FPS)
+        bone = per_second(bone_length_error(pos, skel))
+        freeze_line = FREEZE_FRACTION * real_change[style]
+        height = pos[:, 0, 1]
+        run = {"style": style, "seed": seed["name"], "frames": frames, "finite": finite,
+               "min_pose_change": float(change.min()), "median_pose_change": float(np.median(change)),
+               "frozen_seconds": int((change < freeze_line).sum()), "seconds": len(change),
+               "first_frozen_second": int(np.argmax(change < freeze_line)) if (change < freeze_line).any() else None,
+               "bone_error_max_second": float(bone.max()), "bone_error_mean": float(bone.mean()),
+               "root_height_min": float(height.min()), "root_height_max": float(height.max()),
+               "pose_change_curve": change.round(4).tolist()}
+        run["frozen"] = run["frozen_seconds"] > 0
+        run["diverged"] = (not finite or run["bone_error_max_second"] > BONE_ERROR_LIMIT
+                           or not (HEIGHT_BAND[0] <= run["root_height_min"] and run["root_height_max"] <= HEIGHT_BAND[1]))
+        run["stable"] = not run["frozen"] and not run["diverged"]
+        runs.append(run)
+    return runs
+
+
+def prediction_windows(clips: list[dict], style: str, count: int = 20, seed_frames: int = 10) -> tuple[np.ndarray, np.ndarray]:
+    """Held-out windows: seed features (count, seed_frames, dim) and true world positions of the next frames."""
+    rng = np.random.default_rng(7)
+    held = [c for c in clips if c["style"] == style and c["held_out"]]
+    future = int(round(HORIZONS_MS[-1] * MODEL_FPS / 1000))
+    seeds, truth = [], []
+    for k in range(count):
+        c = held[k % len(held)]
+        span = (seed_frames + future + 1) / MODEL_FPS
+        start = rng.uniform(0, len(c["positions"]) / c["fps"] - span)
+        feats = encode(resample_positions(c["positions"], c["fps"], start, seed_frames + future + 1))
+        seeds.append(feats[:seed_frames])
+        truth.append(feats[seed_frames:])
+    return np.array(seeds, np.float32), np.array(truth)
+
+
+def prediction_errors(model: ShippedDance, clips: list[dict]) -> dict:
+    """Mean joint position error (cm, world positions with the root starting at the seed's end) per horizon."""
+    table = {}
+    for style in STYLES:
+        seeds, truth = prediction_windows(clips, style)
+        pred = model.generate(seeds, [style] * len(seeds), truth.shape[1]).astype(np.float64)
+        errs = np.array([np.linalg.norm(decode(p) - decode(t), axis=-1).mean(axis=1) for p, t in zip(pred, truth)])
+        table[style] = {ms: float(errs[:, int(round(ms * MODEL_FPS / 1000)) - 1].mean() * 100) for ms in HORIZONS_MS}
+    return table
+
+
+def evaluate_dance(models_dir: Path, frames: int, n_seeds: int, mocap: str | None) -> dict:
+    skel, clips = load_clips(mocap)
+    real_change = real_pose_change(clips)
+    report = {"frames_per_seed": frames, "fps": MODEL_FPS, "seeds_per_style": n_seeds, "freeze_fraction": FREEZE_FRACTION,
+              "bone_error_limit": BONE_ERROR_LIMIT, "height_band": HEIGHT_BAND, "real_median_pose_change": real_change,
+              "models": {}}
+    for label, model_id in MODELS.items():
+        if not (models_dir / f"{model_id}.json").exists():
+            print(f"skipping {label}: no {model_id}.json in {models_dir}")
+            continue
+        model = ShippedDance(models_dir, model_id)
+        runs = long_runs(model, skel, frames, n_seeds, real_change)
+        report["models"][label] = {
+            "id": model_id, "file": model.info["file"], "bytes": model.info["bytes"],
+            "training": {k: model.info["training"][k] for k in ("iterations", "valid")},
+            "minutes": model.info["training"].get("minutes"),
+            "runs": runs, "all_stable": all(r["stable"] for r in runs),
+            "prediction_error_cm": prediction_errors(model, clips),
+        }
+    return report
+
+
+def plot(report: dict) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(STYLES), figsize=(16, 4), sharey=False)
+    colours = {"acLSTM": "tab:blue", "vanilla": "tab:red"}
+    for ax, style in zip(axes, STYLES):
+        for label, m in report["models"].items():
+            for k, run in enumerate(r for r in m["runs"] if r["style"] == style):
+                ax.plot(run["pose_change_curve"], color=colours[label], lw=0.6, alpha=0.7, label=label if k == 0 else None)
+        real = report["real_median_pose_change"][style]
+        ax.axhline(real, color="k", lw=1, label="real median")
+        ax.axhline(FREEZE_FRACTION * real, color="k", ls="--", lw=1, label="freeze line (20%)")
+        ax.set(title=f"{style}: pose change per second", xlabel="second of generation", ylabel="m/s", yscale="log")
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(REPORTS / "aclstm.png", dpi=90)
+    plt.close(fig)
+
+
+def write_markdown(report: dict) -> None:
+    n = report["frames_per_seed"]
+    lines = [
+        "# Dance report: acLSTM against the vanilla LSTM",
+        "",
+        "Made by `python -m training.evaluate aclstm` from the shipped `public/models/aclstm.onnx` and "
+        "`aclstm-vanilla.onnx` run with onnxruntime. Both are the same network (3 × LSTM(256), linear decoder, one "
+        "model for all styles with a one-hot style input); they differ only in training: auto-conditioning "
+        "(u = v = 5) against teacher forcing.",
+        "",
+        "![pose change over the long runs](aclstm.png)",
+        "",
+        f"## Long runs: {n} frames ({n / report['fps']:.0f} s) per seed, {report['seeds_per_style']} seeds per style",
+        "",
+        f"Freeze: any second with pose change (mean joint speed relative to the root) below {report['freeze_fraction']:.0%} of "
+        "the real median for the style; real medians (held-out clips): "
+        + ", ".join(f"{s} {v:.3f} m/s" for s, v in report["real_median_pose_change"].items()) + ". "
+        f"Divergence: NaN, a second whose mean bone-length error (raw predicted points against the skeleton) exceeds "
+        f"{report['bone_error_limit']:.0%}, or the root outside {report['height_band'][0]}–{report['height_band'][1]} m.",
+        "",
+        "| model | style | seed | frozen seconds (first) | min / median pose change (m/s) | bone error mean / worst second | root height (m) | stable |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for label, m in report["models"].items():
+        for r in m["runs"]:
+            first = f" (from {r['first_frozen_second']} s)" if r["first_frozen_second"] is not None else ""
+            lines.append(f"| {label} | {r['style']} | {r['seed']} | {r['frozen_seconds']}/{r['seconds']}{first} | "
+                         f"{r['min_pose_change']:.3f} / {r['median_pose_change']:.3f} | "
+                         f"{r['bone_error_mean']:.1%} / {r['bone_error_max_second']:.1%} | "
+                         f"{r['root_height_min']:.2f}–{r['root_height_max']:.2f} | "
+                         f"{'yes' if r['stable'] else ('NaN' if not r['finite'] else 'NO')} |")
+    lines.append("")
+    for label, m in report["models"].items():
+        stable = sum(r["stable"] for r in m["runs"])
+        lines.append(f"- **{label}**: {stable} of {len(m['runs'])} runs stable"
+                     f" ({sum(r['frozen'] for r in m['runs'])} froze, {sum(r['diverged'] for r in m['runs'])} diverged).")
+    lines += ["", "## Prediction error (the form of the paper's Table 1)", "",
+              "Mean joint position error in centimetres (all 57 points, world positions, root starting where the seed "
+              "ends) after 10 seed frames from held-out clips, averaged over 20 windows per style. The paper's "
+              "numbers are in other units and a bigger network, so compare the rows here with each other.", "",
+              "| model | style | " + " | ".join(f"{ms} ms" for ms in HORIZONS_MS) + " |",
+              "|---|---|" + "---|" * len(HORIZONS_MS)]
+    for label, m in report["models"].items():
+        for style, row in m["prediction_error_cm"].items():
+            lines.append(f"| {label} | {style} | " + " | ".join(f"{row[ms]:.1f}" for ms in HORIZONS_MS) + " |")
+    lines += ["", "## Training", ""]
+    for label, m in report["models"].items():
+        v = m["training"]["valid"] or {}
+        lines.append(f"- **{label}** (`{m['file']}`, {m['bytes'] / 1e6:.2f} MB): {m['training']['iterations']} iterations; "
+                     "held-out loss (normalised units) teacher-forced / auto-conditioned: "
+                     + ", ".join(f"{s} {v[s]['teacher_forced']:.3f} / {v[s]['auto_conditioned']:.3f}" for s in STYLES if s in v) + ".")
+    lines.append("")
+    (REPORTS / "aclstm.md").write_text("\n".join(lines))
+
+
+def run(frames: int, n_seeds: int, mocap: str | None, models_dir: Path) -> None:
+    REPORTS.mkdir(parents=True, exist_ok=True)
+    report = evaluate_dance(models_dir, frames, n_seeds, mocap)
+    plot(report)
+    slim = json.loads(json.dumps(report))
+    for m in slim["models"].values():
+        for r in m["runs"]:
+            r.pop("pose_change_curve")
+    (REPORTS / "aclstm.json").write_text(json.dumps(slim, indent=1) + "\n")
+    write_markdown(report)
+    print(f"wrote {REPORTS / 'aclstm.md'}; " + ", ".join(f"{k}: all stable {m['all_stable']}" for k, m in report["models"].items()))
