@@ -1,12 +1,11 @@
 // The generator step loop (web/runtime/generatorCore.ts) on the shipped model, run by onnxruntime-web's
 // Node build (the same wasm runtime the browser worker uses): one-step parity with the Python
 // onnxruntime fixture, seeded determinism, and streams that continue exactly where they stopped.
-import { readFileSync } from 'node:fs';
-import * as ort from 'onnxruntime-web';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { GeneratorCore } from '../../web/runtime/generatorCore';
 import { parseGeneratorInfo } from '../../web/runtime/generatorModel';
-import { REPO_ROOT, readRepoFile } from './corpus';
+import { readRepoFile } from './corpus';
+import { bytes, maxAbsDiff, ort, shippedSession } from './shippedModel';
 
 interface StepFixture {
   inputs: { batch: number; x: number[]; h: number[]; c: number[] };
@@ -20,20 +19,11 @@ const step = JSON.parse(readRepoFile('tests/fixtures/generator_reference.json'))
 let core: GeneratorCore;
 
 beforeAll(async () => {
-  ort.env.wasm.numThreads = 1;
-  const session = await ort.InferenceSession.create(readFileSync(`${REPO_ROOT}public/models/${info.file}`));
-  core = new GeneratorCore(session, info, ort.Tensor);
+  core = new GeneratorCore(await shippedSession(info.file), info, ort.Tensor);
   await core.check();
 });
 
 afterAll(() => core?.release());
-
-function maxAbsDiff(a: ArrayLike<number>, b: ArrayLike<number>): number {
-  if (a.length !== b.length) return Infinity;
-  let worst = 0;
-  for (let i = 0; i < a.length; i++) worst = Math.max(worst, Math.abs(a[i] - b[i]));
-  return worst;
-}
 
 /** Like maxAbsDiff, but relative for values above 1: unused mixture components can have sigmas in the
  * hundreds, where float32 rounding alone exceeds an absolute 1e-4 (the Python export check does the same). */
@@ -44,7 +34,6 @@ function maxScaledDiff(a: ArrayLike<number>, b: ArrayLike<number>): number {
   return worst;
 }
 
-const bytes = (a: Float32Array | Uint8Array) => Array.from(new Uint8Array(a.buffer, a.byteOffset, a.byteLength));
 
 describe('GeneratorCore', () => {
   it('builds the fixture inputs from the seed states and matches Python onnxruntime', async () => {

@@ -1,19 +1,8 @@
-// Main-thread handle on the generator worker: promise methods, requests matched to replies by id.
+// Main-thread handle on the generator worker: promise methods (ModelClient; requests matched to
+// replies by id: WorkerClient).
 import type { Motion } from '../motion/types';
-import {
-  WORKER_ERROR_ID,
-  type BenchmarkResult,
-  type GeneratedChunk,
-  type GenerateParams,
-  type GeneratorReply,
-  type GeneratorRequest,
-  type InitResult,
-  type ParityResult,
-  type ReplyMap,
-  type StepInputs,
-  type StreamInfo,
-  type StreamParams,
-} from './protocol';
+import type { BenchmarkResult, GeneratedChunk, GenerateParams, InitResult, ParityResult, StepInputs, StreamInfo, StreamParams } from './protocol';
+import { ModelClient } from './workerClient';
 
 export type { BenchmarkResult, GenerateParams, InitResult, ParityResult, StepInputs, StreamInfo, StreamParams };
 
@@ -38,71 +27,13 @@ export interface GeneratorClientOptions {
   initTimeoutMs?: number;
 }
 
-interface Pending {
-  resolve: (value: unknown) => void;
-  reject: (error: Error) => void;
-  timer?: ReturnType<typeof setTimeout>;
-}
-
-type RequestType = GeneratorRequest['type'];
-type Body<T extends RequestType> = Omit<Extract<GeneratorRequest, { type: T }>, 'type'>;
-
-export class GeneratorClient {
-  private worker: Worker | undefined;
-  private readonly pending = new Map<number, Pending>();
-  private nextId = 1;
-  private failure: Error | undefined;
-  private skeleton: { fps: number; joints: string[]; parents: number[] } | undefined;
-  private readonly modelUrl: string;
-  private readonly infoUrl: string;
-  private readonly initTimeoutMs: number;
-  private readonly threads: number | undefined;
-
+export class GeneratorClient extends ModelClient<StreamParams, InitResult, GeneratedChunk, StreamInfo, ParityResult, StepInputs, GeneratedMotion> {
   constructor(options: GeneratorClientOptions = {}) {
-    // The worker resolves relative URLs against its own script URL, so make them absolute here.
-    this.modelUrl = new URL(options.modelUrl ?? 'models/generator.onnx', document.baseURI).href;
-    this.infoUrl = new URL(options.infoUrl ?? 'models/generator.json', document.baseURI).href;
-    this.initTimeoutMs = options.initTimeoutMs ?? 60_000;
-    this.threads = options.threads;
-    this.worker = new Worker(new URL('./generator.worker.ts', import.meta.url), { type: 'module', name: 'generator' });
-    this.worker.addEventListener('message', (event: MessageEvent<GeneratorReply>) => this.onReply(event.data));
-    this.worker.addEventListener('error', (event) => {
-      event.preventDefault();
-      this.fail(new Error(`generator worker failed: ${event.message || 'could not load or run the worker script'}`));
+    super(new Worker(new URL('./generator.worker.ts', import.meta.url), { type: 'module', name: 'generator' }), 'generator', {
+      ...options,
+      modelUrl: options.modelUrl ?? 'models/generator.onnx',
+      infoUrl: options.infoUrl ?? 'models/generator.json',
     });
-    this.worker.addEventListener('messageerror', () => this.fail(new Error('generator worker sent a message that could not be read')));
-  }
-
-  /** Loads the model; resolves with the thread count and load time. Call before anything else. */
-  async init(): Promise<InitResult> {
-    const result = await this.request('init', { modelUrl: this.modelUrl, infoUrl: this.infoUrl, threads: this.threads }, this.initTimeoutMs);
-    this.skeleton = { fps: result.fps, joints: result.joints, parents: result.parents };
-    return result;
-  }
-
-  /** `frames` new frames from a seed state; the same parameters always give bit-identical output. */
-  async generate(params: GenerateParams): Promise<GeneratedMotion> {
-    return this.toMotion(await this.request('generate', { ...params }));
-  }
-
-  /** Starts (or replaces) the endless stream; frames come from `pull`. */
-  startStream(params: StreamParams): Promise<StreamInfo> {
-    return this.request('startStream', { ...params });
-  }
-
-  /** The stream's next `frames` frames, continuing its state and root trajectory. */
-  async pull(frames: number): Promise<GeneratedMotion> {
-    return this.toMotion(await this.request('pull', { frames }));
-  }
-
-  /** Back to the start of the stream, with the parameters it was started with. */
-  restart(): Promise<StreamInfo> {
-    return this.request('restart', {});
-  }
-
-  /** Times `steps` raw session calls at `batch` streams. */
-  benchmark(batch: number, steps: number): Promise<BenchmarkResult> {
-    return this.request('benchmark', { batch, steps });
   }
 
   /**
@@ -110,66 +41,17 @@ export class GeneratorClient {
    * tests/fixtures/generator_reference.json's `step`.
    */
   parity(inputs?: StepInputs): Promise<ParityResult> {
-    return this.request('parity', inputs ? { inputs } : {});
+    return this.parityRequest(inputs);
   }
 
-  /** Stops the worker; pending and later calls reject. */
-  dispose(): void {
-    this.fail(new Error('the generator client was disposed'));
-  }
-
-  private toMotion(chunk: GeneratedChunk): GeneratedMotion {
-    if (!this.skeleton) throw new Error('generator: init has not completed');
+  protected toMotion(chunk: GeneratedChunk): GeneratedMotion {
     return {
-      fps: this.skeleton.fps,
-      frames: chunk.frames,
-      joints: this.skeleton.joints,
-      parents: this.skeleton.parents,
-      positions: chunk.positions,
+      ...this.motionOf(chunk),
       contacts: chunk.contacts,
       features: chunk.features,
       rootHeading: chunk.rootHeading,
       seedIndex: chunk.seedIndex,
       startFrame: chunk.startFrame,
     };
-  }
-
-  private request<T extends RequestType>(type: T, body: Body<T>, timeoutMs?: number): Promise<ReplyMap[T]> {
-    if (this.failure || !this.worker) return Promise.reject(this.failure ?? new Error('generator worker is not running'));
-    const id = this.nextId++;
-    return new Promise<ReplyMap[T]>((resolve, reject) => {
-      const entry: Pending = { resolve: resolve as (value: unknown) => void, reject };
-      if (timeoutMs !== undefined) {
-        // A worker that stalls would hold every later request in its queue too: give up on it entirely.
-        entry.timer = setTimeout(() => this.fail(new Error(`generator ${type}: no answer from the worker within ${timeoutMs / 1000} s`)), timeoutMs);
-      }
-      this.pending.set(id, entry);
-      this.worker!.postMessage({ id, type, ...body });
-    });
-  }
-
-  private onReply(message: GeneratorReply): void {
-    if (message.id === WORKER_ERROR_ID) {
-      if (!message.ok) this.fail(new Error(message.error));
-      return;
-    }
-    const entry = this.pending.get(message.id);
-    if (!entry) return;
-    this.pending.delete(message.id);
-    clearTimeout(entry.timer);
-    if (message.ok) entry.resolve(message.result);
-    else entry.reject(new Error(`generator ${message.error}`));
-  }
-
-  /** Rejects everything pending, stops the worker and makes later calls reject with the same error. */
-  private fail(error: Error): void {
-    this.failure ??= error;
-    for (const entry of this.pending.values()) {
-      clearTimeout(entry.timer);
-      entry.reject(error);
-    }
-    this.pending.clear();
-    this.worker?.terminate();
-    this.worker = undefined;
   }
 }

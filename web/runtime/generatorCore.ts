@@ -1,14 +1,12 @@
 // The generator's step loop, independent of where it runs: an onnxruntime session, the mixture sampler
 // and the feature decoder. generator.worker.ts wraps it in messages; unit tests drive it directly with
 // onnxruntime-web's Node build.
-import type { InferenceSession, Tensor, TensorConstructor } from 'onnxruntime-web';
+import type { InferenceSession, TensorConstructor } from 'onnxruntime-web';
 import { decodeFeatures, type RootStart } from './featureDecode';
 import type { GeneratorInfo } from './generatorModel';
-import type { BenchmarkResult, GeneratedChunk, GenerateParams, ParityResult, StepInputs, StepOutputs, StreamInfo, StreamParams } from './protocol';
+import type { BenchmarkResult, GeneratedChunk, GenerateParams, InitResult, ParityResult, StepInputs, StepOutputs, StreamInfo, StreamParams } from './protocol';
 import { denormalise, Rng, sampleMixture, snapContacts } from './sampler';
-
-export const MAX_FRAMES_PER_REQUEST = 100_000;
-export const MAX_BENCHMARK_BATCH = 4096;
+import { checkFrameCount, SessionCore, timeSteps } from './session';
 
 /** One generation stream: the LSTM input and state, the PRNG and where the root stands. */
 export interface GeneratorStream {
@@ -22,13 +20,7 @@ export interface GeneratorStream {
   frame: number;
 }
 
-export class GeneratorCore {
-  readonly info: GeneratorInfo;
-  readonly threads: number;
-  private readonly session: InferenceSession;
-  private readonly Tensor: TensorConstructor;
-  private readonly mean: Float32Array;
-  private readonly std: Float32Array;
+export class GeneratorCore extends SessionCore<GeneratorInfo> {
   private readonly L: number;
   private readonly H: number;
   private readonly M: number;
@@ -36,19 +28,7 @@ export class GeneratorCore {
 
   /** `Tensor` must come from the same onnxruntime module as the session. */
   constructor(session: InferenceSession, info: GeneratorInfo, Tensor: TensorConstructor, threads = 1) {
-    const missing = [
-      ...info.onnx.inputs.filter((n) => !session.inputNames.includes(n)).map((n) => `input "${n}"`),
-      ...info.onnx.outputs.filter((n) => !session.outputNames.includes(n)).map((n) => `output "${n}"`),
-    ];
-    if (missing.length) {
-      throw new Error(`the model lacks ${missing.join(', ')} (it has inputs [${session.inputNames}], outputs [${session.outputNames}])`);
-    }
-    this.session = session;
-    this.info = info;
-    this.Tensor = Tensor;
-    this.threads = threads;
-    this.mean = Float32Array.from(info.normalisation.mean);
-    this.std = Float32Array.from(info.normalisation.std);
+    super(session, info, Tensor, threads);
     ({ layers: this.L, hidden: this.H, mixtures: this.M, dim: this.D } = info.onnx);
   }
 
@@ -58,27 +38,25 @@ export class GeneratorCore {
     await this.step(1, x, h, c);
   }
 
-  release(): Promise<void> {
-    return this.session.release();
+  /** What the page needs to know about the loaded model (the worker's `init` reply). */
+  describe(loadMs: number): InitResult {
+    const info = this.info;
+    return {
+      ok: true,
+      threads: this.threads,
+      loadMs,
+      fps: info.fps,
+      joints: info.skeleton.joints,
+      parents: info.skeleton.parents,
+      dim: info.onnx.dim,
+      seeds: info.seeds.map((s) => s.name),
+    };
   }
 
   /** One raw session call: x (B×D normalised), h and c (layers×B×H). */
   async step(batch: number, x: Float32Array, h: Float32Array, c: Float32Array): Promise<StepOutputs> {
     const { L, H, M, D } = this;
-    const out = await this.session.run({
-      x: new this.Tensor('float32', x, [batch, D]),
-      h: new this.Tensor('float32', h, [L, batch, H]),
-      c: new this.Tensor('float32', c, [L, batch, H]),
-    });
-    const read = (name: string, size: number): Float32Array => {
-      const tensor: Tensor | undefined = out[name];
-      if (!tensor) throw new Error(`the model gave no output "${name}"`);
-      if (!(tensor.data instanceof Float32Array)) throw new Error(`model output "${name}" is ${tensor.type}, expected float32`);
-      if (tensor.data.length !== size) {
-        throw new Error(`model output "${name}" has ${tensor.data.length} values (dims ${tensor.dims.join('×')}), expected ${size}; does generator.json match generator.onnx?`);
-      }
-      return tensor.data;
-    };
+    const read = await this.run({ x: [x, [batch, D]], h: [h, [L, batch, H]], c: [c, [L, batch, H]] });
     return {
       weights: read('weights', batch * M),
       mu: read('mu', batch * M * D),
@@ -118,9 +96,7 @@ export class GeneratorCore {
 
   /** Advances a stream by `frames` steps and decodes them, continuing its root trajectory. */
   async advance(stream: GeneratorStream, frames: number): Promise<GeneratedChunk> {
-    if (!Number.isInteger(frames) || frames < 1 || frames > MAX_FRAMES_PER_REQUEST) {
-      throw new Error(`frames must be an integer from 1 to ${MAX_FRAMES_PER_REQUEST}, got ${frames}`);
-    }
+    checkFrameCount(frames);
     const { M, D } = this;
     const features = new Float32Array(frames * D);
     for (let t = 0; t < frames; t++) {
@@ -153,22 +129,17 @@ export class GeneratorCore {
   }
 
   /** Times `steps` raw session calls at `batch` rows, all starting from the first seed state. */
-  async benchmark(batch: number, steps: number): Promise<BenchmarkResult> {
-    if (!Number.isInteger(batch) || batch < 1 || batch > MAX_BENCHMARK_BATCH) throw new Error(`batch must be an integer from 1 to ${MAX_BENCHMARK_BATCH}, got ${batch}`);
-    if (!Number.isInteger(steps) || steps < 1) throw new Error(`steps must be a positive integer, got ${steps}`);
-    const inputs = this.batchInputs(new Array<number>(batch).fill(0));
-    let h: Float32Array = inputs.h;
-    let c: Float32Array = inputs.c;
-    for (let i = 0; i < 3; i++) await this.step(batch, inputs.x, h, c); // warm-up
-    const started = performance.now();
-    for (let i = 0; i < steps; i++) {
-      const out = await this.step(batch, inputs.x, h, c);
-      h = out.h_out;
-      c = out.c_out;
-    }
-    const ms = performance.now() - started;
-    const stepsPerSecond = (steps * 1000) / ms;
-    return { batch, steps, threads: this.threads, stepsPerSecond, msPerCall: ms / steps, particleStepsPerSecond: stepsPerSecond * batch };
+  benchmark(batch: number, steps: number): Promise<BenchmarkResult> {
+    return timeSteps(batch, steps, this.threads, () => {
+      const inputs = this.batchInputs(new Array<number>(batch).fill(0));
+      let h: Float32Array = inputs.h;
+      let c: Float32Array = inputs.c;
+      return async () => {
+        const out = await this.step(batch, inputs.x, h, c);
+        h = out.h_out;
+        c = out.c_out;
+      };
+    });
   }
 
   /** One raw step; without inputs, the first and last seed states at batch 2 (the Python fixture's inputs). */

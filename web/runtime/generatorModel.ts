@@ -3,6 +3,8 @@
 // seed states. `parseGeneratorInfo` checks everything the runtime relies on, so a mismatched or
 // truncated file fails at load time with a message saying which field is wrong.
 
+import { fieldChecks, loadModelInfo, ModelInfoError } from './modelInfo';
+
 export interface GeneratorInfo {
   id: string;
   kind: string;
@@ -55,73 +57,28 @@ export const EXPECTED_OUTPUTS = ['weights', 'mu', 'sigma', 'h_out', 'c_out'] as 
 /** Index of the first joint rotation vector in a feature row (after dtx, dtz, dry, ty, tilt xyz). */
 export const JOINT_FEATURES_START = 7;
 
-export class GeneratorInfoError extends Error {
-  constructor(source: string, message: string) {
-    super(`${source}: ${message}`);
-    this.name = 'GeneratorInfoError';
-  }
+export class GeneratorInfoError extends ModelInfoError {
+  override readonly name = 'GeneratorInfoError';
 }
 
-/** Fetches and checks the generator JSON. */
-export async function loadGeneratorInfo(url: string | URL): Promise<GeneratorInfo> {
-  const source = String(url);
-  let response: Response;
-  try {
-    response = await fetch(url);
-  } catch (err) {
-    throw new GeneratorInfoError(source, `could not fetch (${err instanceof Error ? err.message : String(err)})`);
-  }
-  if (!response.ok) throw new GeneratorInfoError(source, `HTTP ${response.status} ${response.statusText}`);
-  let raw: unknown;
-  try {
-    raw = await response.json();
-  } catch (err) {
-    throw new GeneratorInfoError(source, `not valid JSON (${err instanceof Error ? err.message : String(err)})`);
-  }
-  return parseGeneratorInfo(raw, source);
+/** Fetches and checks the model JSON. */
+export function loadGeneratorInfo(url: string | URL): Promise<GeneratorInfo> {
+  return loadModelInfo(url, parseGeneratorInfo, GeneratorInfoError);
 }
 
 /** Checks a parsed generator JSON; throws GeneratorInfoError naming the first bad field. */
 export function parseGeneratorInfo(raw: unknown, source = 'generator.json'): GeneratorInfo {
-  const fail = (message: string): never => {
-    throw new GeneratorInfoError(source, message);
-  };
-  const obj = (value: unknown, path: string): Record<string, unknown> =>
-    typeof value === 'object' && value !== null && !Array.isArray(value) ? (value as Record<string, unknown>) : fail(`${path} must be an object`);
-  const num = (value: unknown, path: string): number => (typeof value === 'number' && Number.isFinite(value) ? value : fail(`${path} must be a finite number`));
-  const posInt = (value: unknown, path: string): number => {
-    const n = num(value, path);
-    return Number.isInteger(n) && n > 0 ? n : fail(`${path} must be a positive integer, got ${n}`);
-  };
-  const numbers = (value: unknown, path: string, length?: number): number[] => {
-    if (!Array.isArray(value)) return fail(`${path} must be an array of numbers`);
-    if (length !== undefined && value.length !== length) fail(`${path} has ${value.length} values, expected ${length}`);
-    const bad = value.findIndex((v) => typeof v !== 'number' || !Number.isFinite(v));
-    if (bad >= 0) fail(`${path}[${bad}] is not a finite number`);
-    return value as number[];
-  };
-  const strings = (value: unknown, path: string): string[] =>
-    Array.isArray(value) && value.every((v) => typeof v === 'string') ? (value as string[]) : fail(`${path} must be an array of strings`);
+  const check = fieldChecks(source, GeneratorInfoError);
+  const { fail, obj, posInt, numbers, strings } = check;
 
   const root = obj(raw, 'the file');
-  const fps = num(root.fps, 'fps');
-  if (fps <= 0) fail(`fps must be positive, got ${fps}`);
+  check.positive(root.fps, 'fps');
 
-  const skeleton = obj(root.skeleton, 'skeleton');
-  const joints = strings(skeleton.joints, 'skeleton.joints');
-  const J = joints.length;
-  if (J === 0) fail('skeleton.joints is empty');
-  const parents = numbers(skeleton.parents, 'skeleton.parents', J);
-  parents.forEach((p, j) => {
-    if (j === 0 ? p !== -1 : !Number.isInteger(p) || p < 0 || p >= j) fail(`skeleton.parents[${j}] = ${p}: the root must be first (-1) and parents must precede children`);
-  });
-  numbers(skeleton.offsets, 'skeleton.offsets', J * 3);
+  const J = check.skeleton(root.skeleton);
 
   const onnx = obj(root.onnx, 'onnx');
-  const inputs = strings(onnx.inputs, 'onnx.inputs');
-  const outputs = strings(onnx.outputs, 'onnx.outputs');
-  if (inputs.join() !== EXPECTED_INPUTS.join()) fail(`onnx.inputs is [${inputs}], expected [${EXPECTED_INPUTS}]`);
-  if (outputs.join() !== EXPECTED_OUTPUTS.join()) fail(`onnx.outputs is [${outputs}], expected [${EXPECTED_OUTPUTS}]`);
+  check.names(onnx.inputs, 'onnx.inputs', EXPECTED_INPUTS);
+  check.names(onnx.outputs, 'onnx.outputs', EXPECTED_OUTPUTS);
   const layers = posInt(onnx.layers, 'onnx.layers');
   const hidden = posInt(onnx.hidden, 'onnx.hidden');
   posInt(onnx.mixtures, 'onnx.mixtures');
@@ -150,11 +107,7 @@ export function parseGeneratorInfo(raw: unknown, source = 'generator.json'): Gen
     if (Math.abs(n - 1) > 1e-3) fail(`features.references[${j}] is not a unit quaternion (norm ${n})`);
   });
 
-  const norm = obj(root.normalisation, 'normalisation');
-  numbers(norm.mean, 'normalisation.mean', D);
-  const std = numbers(norm.std, 'normalisation.std', D);
-  const badStd = std.findIndex((s) => s <= 0);
-  if (badStd >= 0) fail(`normalisation.std[${badStd}] = ${std[badStd]} must be positive`);
+  check.normalisation(root.normalisation, D);
 
   if (!Array.isArray(root.seeds) || root.seeds.length === 0) fail('seeds must be a non-empty array');
   (root.seeds as unknown[]).forEach((s, i) => {

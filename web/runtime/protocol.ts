@@ -1,5 +1,6 @@
 // Messages between GeneratorClient (main thread) and generator.worker.ts. Every request carries an id;
-// the worker answers each with exactly one reply carrying the same id.
+// the worker answers each with exactly one reply carrying the same id (WorkerReply, also used by the
+// dance worker: danceProtocol.ts).
 
 export interface GenerateParams {
   frames: number;
@@ -29,16 +30,16 @@ export interface StepOutputs {
   c_out: Float32Array;
 }
 
-export type GeneratorRequest =
+/** The requests every model worker understands (ortWorker.ts serveModel); `P` is the model's stream parameters. */
+export type ModelRequest<P, Inputs> =
   /** threads: onnxruntime-web wasm threads when cross-origin isolated (default 2; always 1 otherwise). */
   | { type: 'init'; modelUrl: string; infoUrl: string; threads?: number }
-  | ({ type: 'generate' } & GenerateParams)
-  | ({ type: 'startStream' } & StreamParams)
+  | ({ type: 'generate'; frames: number } & P)
+  | ({ type: 'startStream' } & P)
   | { type: 'pull'; frames: number }
   | { type: 'restart' }
   | { type: 'benchmark'; batch: number; steps: number }
-  /** Without inputs: the first and last seed states at batch 2, the same inputs the Python export used for its fixture. */
-  | { type: 'parity'; inputs?: StepInputs };
+  | { type: 'parity'; inputs?: Inputs };
 
 export interface InitResult {
   ok: true;
@@ -90,17 +91,9 @@ export interface ParityResult {
   outputs: StepOutputs;
 }
 
-export interface ReplyMap {
-  init: InitResult;
-  generate: GeneratedChunk;
-  startStream: StreamInfo;
-  pull: GeneratedChunk;
-  restart: StreamInfo;
-  benchmark: BenchmarkResult;
-  parity: ParityResult;
-}
-
-export type GeneratorReply = { id: number; ok: true; result: unknown } | { id: number; ok: false; error: string };
+/** A worker's answer to one request (the same shape for every model worker). */
+export type WorkerReply = { id: number; ok: true; result: unknown } | { id: number; ok: false; error: string };
+export type GeneratorReply = WorkerReply;
 
 /** Id of replies that are about the worker as a whole (an uncaught error), not one request. */
 export const WORKER_ERROR_ID = -1;

@@ -1,0 +1,195 @@
+/// <reference lib="webworker" />
+// What every model worker shares: onnxruntime-web's wasm setup (threads when cross-origin isolated,
+// else 1), fetching a model's JSON and ONNX bytes, creating the session, and the request loop (one
+// request at a time, in order, each answered by exactly one reply carrying its id).
+import * as ort from 'onnxruntime-web/wasm';
+// The runtime's files, handed to onnxruntime explicitly so Vite serves them in dev and emits them in a
+// build. The .mjs stays a file of its own (not bundled into the worker) because the threaded runtime
+// starts its helper workers from the .mjs's own URL.
+import ortWasmUrl from 'onnxruntime-web/ort-wasm-simd-threaded.wasm?url';
+import ortGlueUrl from 'onnxruntime-web/ort-wasm-simd-threaded.mjs?url';
+import { WORKER_ERROR_ID, type ModelRequest, type WorkerReply } from './protocol';
+
+declare const self: DedicatedWorkerGlobalScope;
+
+export { ort };
+
+/** Thread count onnxruntime settled on when it loaded its wasm (it cannot change afterwards). */
+let runtimeThreads: number | undefined;
+
+export function describe(err: unknown): string {
+  if (err instanceof Error) return err.message || err.name;
+  return typeof err === 'string' ? err : (JSON.stringify(err) ?? String(err));
+}
+
+function absolute(url: string): string {
+  return new URL(url, self.location.href).href;
+}
+
+/**
+ * Sets onnxruntime-web up on first use: `requestedThreads` when the page is cross-origin isolated
+ * (default 2), else 1. Later calls cannot change it (the wasm is loaded once per worker).
+ */
+function configureRuntime(requestedThreads?: number): void {
+  if (requestedThreads !== undefined && !(Number.isInteger(requestedThreads) && requestedThreads >= 1)) {
+    throw new Error(`threads must be a positive integer, got ${requestedThreads}`);
+  }
+  if (runtimeThreads !== undefined) return;
+  ort.env.wasm.numThreads = self.crossOriginIsolated ? (requestedThreads ?? 2) : 1;
+  ort.env.wasm.simd = true;
+  ort.env.wasm.proxy = false; // already off the main thread
+  ort.env.wasm.wasmPaths = { wasm: absolute(ortWasmUrl), mjs: absolute(ortGlueUrl) };
+}
+
+async function fetchBytes(url: string, what: string): Promise<Uint8Array> {
+  let response: Response;
+  try {
+    response = await fetch(url);
+  } catch (err) {
+    throw new Error(`${what} ${url}: could not fetch (${describe(err)})`);
+  }
+  if (!response.ok) throw new Error(`${what} ${url}: HTTP ${response.status} ${response.statusText}`);
+  // Dev servers answer unknown paths with the app's index.html; say so rather than "protobuf parsing failed".
+  if (response.headers.get('content-type')?.includes('text/html')) throw new Error(`${what} ${url}: got an HTML page, not a model file (wrong URL?)`);
+  return new Uint8Array(await response.arrayBuffer());
+}
+
+/**
+ * Fetches a model's description (`loadInfo`) and ONNX bytes in parallel, sets the runtime up and
+ * creates a session. `what` names the model in messages ("generator model").
+ */
+async function loadSession<Info>(
+  modelUrl: string,
+  infoUrl: string,
+  loadInfo: (url: string) => Promise<Info>,
+  what: string,
+  requestedThreads?: number,
+): Promise<{ session: ort.InferenceSession; info: Info; threads: number }> {
+  configureRuntime(requestedThreads);
+  const [info, bytes] = await Promise.all([loadInfo(infoUrl), fetchBytes(modelUrl, what)]);
+  let session: ort.InferenceSession;
+  try {
+    session = await ort.InferenceSession.create(bytes, { executionProviders: ['wasm'], graphOptimizationLevel: 'all' });
+  } catch (err) {
+    throw new Error(`could not create an onnxruntime-web session for ${modelUrl}: ${describe(err)}`);
+  }
+  runtimeThreads ??= ort.env.wasm.numThreads ?? 1; // onnxruntime lowers it to 1 where threads are unavailable
+  return { session, info, threads: runtimeThreads };
+}
+
+/** ArrayBuffers in a result (up to two levels deep), handed over instead of copied. */
+function transferables(result: unknown): Transferable[] {
+  const found = new Set<ArrayBuffer>();
+  const visit = (value: unknown, depth: number) => {
+    if (ArrayBuffer.isView(value) && value.buffer instanceof ArrayBuffer) found.add(value.buffer);
+    else if (value && typeof value === 'object' && depth < 2) Object.values(value).forEach((v) => visit(v, depth + 1));
+  };
+  visit(result, 0);
+  return [...found];
+}
+
+/**
+ * The worker's message loop: requests are handled one at a time, in order; each gets exactly one
+ * reply with its id, an error reply (`<type>: <message>`) if `handle` throws. An unhandled rejection
+ * is reported with WORKER_ERROR_ID, prefixed with `name` ("generator worker").
+ */
+function serveRequests<Request extends { type: string }>(name: string, handle: (request: Request) => Promise<unknown>): void {
+  const reply = (message: WorkerReply, transfer: Transferable[] = []) => self.postMessage(message, transfer);
+  let queue: Promise<void> = Promise.resolve();
+  self.addEventListener('message', (event: MessageEvent<{ id: number } & Request>) => {
+    const request = event.data;
+    queue = queue.then(async () => {
+      try {
+        const result = await handle(request);
+        reply({ id: request.id, ok: true, result }, transferables(result));
+      } catch (err) {
+        reply({ id: request.id, ok: false, error: `${request.type}: ${describe(err)}` });
+      }
+    });
+  });
+  self.addEventListener('unhandledrejection', (event) => {
+    reply({ id: WORKER_ERROR_ID, ok: false, error: `${name}: ${describe(event.reason)}` });
+  });
+}
+
+/** What a model worker runs: a step-loop core over one session (GeneratorCore, DanceCore). */
+export interface ModelCore<Stream, StreamParams> {
+  /** One step on fixed inputs: a model whose sizes disagree with its JSON fails at load time. */
+  check(): Promise<void>;
+  release(): Promise<void>;
+  /** The `init` reply. */
+  describe(loadMs: number): unknown;
+  generate(params: StreamParams & { frames: number }): Promise<unknown>;
+  createStream(params: StreamParams): Stream | Promise<Stream>;
+  streamInfo(stream: Stream): unknown;
+  advance(stream: Stream, frames: number): Promise<unknown>;
+  benchmark(batch: number, steps: number): Promise<unknown>;
+  parity(inputs: never): Promise<unknown>;
+}
+
+export interface ModelWorker<Info, Stream, P> {
+  /** Names the model in messages: "generator" → "generator worker: …", "the generator model is not loaded". */
+  name: string;
+  loadInfo(url: string): Promise<Info>;
+  makeCore(session: ort.InferenceSession, info: Info, threads: number): ModelCore<Stream, P>;
+  /** The stream parameters of a generate or startStream request. */
+  streamParams(request: P): P;
+}
+
+/**
+ * Serves one model in this worker: `init` loads it (replacing any earlier one), `generate` makes a
+ * motion in one go, `startStream` / `pull` / `restart` drive one endless stream, `benchmark` and
+ * `parity` time and check raw steps.
+ */
+export function serveModel<Info, Stream, P, StepInputs>(spec: ModelWorker<Info, Stream, P>): void {
+  let core: ModelCore<Stream, P> | undefined;
+  let stream: { value: Stream; params: P } | undefined;
+  const requireCore = () => core ?? fail(`the ${spec.name} model is not loaded: send init first`);
+  const requireStream = () => stream ?? fail('no stream: send startStream first');
+  const fail = (message: string): never => {
+    throw new Error(message);
+  };
+  const start = async (c: ModelCore<Stream, P>, params: P) => {
+    stream = undefined; // a failed start leaves no stale stream behind
+    stream = { value: await c.createStream(params), params };
+    return c.streamInfo(stream.value);
+  };
+
+  async function init(modelUrl: string, infoUrl: string, threads?: number): Promise<unknown> {
+    const started = performance.now();
+    const loaded = await loadSession(modelUrl, infoUrl, (url) => spec.loadInfo(url), `${spec.name} model`, threads);
+    await core?.release();
+    core = undefined;
+    stream = undefined;
+    try {
+      const made = spec.makeCore(loaded.session, loaded.info, loaded.threads);
+      await made.check();
+      core = made;
+    } catch (err) {
+      await loaded.session.release();
+      throw new Error(`${modelUrl} with ${infoUrl}: ${describe(err)}`);
+    }
+    return core.describe(performance.now() - started);
+  }
+
+  serveRequests<ModelRequest<P, StepInputs>>(`${spec.name} worker`, async (request) => {
+    switch (request.type) {
+      case 'init':
+        return init(request.modelUrl, request.infoUrl, request.threads);
+      case 'generate':
+        return requireCore().generate({ ...spec.streamParams(request), frames: request.frames });
+      case 'startStream':
+        return start(requireCore(), spec.streamParams(request));
+      case 'pull':
+        return requireCore().advance(requireStream().value, request.frames);
+      case 'restart':
+        return start(requireCore(), requireStream().params);
+      case 'benchmark':
+        return requireCore().benchmark(request.batch, request.steps);
+      case 'parity':
+        return requireCore().parity(request.inputs as never);
+      default:
+        throw new Error(`unknown request type "${(request as { type?: unknown }).type}"`);
+    }
+  });
+}

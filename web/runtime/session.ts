@@ -1,0 +1,97 @@
+// What the model cores (generatorCore.ts, danceCore.ts) share around an onnxruntime session: checking
+// its input and output names, normalisation, float32 feeds, reading outputs with clear errors, and
+// timing raw calls.
+import type { InferenceSession, Tensor, TensorConstructor } from 'onnxruntime-web';
+import type { BenchmarkResult } from './protocol';
+
+/** Throws unless the session has every input and output the model's JSON names. */
+function checkSessionNames(session: InferenceSession, inputs: readonly string[], outputs: readonly string[]): void {
+  const missing = [
+    ...inputs.filter((n) => !session.inputNames.includes(n)).map((n) => `input "${n}"`),
+    ...outputs.filter((n) => !session.outputNames.includes(n)).map((n) => `output "${n}"`),
+  ];
+  if (missing.length) {
+    throw new Error(`the model lacks ${missing.join(', ')} (it has inputs [${session.inputNames}], outputs [${session.outputNames}])`);
+  }
+}
+
+/** A float32 output of `size` values; `files` names the pair to blame on a size mismatch ("generator.json match generator.onnx"). */
+function readOutput(out: InferenceSession.OnnxValueMapType, name: string, size: number, files: string): Float32Array {
+  const tensor = out[name] as Tensor | undefined;
+  if (!tensor) throw new Error(`the model gave no output "${name}"`);
+  if (!(tensor.data instanceof Float32Array)) throw new Error(`model output "${name}" is ${tensor.type}, expected float32`);
+  if (tensor.data.length !== size) {
+    throw new Error(`model output "${name}" has ${tensor.data.length} values (dims ${tensor.dims.join('×')}), expected ${size}; does ${files}?`);
+  }
+  return tensor.data;
+}
+
+export const MAX_BENCHMARK_BATCH = 4096;
+export const MAX_FRAMES_PER_REQUEST = 100_000;
+
+/** Throws unless `frames` is a frame count one generate or pull request may ask for. */
+export function checkFrameCount(frames: number): void {
+  if (!Number.isInteger(frames) || frames < 1 || frames > MAX_FRAMES_PER_REQUEST) {
+    throw new Error(`frames must be an integer from 1 to ${MAX_FRAMES_PER_REQUEST}, got ${frames}`);
+  }
+}
+
+/**
+ * Checks batch and steps, then `setup()` builds the inputs and returns one step (which may feed its
+ * state forward); 3 warm-up calls, then `steps` timed ones.
+ */
+export async function timeSteps(batch: number, steps: number, threads: number, setup: () => () => Promise<void>): Promise<BenchmarkResult> {
+  if (!Number.isInteger(batch) || batch < 1 || batch > MAX_BENCHMARK_BATCH) throw new Error(`batch must be an integer from 1 to ${MAX_BENCHMARK_BATCH}, got ${batch}`);
+  if (!Number.isInteger(steps) || steps < 1) throw new Error(`steps must be a positive integer, got ${steps}`);
+  const step = setup();
+  for (let i = 0; i < 3; i++) await step(); // warm-up
+  const started = performance.now();
+  for (let i = 0; i < steps; i++) await step();
+  const ms = performance.now() - started;
+  const stepsPerSecond = (steps * 1000) / ms;
+  return { batch, steps, threads, stepsPerSecond, msPerCall: ms / steps, particleStepsPerSecond: stepsPerSecond * batch };
+}
+
+interface SessionModelInfo {
+  id?: string;
+  file: string;
+  onnx: { inputs: string[]; outputs: string[] };
+  normalisation: { mean: number[]; std: number[] };
+}
+
+/** Base of the model cores: one session, the model's JSON, its normalisation. */
+export abstract class SessionCore<Info extends SessionModelInfo> {
+  readonly info: Info;
+  readonly threads: number;
+  protected readonly mean: Float32Array;
+  protected readonly std: Float32Array;
+  private readonly session: InferenceSession;
+  private readonly Tensor: TensorConstructor;
+
+  /** `Tensor` must come from the same onnxruntime module as the session. */
+  constructor(session: InferenceSession, info: Info, Tensor: TensorConstructor, threads: number) {
+    checkSessionNames(session, info.onnx.inputs, info.onnx.outputs);
+    this.session = session;
+    this.info = info;
+    this.Tensor = Tensor;
+    this.threads = threads;
+    this.mean = Float32Array.from(info.normalisation.mean);
+    this.std = Float32Array.from(info.normalisation.std);
+  }
+
+  release(): Promise<void> {
+    return this.session.release();
+  }
+
+  /**
+   * One session call on float32 feeds (`name: [data, dims]`); returns a reader for outputs of known
+   * size, which names the files to blame when a size disagrees with the JSON.
+   */
+  protected async run(feeds: Record<string, [Float32Array, number[]]>): Promise<(name: string, size: number) => Float32Array> {
+    const tensors: Record<string, Tensor> = {};
+    for (const [name, [data, dims]] of Object.entries(feeds)) tensors[name] = new this.Tensor('float32', data, dims);
+    const out = await this.session.run(tensors);
+    const files = `${this.info.id ?? 'the model'}.json match ${this.info.file}`;
+    return (name, size) => readOutput(out, name, size, files);
+  }
+}
