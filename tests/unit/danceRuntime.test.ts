@@ -1,0 +1,90 @@
+// The dance step loop (web/runtime/danceCore.ts) on the shipped acLSTM model, run by onnxruntime-web's
+// Node build (the same wasm runtime the browser worker uses): one-step parity with the Python
+// onnxruntime fixture, determinism, streams that continue exactly, fitted frames at exact bone lengths.
+import { afterAll, beforeAll, describe, expect, it } from 'vitest';
+import { DanceCore } from '../../web/runtime/danceCore';
+import { parseDanceInfo, seedsOfStyle } from '../../web/runtime/danceModel';
+import { readRepoFile } from './corpus';
+import { bytes, maxAbsDiff, ort, shippedSession } from './shippedModel';
+
+const info = parseDanceInfo(JSON.parse(readRepoFile('public/models/aclstm.json')), 'public/models/aclstm.json');
+const step = JSON.parse(readRepoFile('tests/fixtures/aclstm_reference.json')).step as {
+  inputs: { batch: number; x: number[]; style: number[]; h: number[]; c: number[] };
+  outputs: Record<'y' | 'h_out' | 'c_out', number[]>;
+};
+const J = info.skeleton.joints.length;
+
+let core: DanceCore;
+
+beforeAll(async () => {
+  core = new DanceCore(await shippedSession(info.file), info, ort.Tensor);
+  await core.check();
+});
+
+afterAll(() => core?.release());
+
+
+describe('DanceCore', () => {
+  it('matches Python onnxruntime on the fixture step within 1e-4', async () => {
+    const { outputs } = await core.parity(step.inputs);
+    for (const name of ['y', 'h_out', 'c_out'] as const) {
+      expect(outputs[name].length, name).toBe(step.outputs[name].length);
+      expect(maxAbsDiff(outputs[name], step.outputs[name]), name).toBeLessThan(1e-4);
+    }
+  });
+
+  it('gives identical frames for the same style and seed, other frames for another seed motion', async () => {
+    const a = await core.generate({ style: 'salsa', seed: 0, frames: 30 });
+    const b = await core.generate({ style: 'salsa', seed: 0, frames: 30 });
+    const count = seedsOfStyle(info, 'salsa').length;
+    const wrapped = await core.generate({ style: 'salsa', seed: count, frames: 30 });
+    const other = await core.generate({ style: 'salsa', seed: 1, frames: 30 });
+    expect(bytes(a.positions)).toEqual(bytes(b.positions));
+    expect(bytes(wrapped.positions)).toEqual(bytes(a.positions));
+    expect(wrapped.seedIndex).toBe(a.seedIndex);
+    expect(bytes(other.positions)).not.toEqual(bytes(a.positions));
+    expect(info.seeds[a.seedIndex].style).toBe('salsa');
+  });
+
+  it('continues a stream exactly where the previous pull stopped', async () => {
+    const whole = await core.generate({ style: 'martial', seed: 2, frames: 50 });
+    const stream = await core.createStream({ style: 'martial', seed: 2 });
+    const first = await core.advance(stream, 20);
+    const rest = await core.advance(stream, 30);
+    expect(rest.startFrame).toBe(20);
+    const joined = new Float32Array(whole.positions.length);
+    joined.set(first.positions);
+    joined.set(rest.positions, first.positions.length);
+    expect(bytes(joined)).toEqual(bytes(whole.positions));
+  });
+
+  it('fits every frame to the skeleton: exact bone lengths, close to the network points', async () => {
+    const m = await core.generate({ style: 'indian', seed: 0, frames: 120 });
+    expect(m.positions.length).toBe(120 * J * 3);
+    expect(m.positions.every(Number.isFinite)).toBe(true);
+    let worstBone = 0;
+    let meanShift = 0;
+    for (let f = 0; f < 120; f++) {
+      for (let j = 0; j < J; j++) {
+        const o = (f * J + j) * 3;
+        meanShift += Math.hypot(m.positions[o] - m.predicted[o], m.positions[o + 1] - m.predicted[o + 1], m.positions[o + 2] - m.predicted[o + 2]) / (120 * J);
+        if (j === 0) continue;
+        const p = (f * J + info.skeleton.parents[j]) * 3;
+        const len = Math.hypot(m.positions[o] - m.positions[p], m.positions[o + 1] - m.positions[p + 1], m.positions[o + 2] - m.positions[p + 2]);
+        const want = Math.hypot(...info.skeleton.offsets.slice(j * 3, j * 3 + 3));
+        worstBone = Math.max(worstBone, Math.abs(len - want));
+      }
+    }
+    expect(worstBone).toBeLessThan(1e-4);
+    expect(meanShift).toBeLessThan(0.05);
+    // The first frame follows the seed, whose root ends over the origin.
+    expect(Math.hypot(m.positions[0], m.positions[2])).toBeLessThan(0.05);
+  });
+
+  it('rejects unknown styles, bad seeds and bad frame counts', async () => {
+    await expect(core.generate({ style: 'tango', seed: 0, frames: 1 })).rejects.toThrow('unknown style "tango" (styles: salsa, indian, martial)');
+    await expect(core.generate({ style: 'salsa', seed: -1, frames: 1 })).rejects.toThrow(/seed must be an integer ≥ 0/);
+    await expect(core.generate({ style: 'salsa', seed: 0, frames: 0 })).rejects.toThrow(/frames must be an integer from 1 to 100000/);
+    await expect(core.parity({ batch: 1, x: [], style: [], h: [], c: [] })).rejects.toThrow(/parity inputs do not fit batch 1/);
+  });
+});

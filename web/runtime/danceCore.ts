@@ -1,0 +1,171 @@
+// The dance models' step loop (acLSTM and its vanilla baseline), independent of where it runs: an
+// onnxruntime session, the feature decoder and the skeleton fit. dance.worker.ts wraps it in messages;
+// unit tests drive it directly with onnxruntime-web's Node build. The loop is training/dance.py's:
+// h = c = 0, the seed motion's frames are fed one by one (normalised), then each output y is one new
+// frame and is fed back as the next input. No randomness: the same style and seed give the same dance.
+import type { InferenceSession, TensorConstructor } from 'onnxruntime-web';
+import { SkeletonFitter } from '../motion/fitSkeleton';
+import { decodeDance, type DanceRoot } from './danceDecode';
+import { seedsOfStyle, type DanceInfo } from './danceModel';
+import type { DanceChunk, DanceGenerateParams, DanceInitResult, DanceParityResult, DanceStepInputs, DanceStepOutputs, DanceStreamInfo, DanceStreamParams } from './danceProtocol';
+import type { BenchmarkResult } from './protocol';
+import { denormalise } from './sampler';
+import { checkFrameCount, SessionCore, timeSteps } from './session';
+
+/** One dance: the next network input, the LSTM state, and where the root stands. */
+export interface DanceStream {
+  readonly params: DanceStreamParams;
+  readonly seedIndex: number;
+  readonly style: Float32Array;
+  /** The next input (normalised): the last output. */
+  x: Float32Array;
+  h: Float32Array;
+  c: Float32Array;
+  root: DanceRoot;
+  frame: number;
+}
+
+export class DanceCore extends SessionCore<DanceInfo> {
+  private readonly fitter: SkeletonFitter;
+  private readonly L: number;
+  private readonly H: number;
+  private readonly D: number;
+  private readonly S: number;
+  private readonly J: number;
+
+  /** `Tensor` must come from the same onnxruntime module as the session. */
+  constructor(session: InferenceSession, info: DanceInfo, Tensor: TensorConstructor, threads = 1) {
+    super(session, info, Tensor, threads);
+    ({ layers: this.L, hidden: this.H, dim: this.D } = info.onnx);
+    this.S = info.styles.length;
+    this.J = info.skeleton.joints.length;
+    this.fitter = new SkeletonFitter({ joints: info.skeleton.joints, parents: info.skeleton.parents, offsets: Float32Array.from(info.skeleton.offsets) });
+  }
+
+  /** One step at batch 1 from zeros: a model whose sizes disagree with the JSON fails here, not mid-dance. */
+  async check(): Promise<void> {
+    const { L, H, D, S } = this;
+    await this.step(1, new Float32Array(D), new Float32Array(S), new Float32Array(L * H), new Float32Array(L * H));
+  }
+
+  describe(loadMs: number): DanceInitResult {
+    const info = this.info;
+    return {
+      ok: true,
+      threads: this.threads,
+      loadMs,
+      id: info.id,
+      fps: info.fps,
+      joints: info.skeleton.joints,
+      parents: info.skeleton.parents,
+      offsets: info.skeleton.offsets,
+      styles: info.styles,
+      seeds: info.seeds.map((s) => ({ style: s.style, name: s.name })),
+      realPoseChange: info.real_pose_change,
+      trainingScheme: info.training_scheme ?? 'unknown',
+    };
+  }
+
+  /** One raw session call: x (B×D normalised), style (B×S one-hot), h and c (layers×B×H). */
+  async step(batch: number, x: Float32Array, style: Float32Array, h: Float32Array, c: Float32Array): Promise<DanceStepOutputs> {
+    const { L, H, D, S } = this;
+    const read = await this.run({ x: [x, [batch, D]], style: [style, [batch, S]], h: [h, [L, batch, H]], c: [c, [L, batch, H]] });
+    return { y: read('y', batch * D), h_out: read('h_out', L * batch * H), c_out: read('c_out', L * batch * H) };
+  }
+
+  /** Index into info.seeds of the seed motion for `style` and `seed` (seed mod the style's seed count). */
+  seedIndex(style: string, seed: number): number {
+    if (!this.info.styles.includes(style)) throw new Error(`unknown style "${style}" (styles: ${this.info.styles.join(', ')})`);
+    if (!Number.isInteger(seed) || seed < 0) throw new Error(`seed must be an integer ≥ 0, got ${seed}`);
+    const list = seedsOfStyle(this.info, style);
+    return list[seed % list.length];
+  }
+
+  /** A new dance: zero state, warmed up on the seed motion; its root stands at the origin, where the seed ends. */
+  async createStream(params: DanceStreamParams): Promise<DanceStream> {
+    const seedIndex = this.seedIndex(params.style, params.seed);
+    const { L, H, D, S } = this;
+    const style = new Float32Array(S);
+    style[this.info.styles.indexOf(params.style)] = 1;
+    let h: Float32Array = new Float32Array(L * H);
+    let c: Float32Array = new Float32Array(L * H);
+    let x: Float32Array = new Float32Array(D);
+    for (const frame of this.info.seeds[seedIndex].frames) {
+      const input = new Float32Array(D);
+      for (let d = 0; d < D; d++) input[d] = (frame[d] - this.mean[d]) / this.std[d];
+      ({ y: x, h_out: h, c_out: c } = await this.step(1, input, style, h, c));
+    }
+    return { params: { style: params.style, seed: params.seed }, seedIndex, style, x, h, c, root: { x: 0, z: 0 }, frame: 0 };
+  }
+
+  streamInfo(stream: DanceStream): DanceStreamInfo {
+    return { style: stream.params.style, seedIndex: stream.seedIndex, seedName: this.info.seeds[stream.seedIndex].name };
+  }
+
+  /** The stream's next `frames` frames: decoded, fitted to the skeleton, continuing its root path. */
+  async advance(stream: DanceStream, frames: number): Promise<DanceChunk> {
+    checkFrameCount(frames);
+    const { D } = this;
+    const features = new Float32Array(frames * D);
+    for (let t = 0; t < frames; t++) {
+      const row = features.subarray(t * D, (t + 1) * D);
+      denormalise(stream.x, this.mean, this.std, row);
+      if (!row.every(Number.isFinite)) throw new Error(`the model produced a non-finite value at frame ${stream.frame + t}`);
+      const out = await this.step(1, stream.x, stream.style, stream.h, stream.c);
+      stream.x = out.y;
+      stream.h = out.h_out;
+      stream.c = out.c_out;
+    }
+    const decoded = decodeDance(features, this.J, stream.root);
+    const chunk: DanceChunk = {
+      frames,
+      features,
+      predicted: decoded.positions,
+      positions: this.fitter.fit(decoded.positions).positions,
+      seedIndex: stream.seedIndex,
+      startFrame: stream.frame,
+    };
+    stream.root = decoded.end;
+    stream.frame += frames;
+    return chunk;
+  }
+
+  async generate(params: DanceGenerateParams): Promise<DanceChunk> {
+    const { frames, ...streamParams } = params;
+    checkFrameCount(frames);
+    return this.advance(await this.createStream(streamParams), frames);
+  }
+
+  /** Times `steps` raw session calls at `batch` rows, each feeding its output and state back (the dance loop). */
+  benchmark(batch: number, steps: number): Promise<BenchmarkResult> {
+    return timeSteps(batch, steps, this.threads, () => {
+      const { L, H, D, S } = this;
+      let x: Float32Array = new Float32Array(batch * D);
+      const style = new Float32Array(batch * S);
+      for (let b = 0; b < batch; b++) style[b * S + (b % S)] = 1;
+      let h: Float32Array = new Float32Array(L * batch * H);
+      let c: Float32Array = new Float32Array(L * batch * H);
+      return async () => {
+        ({ y: x, h_out: h, c_out: c } = await this.step(batch, x, style, h, c));
+      };
+    });
+  }
+
+  /** One raw step on the given inputs (tests/fixtures/aclstm_reference.json's `step.inputs`). */
+  async parity(inputs: DanceStepInputs): Promise<DanceParityResult> {
+    const { L, H, D, S } = this;
+    const batch = inputs?.batch;
+    if (!Number.isInteger(batch) || batch < 1) throw new Error(`parity needs inputs { batch, x, style, h, c }, got batch ${String(batch)}`);
+    const x = Float32Array.from(inputs.x ?? []);
+    const style = Float32Array.from(inputs.style ?? []);
+    const h = Float32Array.from(inputs.h ?? []);
+    const c = Float32Array.from(inputs.c ?? []);
+    if (x.length !== batch * D || style.length !== batch * S || h.length !== L * batch * H || c.length !== L * batch * H) {
+      throw new Error(
+        `parity inputs do not fit batch ${batch}: x has ${x.length} values (expected ${batch * D}), style ${style.length} (expected ${batch * S}), ` +
+          `h ${h.length} and c ${c.length} (expected ${L * batch * H})`,
+      );
+    }
+    return { outputs: await this.step(batch, x, style, h, c) };
+  }
+}
