@@ -8,7 +8,11 @@ import type { Motion } from '../motion/types';
 import { Viewer } from '../viewer/viewer';
 import { downloadText } from './download';
 import { baseName, readTextFile, type TextFile } from './files';
-import { GeneratorHost } from './generatorHost';
+import { DanceClient, type DanceInitResult } from '../runtime/danceClient';
+import { GeneratorClient, type InitResult } from '../runtime/generatorClient';
+import { DanceMode } from './danceMode';
+import type { LiveChunk, LiveMode } from './liveMode';
+import { BusyIndicator, ModelHost, pageThreads } from './modelHost';
 import { Panel } from './panel';
 import { RandomWalk } from './randomWalk';
 import { Toasts } from './toast';
@@ -24,19 +28,25 @@ export function errorMessage(e: unknown): string {
   return String(e);
 }
 
+export type Mode = 'clip' | 'walk' | 'dance';
+const MODES: Mode[] = ['clip', 'walk', 'dance'];
+
 export class App {
   readonly viewer: Viewer;
   readonly panel: Panel;
   readonly toasts: Toasts;
+  private readonly busy = new BusyIndicator(document.getElementById('model-status'));
   /** The generator model, loaded on first use (playground.generate, Random walk). */
-  readonly generator = new GeneratorHost(document.getElementById('model-status'));
+  readonly generator = new ModelHost<GeneratorClient, InitResult>(() => new GeneratorClient({ threads: pageThreads() }), this.busy);
+  private readonly danceHosts = new Map<string, ModelHost<DanceClient, DanceInitResult>>();
   private name = '';
   private lastAsf: TextFile | null = null;
   private lastErrorMessage: string | null = null;
   private readonly exportBtn = $('export-btn') as HTMLButtonElement;
   readonly walk: RandomWalk;
-  private mode: 'clip' | 'walk' = 'clip';
-  /** The clip shown before Random walk mode, restored when switching back. */
+  readonly danceMode: DanceMode;
+  private mode: Mode = 'clip';
+  /** The clip shown before a live mode (Random walk, Dance), restored when switching back. */
   private clip: { motion: Motion; name: string } | null = null;
 
   constructor() {
@@ -56,43 +66,76 @@ export class App {
     this.installDropZone();
 
     this.walk = new RandomWalk(this);
-    this.walk.onFailed = () => this.setMode('clip');
-    $('mode-clip').addEventListener('click', () => this.setMode('clip'));
-    $('mode-walk').addEventListener('click', () => this.setMode('walk'));
+    this.danceMode = new DanceMode(this);
+    for (const m of MODES) {
+      $(`mode-${m}`).addEventListener('click', () => this.setMode(m));
+      const live = this.liveMode(m);
+      if (live) live.onFailed = () => this.setMode('clip');
+    }
   }
 
-  get currentMode(): 'clip' | 'walk' {
+  get currentMode(): Mode {
     return this.mode;
   }
 
-  /** Clip mode shows the imported clip; Random walk mode streams from the generator (loaded on first use). */
-  setMode(mode: 'clip' | 'walk'): void {
+  /** A dance model's client (`id` "aclstm" or "aclstm-vanilla"), loaded on first use. */
+  dance(id: string): ModelHost<DanceClient, DanceInitResult> {
+    let host = this.danceHosts.get(id);
+    if (!host) {
+      host = new ModelHost(() => new DanceClient({ model: id, threads: pageThreads() }), this.busy);
+      this.danceHosts.set(id, host);
+    }
+    return host;
+  }
+
+  private liveMode(mode: Mode): LiveMode<LiveChunk> | null {
+    return mode === 'walk' ? this.walk : mode === 'dance' ? this.danceMode : null;
+  }
+
+  /**
+   * Clip mode shows the imported clip; Random walk and Dance modes stream from their models (loaded on
+   * first use). Leaving a live mode for Clip restores the clip shown before it.
+   */
+  setMode(mode: Mode): void {
     if (mode === this.mode) return;
+    const previous = this.mode;
     this.mode = mode;
-    $('mode-clip').setAttribute('aria-pressed', String(mode === 'clip'));
-    $('mode-walk').setAttribute('aria-pressed', String(mode === 'walk'));
+    for (const m of MODES) $(`mode-${m}`).setAttribute('aria-pressed', String(mode === m));
     document.body.classList.toggle('walk-mode', mode === 'walk');
-    if (mode === 'walk') {
-      const m = this.viewer.current;
-      this.clip = m ? { motion: m, name: this.name } : null;
-      $('clip-name').textContent = 'Random walk';
-      $('clip-meta').textContent = ' generator · 30 fps · live';
-      this.exportBtn.title = 'Download the last 20 s of the walk as BVH';
-      void this.walk.begin();
-    } else {
-      this.walk.stop();
+    document.body.classList.toggle('dance-mode', mode === 'dance');
+    this.liveMode(previous)?.stop();
+    if (mode === 'clip') {
       this.exportBtn.title = 'Download the shown motion as BVH';
       const clip = this.clip;
       this.clip = null;
       if (clip) this.show(clip.motion, clip.name);
       else this.clearMotion();
+      return;
     }
+    if (previous === 'clip') {
+      const m = this.viewer.current;
+      this.clip = m ? { motion: m, name: this.name } : null;
+    }
+    if (mode === 'walk') {
+      this.setLiveLabel('Random walk', 'generator · 30 fps · live');
+      this.exportBtn.title = 'Download the last 20 s of the walk as BVH';
+    } else {
+      this.setLiveLabel('Dance', 'loading…');
+      this.exportBtn.title = 'Download the last 20 s of the dance as BVH';
+    }
+    void this.liveMode(mode)!.begin();
   }
 
-  /** Random walk: shows the current window of streamed frames (`dropped` < 0: a new stream). */
-  showLive(motion: Motion, dropped: number): void {
+  /** The title line in a live mode. */
+  setLiveLabel(name: string, meta: string): void {
+    $('clip-name').textContent = name;
+    $('clip-meta').textContent = ` ${meta}`;
+  }
+
+  /** A live mode: shows the current window of streamed frames (`dropped` < 0: a new stream); `name` names exports. */
+  showLive(motion: Motion, dropped: number, name: string): void {
     this.viewer.setLive(motion, motion.contacts, dropped);
-    this.name = 'random-walk';
+    this.name = name;
     this.exportBtn.disabled = false;
     document.body.classList.add('has-motion');
   }
@@ -126,8 +169,8 @@ export class App {
 
   /** Shows an already validated motion. Contacts are detected when the motion has none. */
   show(motion: Motion, name = 'motion'): void {
-    if (this.mode === 'walk') {
-      // Showing a clip ends the walk; the new clip replaces the one remembered from before it.
+    if (this.mode !== 'clip') {
+      // Showing a clip ends the live mode; the new clip replaces the one remembered from before it.
       this.clip = null;
       this.setMode('clip');
     }

@@ -1,7 +1,6 @@
-// The page's one generator: a GeneratorClient (worker + onnxruntime-web) created on first use, shared by
-// `playground.generate` and the Random walk mode. Shows a loading indicator while the model loads.
-
-import { GeneratorClient, type InitResult } from '../runtime/generatorClient';
+// The page's model clients (a worker + onnxruntime-web each), created on first use and shared by
+// `playground.generate` and the live modes (Random walk, Dance). A loading indicator shows while any
+// model loads.
 
 /**
  * onnxruntime-web threads: `?threads=N` in the page URL; else, when cross-origin isolated, half the cores
@@ -19,22 +18,38 @@ export function pageThreads(): number {
   return Math.max(1, Math.min(4, Math.floor((navigator.hardwareConcurrency || 1) / 2)));
 }
 
-export interface LoadedGenerator {
-  client: GeneratorClient;
-  info: InitResult;
-}
-
-export class GeneratorHost {
-  private loading: Promise<LoadedGenerator> | null = null;
+/** The "Loading model…" indicator: shown while at least one load is running. */
+export class BusyIndicator {
   private busy = 0;
 
-  constructor(private readonly indicator: HTMLElement | null) {}
+  constructor(private readonly element: HTMLElement | null) {}
 
-  /** The loaded generator; loads it (once) on first call. A failed load is retried on the next call. */
-  load(): Promise<LoadedGenerator> {
+  add(delta: number): void {
+    this.busy += delta;
+    if (this.element) this.element.hidden = this.busy <= 0;
+  }
+}
+
+interface Client<Info> {
+  init(): Promise<Info>;
+  dispose(): void;
+}
+
+export interface LoadedModel<C, Info> {
+  client: C;
+  info: Info;
+}
+
+/** One model's client, loaded once on first use; a failed load is retried on the next call. */
+export class ModelHost<C extends Client<Info>, Info> {
+  private loading: Promise<LoadedModel<C, Info>> | null = null;
+
+  constructor(private readonly make: () => C, private readonly indicator: BusyIndicator) {}
+
+  load(): Promise<LoadedModel<C, Info>> {
     if (!this.loading) {
-      const client = new GeneratorClient({ threads: pageThreads() });
-      this.setBusy(+1);
+      const client = this.make();
+      this.indicator.add(+1);
       const loading = client.init().then(
         (info) => ({ client, info }),
         (e: unknown) => {
@@ -43,14 +58,14 @@ export class GeneratorHost {
           throw e;
         },
       );
-      loading.then(() => this.setBusy(-1), () => this.setBusy(-1));
+      loading.then(() => this.indicator.add(-1), () => this.indicator.add(-1));
       this.loading = loading;
     }
     return this.loading;
   }
 
-  /** Forgets a generator whose worker failed, so the next `load` starts a fresh one. */
-  reset(client?: GeneratorClient): void {
+  /** Forgets a client whose worker failed, so the next `load` starts a fresh one. */
+  reset(client?: C): void {
     if (!this.loading) return;
     const loading = this.loading;
     void loading.then(({ client: c }) => {
@@ -58,11 +73,5 @@ export class GeneratorHost {
       if (this.loading === loading) this.loading = null;
       c.dispose();
     }, () => undefined);
-  }
-
-  private setBusy(delta: number): void {
-    this.busy += delta;
-    if (!this.indicator) return;
-    this.indicator.hidden = this.busy <= 0;
   }
 }

@@ -1,0 +1,93 @@
+// Dance mode: a dance model (acLSTM, or the vanilla LSTM baseline for comparison) dances endlessly in
+// its worker (LiveMode) at 60 fps; the viewer shows the last ~20 s of the fitted skeleton, and a small
+// plot shows the pose change per second against real dance (the baseline's curve falls to the freeze
+// line within seconds: it stops moving).
+
+import { PoseChangeMeter } from '../motion/poseChange';
+import type { DanceClient, DanceInitResult, DanceMotion } from '../runtime/danceClient';
+import type { App } from './app';
+import { $, LiveMode, type LiveStream } from './liveMode';
+import { PoseChangePlot } from './poseChangePlot';
+
+export class DanceMode extends LiveMode<DanceMotion> {
+  private readonly model = $<HTMLSelectElement>('dance-model');
+  private readonly style = $<HTMLSelectElement>('dance-style');
+  private readonly seed = $<HTMLSelectElement>('dance-seed');
+  private readonly plot = new PoseChangePlot($<HTMLCanvasElement>('dance-plot'));
+  private meter: PoseChangeMeter | null = null;
+  /** Frames measured so far in this dance (the pose-change meter's input). */
+  private measured = 0;
+  private info: DanceInitResult | null = null;
+  private client: { id: string; client: DanceClient } | null = null;
+  private seedName = '';
+
+  constructor(app: App) {
+    // 1 s chunks at 60 fps, at least 1.5 s ahead, 20 s kept.
+    super(app, $('dance-status'), { chunk: 60, ahead: 90, keep: 1200, label: 'Dance', name: 'dance' });
+    this.model.addEventListener('change', () => this.restartIfActive());
+    this.style.addEventListener('change', () => {
+      if (this.info) this.listSeeds(this.info, 0);
+      this.restartIfActive();
+    });
+    this.seed.addEventListener('change', () => this.restartIfActive());
+    $('dance-restart').addEventListener('click', () => this.restartIfActive());
+  }
+
+  private get modelLabel(): string {
+    return this.model.selectedOptions[0]?.textContent ?? this.model.value;
+  }
+
+  /** The style selector lists the model's styles (kept if they are the same). */
+  private listStyles(info: DanceInitResult): void {
+    const current = [...this.style.options].map((o) => o.value);
+    if (current.join() === info.styles.join()) return;
+    const keep = info.styles.includes(this.style.value) ? this.style.value : info.styles[0];
+    this.style.replaceChildren(...info.styles.map((s) => new Option(s, s)));
+    this.style.value = keep;
+  }
+
+  /** The seed selector lists the seed motions of the selected style; option value = the API's `seed`. */
+  private listSeeds(info: DanceInitResult, selected: number): void {
+    const names = info.seeds.filter((s) => s.style === this.style.value).map((s) => s.name);
+    this.seed.replaceChildren(...names.map((name, i) => new Option(name, String(i))));
+    this.seed.value = String(selected < names.length ? selected : 0);
+    this.seed.dataset.style = this.style.value;
+  }
+
+  protected async open(): Promise<LiveStream<DanceMotion>> {
+    const id = this.model.value;
+    const { client, info } = await this.app.dance(id).load();
+    this.client = { id, client };
+    this.info = info;
+    this.listStyles(info);
+    this.listSeeds(info, this.seed.dataset.style === this.style.value ? Number(this.seed.value) || 0 : 0);
+    const style = this.style.value;
+    const stream = await client.startStream({ style, seed: Number(this.seed.value) || 0 });
+    this.seedName = stream.seedName;
+    this.meter = new PoseChangeMeter(info.joints.length, info.fps);
+    this.measured = 0;
+    this.plot.reset(info.realPoseChange[style]);
+    this.app.setLiveLabel('Dance', `${this.modelLabel} · ${style} · ${info.fps} fps · live`);
+    return { skeleton: info, pull: (frames) => client.pull(frames) };
+  }
+
+  protected forget(): void {
+    if (this.client) this.app.dance(this.client.id).reset(this.client.client);
+  }
+
+  /** Measures the network's own points (as the evaluation does), not the fitted ones. */
+  protected received(chunk: DanceMotion): void {
+    if (!this.meter || !this.info) return;
+    const step = Math.round(this.info.fps);
+    const done = Math.floor(Math.max(this.measured - 1, 0) / step);
+    const values = this.meter.push(chunk.predicted);
+    this.measured += chunk.frames;
+    // Second k is complete at stream frame (k + 1) · step.
+    this.plot.add(values, values.map((_, i) => (done + i + 1) * step));
+  }
+
+  protected describe(frame: number, fps: number): string {
+    this.plot.draw(frame);
+    return `frame ${frame} · ${(frame / fps).toFixed(1)} s · ${this.seedName}`;
+  }
+}
