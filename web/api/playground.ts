@@ -3,6 +3,7 @@
 // whose message says what is wrong, shows the same message on the page, and leaves the scene as it was.
 
 import { exportBVH as exportBVHText } from '../motion/bvh';
+import { detectContacts } from '../motion/contacts';
 import { importMotion as importMotionText, validateMotion } from '../motion/io';
 import type { Motion } from '../motion/types';
 import type { PlaybackState } from '../viewer/playback';
@@ -31,15 +32,20 @@ export interface ViewOptions {
 }
 
 export interface GenerateOptions {
-  /** A model id from `models()` of kind "lstm-gmm" (today: "generator"). */
+  /** A model id from `models()` of kind "lstm-gmm" ("generator") or "aclstm" ("aclstm", "aclstm-vanilla"). */
   model: string;
   /** Number of frames, an integer 1…100000. */
   frames: number;
-  /** Integer 0…2³²−1: picks the seed state (seed mod the number of seed states) and seeds the random stream. */
+  /**
+   * Integer 0…2³²−1. Generator: picks the seed state (seed mod the number of seed states) and seeds the
+   * random stream. acLSTM: picks the seed motion, seed mod the number of seed motions of the style.
+   */
   seed: number;
-  /** Sampling temperature 0…2 (default 0.5): 0 = each step's most likely mixture mean, 1 = the trained distribution. */
+  /** acLSTM models only, and required there: one of the model's `styles` ("salsa", "indian", "martial"). */
+  style?: string;
+  /** Generator only. Sampling temperature 0…2 (default 0.5): 0 = each step's most likely mixture mean, 1 = the trained distribution. */
   temperature?: number;
-  /** Clean-up by the refiner model: not available yet (only `false` is accepted). */
+  /** Generator only. Clean-up by the refiner model: not available yet (only `false` is accepted). */
   refine?: boolean;
 }
 
@@ -78,7 +84,7 @@ export interface Playground {
   /** Rendering diagnostics: display fps, current pixel ratio, quality tier, WebGL renderer. */
   stats(): RenderStats;
   /**
-   * Samples a new motion from a generator model (loaded on first use). Same arguments → bit-identical
+   * A new motion from a generator or dance model (loaded on first use). Same arguments → bit-identical
    * motion. Does not show it (call `show`).
    */
   generate(options: GenerateOptions): Promise<Motion>;
@@ -143,19 +149,29 @@ export function createPlayground(app: App): Playground {
     }
   }
 
-  function checkGenerate(options: unknown): Required<Omit<GenerateOptions, 'refine'>> {
+  type GeneratorCall = { kind: 'lstm-gmm'; model: string; frames: number; seed: number; temperature: number };
+  type DanceCall = { kind: 'aclstm'; model: string; frames: number; seed: number; style: string };
+
+  /** Checks generate's options against the model they name; the error says what is wrong. */
+  function checkGenerate(options: unknown): GeneratorCall | DanceCall {
     if (typeof options !== 'object' || options === null || Array.isArray(options)) {
-      throw new TypeError('options must be an object: { model, frames, seed, temperature? }');
-    }
-    const known = ['model', 'frames', 'seed', 'temperature', 'refine'];
-    for (const k of Object.keys(options)) {
-      if (!known.includes(k)) throw new TypeError(`unknown option "${k}" (known: ${known.join(', ')})`);
+      throw new TypeError('options must be an object: { model, frames, seed, temperature? } (acLSTM: { model, style, frames, seed })');
     }
     const o = options as Partial<Record<keyof GenerateOptions, unknown>>;
-    const generators = models.filter((m) => m.kind === 'lstm-gmm').map((m) => m.id);
-    if (typeof o.model !== 'string') throw new TypeError(`model must be a model id string (available: ${generators.join(', ') || 'none'})`);
-    if (!generators.includes(o.model)) {
-      throw new Error(`unknown model "${o.model}" (available: ${generators.join(', ') || 'none — the model list did not load'})`);
+    const usable = models.filter((m) => m.kind === 'lstm-gmm' || m.kind === 'aclstm');
+    const available = usable.map((m) => m.id).join(', ');
+    if (typeof o.model !== 'string') throw new TypeError(`model must be a model id string (available: ${available || 'none'})`);
+    const entry = usable.find((m) => m.id === o.model);
+    if (!entry) throw new Error(`unknown model "${o.model}" (available: ${available || 'none — the model list did not load'})`);
+    const dance = entry.kind === 'aclstm';
+    if (dance) {
+      // Dance models have no sampling and no refiner: say so rather than silently ignoring the option.
+      if ('temperature' in o) throw new TypeError(`temperature is not meaningful for acLSTM models: they are deterministic (the seed only picks the seed motion); leave it out`);
+      if ('refine' in o) throw new TypeError(`refine is not available for acLSTM models (there is no refiner for dance); leave it out`);
+    }
+    const known = dance ? ['model', 'style', 'frames', 'seed'] : ['model', 'frames', 'seed', 'temperature', 'refine'];
+    for (const k of Object.keys(options)) {
+      if (!known.includes(k)) throw new TypeError(`unknown option "${k}" for model "${entry.id}" (known: ${known.join(', ')})`);
     }
     if (typeof o.frames !== 'number' || !Number.isInteger(o.frames) || o.frames < 1 || o.frames > GENERATE_MAX_FRAMES) {
       throw new RangeError(`frames must be an integer from 1 to ${GENERATE_MAX_FRAMES}, got ${String(o.frames)}`);
@@ -163,13 +179,34 @@ export function createPlayground(app: App): Playground {
     if (typeof o.seed !== 'number' || !Number.isInteger(o.seed) || o.seed < 0 || o.seed > 0xffffffff) {
       throw new RangeError(`seed must be an integer from 0 to 4294967295, got ${String(o.seed)}`);
     }
+    if (dance) {
+      const styles = entry.styles ?? [];
+      if (o.style === undefined) throw new TypeError(`style is required for model "${entry.id}" (styles: ${styles.join(', ')})`);
+      if (typeof o.style !== 'string' || !styles.includes(o.style)) {
+        throw new RangeError(`unknown style ${typeof o.style === 'string' ? `"${o.style}"` : String(o.style)} for model "${entry.id}" (styles: ${styles.join(', ')})`);
+      }
+      return { kind: 'aclstm', model: entry.id, frames: o.frames, seed: o.seed, style: o.style };
+    }
     const temperature = o.temperature ?? GENERATE_DEFAULT_TEMPERATURE;
     if (typeof temperature !== 'number' || !Number.isFinite(temperature) || temperature < 0 || temperature > 2) {
       throw new RangeError(`temperature must be a number from 0 to 2, got ${String(o.temperature)}`);
     }
     if (o.refine === true) throw new Error('refine: the refiner is not available yet (pass refine: false or leave it out)');
     if (o.refine !== undefined && o.refine !== false) throw new TypeError(`refine must be true or false, got ${String(o.refine)}`);
-    return { model: o.model, frames: o.frames, seed: o.seed, temperature };
+    return { kind: 'lstm-gmm', model: entry.id, frames: o.frames, seed: o.seed, temperature };
+  }
+
+  /** A dance as a Motion: the fitted positions, and foot contacts detected as for imported clips. */
+  async function generateDance(o: DanceCall): Promise<Motion> {
+    const { client } = await app.dance(o.model).load();
+    const m = await client.generate({ style: o.style, seed: o.seed, frames: o.frames });
+    const motion: Motion = { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions };
+    try {
+      motion.contacts = detectContacts(motion);
+    } catch {
+      // no recognisable feet: no contacts
+    }
+    return motion;
   }
 
   const ready = loadManifest().then(
@@ -251,6 +288,7 @@ export function createPlayground(app: App): Playground {
       return guardedAsync('generate', async () => {
         await ready;
         const o = checkGenerate(options);
+        if (o.kind === 'aclstm') return generateDance(o);
         const { client } = await app.generator.load();
         const m = await client.generate({ frames: o.frames, seed: o.seed, temperature: o.temperature });
         const motion: Motion = {
