@@ -129,7 +129,9 @@ describe('generator in the page', { timeout: 240_000 }, () => {
       return { messages, same: pg.current() === before, lastError: pg.lastError(), state: pg.state() };
     });
     const m = results.messages;
-    assert.match(m[0], /^generate: unknown model "nope" \(available: generator\)/);
+    // Every model generate can run is offered: the generator and the dance models.
+    assert.match(m[0], /^generate: unknown model "nope" \(available: [^)]*\bgenerator\b[^)]*\)/);
+    assert.match(m[0], /\baclstm\b/);
     assert.match(m[1], /^generate: frames must be an integer from 1 to 100000, got 0/);
     assert.match(m[2], /frames must be an integer/);
     assert.match(m[3], /frames must be an integer/);

@@ -4,6 +4,7 @@ import { existsSync, readFileSync } from 'node:fs';
 import net from 'node:net';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
+import { after, before } from 'node:test';
 import { gunzipSync } from 'node:zlib';
 import { chromium } from 'playwright-core';
 import { createServer } from 'vite';
@@ -99,4 +100,23 @@ export function nextFrames(page, n = 2) {
       }),
     n,
   );
+}
+
+/**
+ * For a `describe` block: starts the dev server, Chromium and one playground page before its tests and
+ * closes them after. Returns an object whose `server`, `url`, `browser`, `page`, `context` and
+ * `problems` are filled in once the tests run.
+ */
+export function usePlayground(options) {
+  const suite = {};
+  before(async () => {
+    Object.assign(suite, await startServer());
+    suite.browser = await launchBrowser();
+    Object.assign(suite, await openPlayground(suite.browser, suite.url, options));
+  });
+  after(async () => {
+    await suite.browser?.close();
+    await suite.server?.close();
+  });
+  return suite;
 }
