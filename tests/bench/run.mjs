@@ -75,26 +75,36 @@ async function playbackBenchmark(ctx, query) {
   }
 }
 
-/** Raw generator throughput via GeneratorClient.benchmark, in a page opened with `?threads=N`. */
-async function generatorBenchmark(ctx, threads, batch, steps) {
+/**
+ * Raw step throughput of a model client (`client`: its module, export and options) via its `benchmark`,
+ * in a page opened with `?threads=N`. With `generate`, also the end-to-end rate of `generate` (steps,
+ * decoding and, for the dance models, the skeleton fit) after a short warm-up call.
+ */
+async function modelBenchmark(ctx, { client, threads, batch, steps, generate }) {
   const { context, page, problems } = await openPlayground(ctx.browser, `${ctx.url}?threads=${threads}`, VIEWPORT);
   try {
     const r = await page.evaluate(
-      async ({ threads, batch, steps }) => {
-        const { GeneratorClient } = await import('/runtime/generatorClient.ts');
-        const client = new GeneratorClient({ threads });
+      async ({ client, threads, batch, steps, generate }) => {
+        const module = await import(client.module);
+        const c = new module[client.name]({ ...client.options, threads });
         try {
-          const info = await client.init();
-          await client.benchmark(batch, Math.min(100, steps)); // warm-up
-          const b = await client.benchmark(batch, steps);
-          return { ...b, loadMs: info.loadMs, isolated: globalThis.crossOriginIsolated };
+          const info = await c.init();
+          await c.benchmark(batch, Math.min(100, steps)); // warm-up
+          const b = await c.benchmark(batch, steps);
+          let generateFps;
+          if (generate) {
+            await c.generate({ ...generate, frames: 60 });
+            const started = performance.now();
+            await c.generate(generate);
+            generateFps = (generate.frames * 1000) / (performance.now() - started);
+          }
+          return { ...b, loadMs: info.loadMs, generateFps, isolated: globalThis.crossOriginIsolated };
         } finally {
-          client.dispose();
+          c.dispose();
         }
       },
-      { threads, batch, steps },
+      { client, threads, batch, steps, generate },
     );
-    const target = batch === 1 ? { target_steps_per_s: 1000 } : { target_particle_steps_per_s: 20000 };
     return {
       threads: r.threads,
       threads_requested: threads,
@@ -104,7 +114,7 @@ async function generatorBenchmark(ctx, threads, batch, steps) {
       steps_per_s: Math.round(r.stepsPerSecond),
       ms_per_call: +r.msPerCall.toFixed(3),
       particle_steps_per_s: Math.round(r.particleStepsPerSecond),
-      ...target,
+      ...(r.generateFps === undefined ? {} : { generate_frames: generate.frames, generate_frames_per_s: Math.round(r.generateFps) }),
       load_ms: Math.round(r.loadMs),
       page_errors: problems.length,
     };
@@ -113,22 +123,31 @@ async function generatorBenchmark(ctx, threads, batch, steps) {
   }
 }
 
-/** Display frame rate while Random walk mode streams (default threads), plus how far the walk got. */
-async function randomWalkBenchmark(ctx) {
+const GENERATOR_CLIENT = { module: '/runtime/generatorClient.ts', name: 'GeneratorClient', options: {} };
+const DANCE_CLIENT = { module: '/runtime/danceClient.ts', name: 'DanceClient', options: { model: 'aclstm' } };
+
+async function generatorBenchmark(ctx, threads, batch, steps) {
+  const r = await modelBenchmark(ctx, { client: GENERATOR_CLIENT, threads, batch, steps });
+  return { ...r, ...(batch === 1 ? { target_steps_per_s: 1000 } : { target_particle_steps_per_s: 20000 }) };
+}
+
+/** Display frame rate while a live mode streams (default threads), plus how far its stream got per second. */
+async function liveModeBenchmark(ctx, button, statusId) {
   const { context, page, problems } = await openPlayground(ctx.browser, ctx.url, VIEWPORT);
+  const streamFrame = () => page.evaluate((id) => Number(document.getElementById(id).dataset.frame), statusId);
   try {
-    await page.click('#mode-walk');
-    await page.waitForFunction(() => Number(document.getElementById('walk-status').dataset.frame) > 0, null, { timeout: 60_000 });
+    await page.click(button);
+    await page.waitForFunction((id) => Number(document.getElementById(id).dataset.frame) > 0, statusId, { timeout: 60_000 });
     await page.waitForTimeout(WARMUP_SECONDS * 1000);
-    const f0 = await page.evaluate(() => Number(document.getElementById('walk-status').dataset.frame));
+    const f0 = await streamFrame();
     const frames = await measureFrames(page, SECONDS);
-    const f1 = await page.evaluate(() => Number(document.getElementById('walk-status').dataset.frame));
+    const f1 = await streamFrame();
     const stats = await page.evaluate(() => window.playground.stats());
     return {
       viewport: `${VIEWPORT.width}x${VIEWPORT.height}`,
       ...frames,
       target_fps: 60,
-      walk_frames_per_s: +((f1 - f0) / SECONDS).toFixed(1),
+      stream_frames_per_s: +((f1 - f0) / SECONDS).toFixed(1),
       ...displayFields(stats, problems),
     };
   } finally {
@@ -146,17 +165,28 @@ function displayFields(stats, problems) {
   };
 }
 
+const ACLSTM_BENCHMARKS = [1, 2].map((threads) => ({
+  name: `aclstm-single-t${threads}`,
+  description: `acLSTM, one dance (batch 1): 2000 raw steps, and generate 3000 frames (steps + decode + skeleton fit), ${threads} thread(s) requested — target ≥ 600 frames/s`,
+  kind: 'aclstm',
+  run: (ctx) =>
+    modelBenchmark(ctx, { client: DANCE_CLIENT, threads, batch: 1, steps: 2000, generate: { style: 'salsa', seed: 0, frames: 3000 } }).then((r) => ({
+      ...r,
+      target_frames_per_s: 600,
+    })),
+}));
+
 const GENERATOR_BENCHMARKS = [1, 2].flatMap((threads) => [
   {
     name: `generator-single-t${threads}`,
     description: `generator, one stream (batch 1, 2000 steps), ${threads} thread(s) requested — target ≥ 1,000 steps/s`,
-    generator: true,
+    kind: 'generator',
     run: (ctx) => generatorBenchmark(ctx, threads, 1, 2000),
   },
   {
     name: `generator-batch64-t${threads}`,
     description: `generator, batch 64 (300 steps), ${threads} thread(s) requested — target ≥ 20,000 particle-steps/s`,
-    generator: true,
+    kind: 'generator',
     run: (ctx) => generatorBenchmark(ctx, threads, 64, 300),
   },
 ]);
@@ -176,7 +206,15 @@ export const BENCHMARKS = [
   {
     name: 'random-walk',
     description: 'Random walk mode streaming from the generator (default threads), default quality — target 60 fps',
-    run: (ctx) => randomWalkBenchmark(ctx),
+    kind: 'live',
+    run: (ctx) => liveModeBenchmark(ctx, '#mode-walk', 'walk-status'),
+  },
+  ...ACLSTM_BENCHMARKS,
+  {
+    name: 'dance-mode',
+    description: 'Dance mode streaming acLSTM at 60 fps (default threads), skeleton fit and pose-change plot, default quality — target 60 fps',
+    kind: 'live',
+    run: (ctx) => liveModeBenchmark(ctx, '#mode-dance', 'dance-status'),
   },
 ];
 
@@ -214,15 +252,22 @@ async function main() {
       console.log(`  ${b.name}: FAILED — ${r.error}`);
       continue;
     }
-    if (b.generator) {
+    if (b.kind === 'aclstm') {
+      console.log(
+        `  ${b.name}: ${r.generate_frames_per_s} frames/s end to end (target ≥ 600), raw steps ${r.steps_per_s}/s, ${r.ms_per_call} ms/call,` +
+          ` ${r.threads} thread(s)${r.isolated ? '' : ' (not isolated)'}\n    ${b.description}`,
+      );
+      continue;
+    }
+    if (b.kind === 'generator') {
       const target = r.batch === 1 ? `${r.steps_per_s} steps/s (target ≥ 1,000)` : `${r.particle_steps_per_s} particle-steps/s (target ≥ 20,000)`;
       console.log(`  ${b.name}: ${target}, ${r.ms_per_call} ms/call, ${r.threads} thread(s)${r.isolated ? '' : ' (not isolated)'}\n    ${b.description}`);
       continue;
     }
-    if (b.name === 'random-walk') {
+    if (b.kind === 'live') {
       console.log(
         `  ${b.name}: ${r.mean_fps} fps mean (target 60), p95 frame ${r.p95_frame_ms} ms, ${r.long_frames}/${r.frames} frames > 25 ms,` +
-          ` walk ${r.walk_frames_per_s} frames/s — ${r.quality} quality at pixel ratio ${r.pixel_ratio}\n    ${b.description}`,
+          ` stream ${r.stream_frames_per_s} frames/s — ${r.quality} quality at pixel ratio ${r.pixel_ratio}\n    ${b.description}`,
       );
       continue;
     }
