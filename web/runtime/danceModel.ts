@@ -2,7 +2,7 @@
 // training/export_aclstm.py): skeleton, ONNX step signature, feature layout, normalisation, the seed
 // motions per style and the real pose change per style. `parseDanceInfo` checks everything the runtime
 // relies on and names the first bad field.
-import { fieldChecks, loadModelInfo, ModelInfoError } from './modelInfo';
+import { modelInfoFormat } from './modelInfo';
 
 export interface DanceInfo {
   id: string;
@@ -54,22 +54,8 @@ export interface DanceSeed {
 export const DANCE_INPUTS = ['x', 'style', 'h', 'c'] as const;
 export const DANCE_OUTPUTS = ['y', 'h_out', 'c_out'] as const;
 
-export class DanceInfoError extends ModelInfoError {
-  override readonly name = 'DanceInfoError';
-}
-
-/** Fetches and checks the model JSON. */
-export function loadDanceInfo(url: string | URL): Promise<DanceInfo> {
-  return loadModelInfo(url, parseDanceInfo, DanceInfoError);
-}
-
-/** Checks a parsed dance model JSON; throws DanceInfoError naming the first bad field. */
-export function parseDanceInfo(raw: unknown, source = 'aclstm.json'): DanceInfo {
-  const check = fieldChecks(source, DanceInfoError);
+const format = modelInfoFormat<DanceInfo>('DanceInfoError', 'aclstm.json', (check, root) => {
   const { fail, obj, posInt, numbers, strings } = check;
-
-  const root = obj(raw, 'the file');
-  check.positive(root.fps, 'fps');
   const styles = strings(root.styles, 'styles');
   if (styles.length === 0 || new Set(styles).size !== styles.length) fail('styles must be a non-empty list of distinct names');
   const J = check.skeleton(root.skeleton);
@@ -102,8 +88,13 @@ export function parseDanceInfo(raw: unknown, source = 'aclstm.json'): DanceInfo 
     if (!seeds.some((s) => s.style === style)) fail(`no seed motion for style "${style}"`);
     check.positive(change[style], `real_pose_change.${style}`);
   }
-  return raw as DanceInfo;
-}
+});
+
+export const DanceInfoError = format.InfoError;
+/** Checks a parsed dance model JSON; throws DanceInfoError naming the first bad field. */
+export const parseDanceInfo = format.parse;
+/** Fetches and checks a dance model JSON. */
+export const loadDanceInfo = format.load;
 
 /** Indices into `info.seeds` of one style's seed motions, in file order. */
 export function seedsOfStyle(info: DanceInfo, style: string): number[] {

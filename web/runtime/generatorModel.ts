@@ -3,7 +3,7 @@
 // seed states. `parseGeneratorInfo` checks everything the runtime relies on, so a mismatched or
 // truncated file fails at load time with a message saying which field is wrong.
 
-import { fieldChecks, loadModelInfo, ModelInfoError } from './modelInfo';
+import { modelInfoFormat } from './modelInfo';
 
 export interface GeneratorInfo {
   id: string;
@@ -57,23 +57,8 @@ export const EXPECTED_OUTPUTS = ['weights', 'mu', 'sigma', 'h_out', 'c_out'] as 
 /** Index of the first joint rotation vector in a feature row (after dtx, dtz, dry, ty, tilt xyz). */
 export const JOINT_FEATURES_START = 7;
 
-export class GeneratorInfoError extends ModelInfoError {
-  override readonly name = 'GeneratorInfoError';
-}
-
-/** Fetches and checks the model JSON. */
-export function loadGeneratorInfo(url: string | URL): Promise<GeneratorInfo> {
-  return loadModelInfo(url, parseGeneratorInfo, GeneratorInfoError);
-}
-
-/** Checks a parsed generator JSON; throws GeneratorInfoError naming the first bad field. */
-export function parseGeneratorInfo(raw: unknown, source = 'generator.json'): GeneratorInfo {
-  const check = fieldChecks(source, GeneratorInfoError);
+const format = modelInfoFormat<GeneratorInfo>('GeneratorInfoError', 'generator.json', (check, root) => {
   const { fail, obj, posInt, numbers, strings } = check;
-
-  const root = obj(raw, 'the file');
-  check.positive(root.fps, 'fps');
-
   const J = check.skeleton(root.skeleton);
 
   const onnx = obj(root.onnx, 'onnx');
@@ -118,5 +103,10 @@ export function parseGeneratorInfo(raw: unknown, source = 'generator.json'): Gen
     numbers(seed.c, `seeds[${i}].c`, layers * hidden);
   });
 
-  return raw as GeneratorInfo;
-}
+});
+
+export const GeneratorInfoError = format.InfoError;
+/** Checks a parsed generator JSON; throws GeneratorInfoError naming the first bad field. */
+export const parseGeneratorInfo = format.parse;
+/** Fetches and checks the generator JSON. */
+export const loadGeneratorInfo = format.load;

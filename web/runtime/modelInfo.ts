@@ -33,6 +33,8 @@ export async function loadModelInfo<T>(url: string | URL, parse: (raw: unknown, 
 
 export interface FieldChecks {
   fail(message: string): never;
+  /** The file's top-level object, with a positive `fps`. */
+  file(raw: unknown): Record<string, unknown>;
   obj(value: unknown, path: string): Record<string, unknown>;
   num(value: unknown, path: string): number;
   posInt(value: unknown, path: string): number;
@@ -54,6 +56,11 @@ export function fieldChecks(source: string, ErrorClass: InfoErrorClass): FieldCh
   };
   const c: FieldChecks = {
     fail,
+    file(raw) {
+      const root = c.obj(raw, 'the file');
+      c.positive(root.fps, 'fps');
+      return root;
+    },
     obj: (value, path) =>
       typeof value === 'object' && value !== null && !Array.isArray(value) ? (value as Record<string, unknown>) : fail(`${path} must be an object`),
     num: (value, path) => (typeof value === 'number' && Number.isFinite(value) ? value : fail(`${path} must be a finite number`)),
@@ -99,4 +106,20 @@ export function fieldChecks(source: string, ErrorClass: InfoErrorClass): FieldCh
     },
   };
   return c;
+}
+
+/**
+ * A model's JSON format: its error class (named `errorName`), `parse(raw, source?)` which checks the file
+ * with `check(checks, root)` (throwing the error class naming the first bad field) and `load(url)`.
+ */
+export function modelInfoFormat<T>(errorName: string, defaultSource: string, check: (c: FieldChecks, root: Record<string, unknown>) => void) {
+  const InfoError = class extends ModelInfoError {
+    override readonly name = errorName;
+  };
+  const parse = (raw: unknown, source = defaultSource): T => {
+    const c = fieldChecks(source, InfoError);
+    check(c, c.file(raw));
+    return raw as T;
+  };
+  return { InfoError, parse, load: (url: string | URL): Promise<T> => loadModelInfo(url, parse, InfoError) };
 }
