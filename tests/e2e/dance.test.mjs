@@ -5,7 +5,7 @@ import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
 import { describe, test } from 'node:test';
-import { openPlayground, ROOT, usePlayground } from './harness.mjs';
+import { openPlayground, ROOT, startServer, usePlayground } from './harness.mjs';
 
 const INFO = JSON.parse(readFileSync(path.join(ROOT, 'public', 'models', 'aclstm.json'), 'utf8'));
 const REFERENCE = JSON.parse(readFileSync(path.join(ROOT, 'tests', 'fixtures', 'aclstm_reference.json'), 'utf8'));
@@ -300,6 +300,26 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
       assert.deepEqual(fresh.problems, []);
     } finally {
       await fresh.context.close();
+    }
+  });
+
+  test('without cross-origin isolation the dance model runs single-threaded', async () => {
+    const plain = await startServer({ headers: { 'Cross-Origin-Opener-Policy': 'unsafe-none', 'Cross-Origin-Embedder-Policy': 'unsafe-none' } });
+    try {
+      const { context, page, problems } = await openPlayground(suite.browser, `${plain.url}?threads=2`);
+      const r = await page.evaluate(async () => {
+        const { DanceClient } = await import('/runtime/danceClient.ts');
+        const client = new DanceClient({ threads: 2 });
+        const info = await client.init();
+        client.dispose();
+        const m = await window.playground.generate({ model: 'aclstm', style: 'salsa', frames: 30, seed: 0 });
+        return { isolated: globalThis.crossOriginIsolated, threads: info.threads, frames: m.frames };
+      });
+      await context.close();
+      assert.deepEqual(r, { isolated: false, threads: 1, frames: 30 });
+      assert.deepEqual(problems, []);
+    } finally {
+      await plain.server.close();
     }
   });
 });
