@@ -130,14 +130,7 @@ def main(argv: list[str] | None = None) -> None:
     scheduler = torch.optim.lr_scheduler.ExponentialLR(optimiser, gamma=args.decay)
     iteration, best, elapsed_before, history = 0, float("inf"), 0.0, []
     if args.resume:
-        state = run.load()
-        if state is None:
-            raise SystemExit(f"error: --resume but no checkpoint at {run.checkpoint_path}")
-        model.load_state_dict(state["model"])
-        optimiser.load_state_dict(state["optimiser"])
-        scheduler.load_state_dict(state["scheduler"])
-        rng.bit_generator.state = state["rng"]
-        torch.set_rng_state(state["torch_rng"])
+        state = run.resume(model, optimiser, scheduler, rng)
         iteration, best, elapsed_before, history = state["iteration"], state["best"], state["elapsed"], state["history"]
         run.log.info("resumed at iteration %d", iteration)
     meta = {"dim": dim, "styles": list(STYLES), "hidden": args.hidden, "layers": args.layers, "fps": MODEL_FPS,
@@ -167,7 +160,7 @@ def main(argv: list[str] | None = None) -> None:
         torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
         optimiser.step()
         iteration += 1
-        losses.append(float(loss))
+        losses.append(loss.item())
         bar.update(1)
         bar.set_postfix(loss=f"{np.mean(losses[-50:]):.4f}")
         if iteration % args.iters_per_epoch == 0:

@@ -152,14 +152,7 @@ def main(argv: list[str] | None = None) -> None:
     iters_per_epoch = args.iters_per_epoch
     start_epoch, start_iter, best, elapsed_before = 0, 0, float("inf"), 0.0
     if args.resume:
-        state = run.load()
-        if state is None:
-            raise SystemExit(f"error: --resume but no checkpoint at {run.checkpoint_path}")
-        model.load_state_dict(state["model"])
-        optimiser.load_state_dict(state["optimiser"])
-        scheduler.load_state_dict(state["scheduler"])
-        rng.bit_generator.state = state["rng"]
-        torch.set_rng_state(state["torch_rng"])
+        state = run.resume(model, optimiser, scheduler, rng)
         start_epoch, start_iter, best = state["epoch"], state["iteration"], state["best"]
         elapsed_before = state["elapsed"]
         run.log.info("resumed at epoch %d iteration %d", start_epoch, start_iter)
