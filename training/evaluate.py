@@ -245,10 +245,12 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--sweep-frames", type=int, default=3000)
     parser.add_argument("--mocap", default=None)
     parser.add_argument("--models", type=Path, default=MODELS_DIR, help="directory with the exported model")
+    parser.add_argument("--also", action="append", default=[], metavar="LABEL=JSON",
+                        help="aclstm: another exported dance model to compare (not shipped), e.g. 'acLSTM v=20=/tmp/x/aclstm.json'")
     args = parser.parse_args(argv)
     if args.model == "aclstm":
         from . import evaluate_aclstm
-        evaluate_aclstm.run(args.frames or 20000, args.seeds, args.mocap, args.models)
+        evaluate_aclstm.run(args.frames or 20000, args.seeds, args.mocap, args.models, args.also)
         return
     args.frames = args.frames or 10000
     REPORTS.mkdir(parents=True, exist_ok=True)

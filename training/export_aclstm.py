@@ -121,6 +121,16 @@ def write_reference_fixture(onnx_path: Path, info: dict) -> None:
     print(f"wrote {FIXTURE}")
 
 
+def training_minutes(checkpoint: Path, iteration: int | None) -> float | None:
+    """Training time (minutes) up to `iteration`, from the run's latest checkpoint history."""
+    latest = checkpoint.parent / "checkpoint.pt"
+    if not latest.exists() or iteration is None:
+        return None
+    history = torch.load(latest, weights_only=False).get("history", [])
+    upto = [h["minutes"] for h in history if h["iteration"] <= iteration]
+    return round(upto[-1], 1) if upto else None
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--run", default="aclstm", help="run under runs/")
@@ -157,8 +167,8 @@ def main(argv: list[str] | None = None) -> None:
         "normalisation": {"mean": [round(float(v), 7) for v in meta["mean"]], "std": [round(float(v), 7) for v in meta["std"]]},
         "real_pose_change": real_pose_change(clips),
         "seeds": pick_seeds(clips),
-        "training": {"iterations": state.get("iteration"), "valid": state.get("valid"), "valid_files": meta["valid_files"],
-                     "args": meta["args"]},
+        "training": {"iterations": state.get("iteration"), "minutes": training_minutes(checkpoint, state.get("iteration")),
+                     "valid": state.get("valid"), "valid_files": meta["valid_files"], "args": meta["args"]},
         "parity": parity,
     }
     (args.out / f"{model_id}.json").write_text(json.dumps(info) + "\n")
