@@ -3,7 +3,7 @@
     python -m training.export_generator [--checkpoint runs/generator/best.pt]
 
 Writes public/models/generator.onnx (one step: x, h, c -> weights, mu, sigma, h_out, c_out; the batch
-dimension is dynamic) and public/models/generator.json (skeleton, feature layout, normalisation,
+dimension is dynamic; the graph is built directly, see step_graph) and public/models/generator.json (skeleton, feature layout, normalisation,
 rotation references, seed states estimated as in eq. 26, training and parity numbers).
 """
 from __future__ import annotations
@@ -13,11 +13,13 @@ import json
 from pathlib import Path
 
 import numpy as np
+import onnx
 import onnxruntime as ort
 import torch
+from onnx import TensorProto, helper, numpy_helper
 
 from .features import FIXED_JOINTS, FeatureCodec, feature_names
-from .models.generator import GeneratorStep, MixtureLSTM, mixture_nll
+from .models.generator import LOG_SIGMA_MIN, GeneratorStep, MixtureLSTM, mixture_nll
 from .manifest import register_model
 from .paths import REPO_ROOT
 from .rotations import matrix_to_quat
@@ -28,6 +30,7 @@ from .train_generator import load_clips
 MODELS_DIR = REPO_ROOT / "public" / "models"
 INPUTS, OUTPUTS = ["x", "h", "c"], ["weights", "mu", "sigma", "h_out", "c_out"]
 PARITY_TOLERANCE = 1e-4
+OPSET = 17
 
 
 def load_generator(checkpoint: Path) -> tuple[MixtureLSTM, dict, dict]:
@@ -38,18 +41,94 @@ def load_generator(checkpoint: Path) -> tuple[MixtureLSTM, dict, dict]:
     return model.eval(), meta, state
 
 
+GATE_ORDER = [0, 1, 3, 2]  # the graph's gate blocks (i, f, o, g) from PyTorch's (i, f, g, o): one Sigmoid covers i, f, o
+
+
+def step_graph(model: MixtureLSTM) -> onnx.ModelProto:
+    """The generator step written directly as an ONNX graph: x (B, D), h, c (2, B, H) -> weights (B, M),
+    mu, sigma (B, M, D), h_out, c_out (2, B, H); the batch dimension is dynamic.
+
+    Each LSTM layer is written out at gate level: gates = Gemm(input, W_ih) + Gemm(h, W_hh, b_ih + b_hh) (the
+    second Gemm is the first's C input, so no separate Add or Concat), then one Sigmoid over (i, f, o), one
+    Tanh over g, and the cell update. fc1 and fc2 are Gemm + Relu (fused by onnxruntime); fc3 is three
+    Gemms (mixture logits, means, log standard deviations), so no output is a slice of a larger tensor.
+    Initializers are named after the torch layers; training/recover_generator.py reads them back.
+    """
+    sd = {k: v.detach().cpu().numpy().astype(np.float32) for k, v in model.state_dict().items()}
+    H, D, M = model.hidden, model.dim, model.mixtures
+    inits, nodes = [], []
+
+    def const(name, value):
+        inits.append(numpy_helper.from_array(np.ascontiguousarray(value), name))
+        return name
+
+    def node(op, inputs, outputs, **attrs):
+        nodes.append(helper.make_node(op, inputs, outputs, **attrs))
+        return outputs[0] if len(outputs) == 1 else outputs
+
+    def gemm(inp, name, weight, bias, out, c=None):  # inp @ weight.T + bias (torch layout), or + c
+        w = const(f"{name}.weight_t", weight.T)
+        return node("Gemm", [inp, w, const(f"{name}.bias", bias) if c is None else c], [out])
+
+    def gates(w):  # rows in PyTorch's gate order -> GATE_ORDER
+        return w.reshape(4, H, *w.shape[1:])[GATE_ORDER].reshape(4 * H, *w.shape[1:])
+
+    y = node("Relu", [gemm("x", "fc1", sd["fc1.weight"], sd["fc1.bias"], "fc1")], ["fc1_relu"])
+    y = node("Relu", [gemm(y, "fc2", sd["fc2.weight"], sd["fc2.bias"], "fc2")], ["fc2_relu"])
+    per_layer = const("per_layer", np.array([1, 1], np.int64))
+    h_in = node("Split", ["h", per_layer], ["h0", "h1"], axis=0)  # (1, B, H) each
+    c_in = node("Split", ["c", per_layer], ["c0", "c1"], axis=0)
+    rows = const("rows", np.array([-1, H], np.int64))
+    gate_split = const("gate_split", np.array([3 * H, H], np.int64))
+    ifo_split = const("ifo_split", np.array([H, H, H], np.int64))
+    h_new, c_new = [], []
+    for layer in range(2):
+        w_ih, w_hh = sd[f"lstm.weight_ih_l{layer}"], sd[f"lstm.weight_hh_l{layer}"]
+        b = sd[f"lstm.bias_ih_l{layer}"] + sd[f"lstm.bias_hh_l{layer}"]
+        h_rows = node("Reshape", [h_in[layer], rows], [f"h{layer}_rows"])
+        c_rows = node("Reshape", [c_in[layer], rows], [f"c{layer}_rows"])
+        rec = gemm(h_rows, f"lstm{layer}_hh", gates(w_hh), gates(b), f"rec{layer}")
+        pre = gemm(y, f"lstm{layer}_ih", gates(w_ih), None, f"gates{layer}", c=rec)
+        sig_in, tanh_in = node("Split", [pre, gate_split], [f"sig_in{layer}", f"tanh_in{layer}"], axis=1)
+        i, f, o = node("Split", [node("Sigmoid", [sig_in], [f"sig{layer}"]), ifo_split], [f"i{layer}", f"f{layer}", f"o{layer}"], axis=1)
+        g = node("Tanh", [tanh_in], [f"g{layer}"])
+        c2 = node("Add", [node("Mul", [f, c_rows], [f"f_c{layer}"]), node("Mul", [i, g], [f"i_g{layer}"])], [f"c_new{layer}"])
+        y = node("Mul", [o, node("Tanh", [c2], [f"tanh_c{layer}"])], [f"h_new{layer}"])
+        h_new.append(y)
+        c_new.append(c2)
+    state = const("state_shape", np.array([2, -1, H], np.int64))
+    node("Reshape", [node("Concat", h_new, ["h_rows"], axis=0), state], ["h_out"])
+    node("Reshape", [node("Concat", c_new, ["c_rows"], axis=0), state], ["c_out"])
+    w3, b3 = sd["fc3.weight"], sd["fc3.bias"]
+    parts = {"logits": slice(0, M), "mu": slice(M, M + M * D), "log_sigma": slice(M + M * D, M + 2 * M * D)}
+    out = {k: gemm(y, f"fc3_{k}", w3[s], b3[s], f"fc3_{k}") for k, s in parts.items()}
+    node("Softmax", [out["logits"]], ["weights"], axis=-1)
+    mixture_shape = const("mixture_shape", np.array([-1, M, D], np.int64))
+    node("Reshape", [out["mu"], mixture_shape], ["mu"])
+    log_sigma = node("Reshape", [out["log_sigma"], mixture_shape], ["log_sigma"])
+    node("Exp", [node("Max", [log_sigma, const("log_sigma_min", np.array(LOG_SIGMA_MIN, np.float32))], ["log_sigma_clamped"])], ["sigma"])
+
+    def value(name, shape):
+        return helper.make_tensor_value_info(name, TensorProto.FLOAT, shape)
+
+    graph = helper.make_graph(
+        nodes, "generator_step",
+        [value("x", ["batch", D]), value("h", [2, "batch", H]), value("c", [2, "batch", H])],
+        [value("weights", ["batch", M]), value("mu", ["batch", M, D]), value("sigma", ["batch", M, D]),
+         value("h_out", [2, "batch", H]), value("c_out", [2, "batch", H])], inits)
+    onnx_model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", OPSET)], producer_name="training.export_generator")
+    onnx_model.ir_version = 8
+    onnx.checker.check_model(onnx_model, full_check=True)
+    return onnx_model
+
+
 def export_onnx(model: MixtureLSTM, path: Path) -> None:
-    step = GeneratorStep(model).eval()
-    x = torch.zeros(1, model.dim)
-    h, c = model.zero_state(1)
-    batch = {0: "batch"}
-    torch.onnx.export(step, (x, h, c), str(path), input_names=INPUTS, output_names=OUTPUTS, opset_version=17,
-                      dynamo=False, dynamic_axes={"x": batch, "h": {1: "batch"}, "c": {1: "batch"}, "weights": batch,
-                                                  "mu": batch, "sigma": batch, "h_out": {1: "batch"}, "c_out": {1: "batch"}})
+    onnx.save(step_graph(model.eval()), str(path))
 
 
 def check_parity(model: MixtureLSTM, path: Path, steps: int = 20) -> dict:
-    """Run torch and onnxruntime side by side for several steps at batch 1 and 7, feeding states back."""
+    """Run torch (GeneratorStep: nn.LSTM, as trained) and onnxruntime (the exported gate-level graph) side by
+    side for several steps at batch 1 and 7, feeding states back."""
     session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
     step = GeneratorStep(model).eval()
     rng = np.random.default_rng(1)
@@ -168,7 +247,8 @@ def main(argv: list[str] | None = None) -> None:
         "description": "Contact-aware LSTM with a 5-component Gaussian mixture over the next frame (Wang, Chai, Xia §4.1), "
                        "trained on CMU walking and running.",
         "skeleton": skel.to_json(),
-        "onnx": {"inputs": INPUTS, "outputs": OUTPUTS, "opset": 17, "layers": 2, "hidden": meta["hidden"],
+        "onnx": {"inputs": INPUTS, "outputs": OUTPUTS, "opset": OPSET, "layers": 2, "hidden": meta["hidden"],
+                 "graph": "gate-level LSTM layers (Gemm + gate maths, no LSTM op), fc3 as three Gemms",
                  "mixtures": meta["mixtures"], "dim": meta["dim"]},
         "features": {
             "names": feature_names(skel), "joints": codec.joints, "fixed_joints": fixed,

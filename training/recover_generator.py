@@ -8,8 +8,10 @@ normalisation, rotation references, training numbers) from generator.json, in th
 training/train_generator.py saves, so python -m training.export_generator works on the result. The rebuilt
 model is checked against the ONNX file with onnxruntime before anything is written.
 
-Reads the export form with two ONNX LSTM nodes (weights in ONNX gate order i, o, f, c; PyTorch's is
-i, f, g, o) and MatMul + Add (or Gemm) for fc1-3.
+Reads both export forms: the original one (torch's exporter: two ONNX LSTM nodes, weights in ONNX gate
+order i, o, f, c, fc layers as MatMul + Add) and the gate-level one training/export_generator.py writes now
+(initializers named after the torch layers, gates in the order GATE_ORDER). The gate-level form keeps only
+b_ih + b_hh, so a checkpoint recovered from it holds that sum in bias_ih and zeros in bias_hh: the same model.
 
 What cannot be recovered: the optimiser state (so no --resume from it) and the unrounded normalisation
 and references (the JSON keeps 7 decimals; those rounded values are what the page uses anyway).
@@ -27,6 +29,7 @@ import onnxruntime as ort
 import torch
 from onnx import numpy_helper
 
+from .export_generator import GATE_ORDER
 from .models.generator import GeneratorStep, MixtureLSTM
 from .paths import REPO_ROOT
 from .rotations import quat_to_matrix
@@ -34,7 +37,7 @@ from .runs import RUNS_DIR
 
 MODELS_DIR = REPO_ROOT / "public" / "models"
 OUTPUTS = ["weights", "mu", "sigma", "h_out", "c_out"]
-ONNX_TO_TORCH_GATES = [0, 2, 3, 1]  # torch (i, f, g, o) from ONNX blocks (i, o, f, c)
+ONNX_TO_TORCH_GATES = [0, 2, 3, 1]  # torch (i, f, g, o) from ONNX LSTM blocks (i, o, f, c)
 
 
 def _reorder_gates(w: np.ndarray, hidden: int) -> np.ndarray:
@@ -86,14 +89,35 @@ def _lstm_node_weights(graph: onnx.GraphProto, inits: dict[str, np.ndarray], hid
     return state
 
 
+def _named_weights(inits: dict[str, np.ndarray], hidden: int) -> dict[str, np.ndarray]:
+    """State dict entries from training/export_generator.py's own graph, whose initializers are named after
+    the torch layers: fcK.weight_t / fcK.bias (fc3 in three parts: logits, mu, log_sigma), and per LSTM
+    layer lstmL_ih.weight_t, lstmL_hh.weight_t and lstmL_hh.bias (gates in the order GATE_ORDER, biases summed)."""
+    state = {}
+    for k in (1, 2):
+        state[f"fc{k}.weight"], state[f"fc{k}.bias"] = inits[f"fc{k}.weight_t"].T, inits[f"fc{k}.bias"]
+    parts = [f"fc3_{p}" for p in ("logits", "mu", "log_sigma")]
+    state["fc3.weight"] = np.concatenate([inits[f"{p}.weight_t"].T for p in parts])
+    state["fc3.bias"] = np.concatenate([inits[f"{p}.bias"] for p in parts])
+    back = lambda w: w.reshape(4, hidden, *w.shape[1:])[np.argsort(GATE_ORDER)].reshape(4 * hidden, *w.shape[1:])
+    for layer in (0, 1):
+        state[f"lstm.weight_ih_l{layer}"] = back(inits[f"lstm{layer}_ih.weight_t"].T)
+        state[f"lstm.weight_hh_l{layer}"] = back(inits[f"lstm{layer}_hh.weight_t"].T)
+        state[f"lstm.bias_ih_l{layer}"] = back(inits[f"lstm{layer}_hh.bias"])
+        state[f"lstm.bias_hh_l{layer}"] = np.zeros(4 * hidden, np.float32)
+    return state
+
+
 def model_from_onnx(path: Path, dim: int, hidden: int, mixtures: int) -> MixtureLSTM:
     """A MixtureLSTM (eval mode) holding the weights of the exported generator step at `path`."""
     graph = onnx.load(str(path)).graph
     inits = {i.name: numpy_helper.to_array(i).astype(np.float32) for i in graph.initializer}
-    if any(n.op_type == "LSTM" for n in graph.node):
+    if "fc1.weight_t" in inits:
+        state = _named_weights(inits, hidden)
+    elif any(n.op_type == "LSTM" for n in graph.node):
         state = _lstm_node_weights(graph, inits, hidden)
     else:
-        raise ValueError(f"{path}: no LSTM nodes; not a generator export")
+        raise ValueError(f"{path}: neither named initializers (fc1.weight_t ...) nor LSTM nodes; not a generator export")
     model = MixtureLSTM(dim, hidden, mixtures)
     expected = model.state_dict()
     for name, value in state.items():

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import torch
 
-from training.export_generator import INPUTS, MODELS_DIR, OUTPUTS, load_generator
+from training.export_generator import INPUTS, MODELS_DIR, OUTPUTS, export_onnx, load_generator
 from training.models.generator import GeneratorStep, MixtureLSTM
 from training.recover_generator import checkpoint_from_shipped, compare_with_onnx, model_from_onnx
 from training.rotations import matrix_to_quat
@@ -38,6 +38,15 @@ def test_recovers_the_lstm_node_export_exactly(tmp_path):
     for name, value in model.state_dict().items():
         assert torch.equal(rebuilt.state_dict()[name], value), name
     assert compare_with_onnx(rebuilt, path) < 1e-5
+
+
+def test_recovers_the_gate_level_export(tmp_path):
+    model = random_model()
+    path = tmp_path / "g.onnx"
+    export_onnx(model, path)
+    rebuilt = model_from_onnx(path, 11, 16, 5)
+    assert compare_with_onnx(rebuilt, path) < 1e-5
+    assert compare_with_onnx(model, path) < 1e-5
 
 
 def test_the_comparison_sees_a_wrong_weight(tmp_path):
