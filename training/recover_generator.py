@@ -25,18 +25,16 @@ from pathlib import Path
 
 import numpy as np
 import onnx
-import onnxruntime as ort
 import torch
 from onnx import numpy_helper
 
-from .export_generator import GATE_ORDER
-from .models.generator import GeneratorStep, MixtureLSTM
+from .export_generator import GATE_ORDER, parity_error
+from .models.generator import MixtureLSTM
 from .paths import REPO_ROOT
 from .rotations import quat_to_matrix
 from .runs import RUNS_DIR
 
 MODELS_DIR = REPO_ROOT / "public" / "models"
-OUTPUTS = ["weights", "mu", "sigma", "h_out", "c_out"]
 ONNX_TO_TORCH_GATES = [0, 2, 3, 1]  # torch (i, f, g, o) from ONNX LSTM blocks (i, o, f, c)
 
 
@@ -128,23 +126,8 @@ def model_from_onnx(path: Path, dim: int, hidden: int, mixtures: int) -> Mixture
 
 
 def compare_with_onnx(model: MixtureLSTM, path: Path, batches=(1, 7), steps: int = 5, seed: int = 0) -> float:
-    """Largest |torch - onnxruntime| / max(1, |torch|) over all outputs, random inputs and random states
-    (fed forward from torch), at each batch size."""
-    session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
-    step = GeneratorStep(model).eval()
-    rng = np.random.default_rng(seed)
-    worst = 0.0
-    for batch in batches:
-        h = rng.normal(scale=0.5, size=(2, batch, model.hidden)).astype(np.float32)
-        c = rng.normal(scale=0.5, size=(2, batch, model.hidden)).astype(np.float32)
-        for _ in range(steps):
-            x = rng.normal(size=(batch, model.dim)).astype(np.float32)
-            with torch.no_grad():
-                ref = [t.numpy() for t in step(torch.from_numpy(x), torch.from_numpy(h), torch.from_numpy(c))]
-            got = session.run(OUTPUTS, {"x": x, "h": h, "c": c})
-            worst = max(worst, max(float((np.abs(a - b) / np.maximum(1.0, np.abs(a))).max()) for a, b in zip(ref, got)))
-            h, c = ref[3], ref[4]
-    return worst
+    """Largest |torch - onnxruntime| / max(1, |torch|) from random states (see export_generator.parity_error)."""
+    return parity_error(model, path, batches, steps, seed, state_scale=0.5)
 
 
 def checkpoint_from_shipped(onnx_path: Path, info: dict) -> dict:
