@@ -276,9 +276,14 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
     // The vanilla baseline runs in the same mode.
     await suite.page.selectOption('#dance-model', 'aclstm-vanilla');
     await suite.page.waitForFunction(() => document.getElementById('clip-meta').textContent.includes('vanilla'), null, { timeout: 60_000 });
+    // The switch shows at once; the baseline's stream starts once its model has loaded (no fixed deadline).
     const g1 = await status(suite.page);
-    await suite.page.waitForTimeout(2000);
-    assert.ok((await status(suite.page)) > g1 + 30, 'the baseline dances too');
+    await suite.page.waitForFunction(
+      (from) => Number(document.getElementById('dance-status').dataset.frame) > from + 30,
+      g1,
+      { timeout: 60_000 },
+    );
+    assert.match(await suite.page.locator('#clip-meta').textContent(), /vanilla/, 'the baseline dances too');
 
     await suite.page.click('#mode-clip');
     const back = await suite.page.evaluate(() => ({ frames: window.playground.current()?.frames, dance: document.body.classList.contains('dance-mode') }));
