@@ -34,6 +34,11 @@ class DanceCorpus:
     def __init__(self, clips: list[dict], window: int, rng: np.random.Generator):
         self.window = window
         self.train = {s: [c for c in clips if c["style"] == s and not c["held_out"]] for s in STYLES}
+        # Clips of a style are drawn in proportion to their duration.
+        self.clip_p = {}
+        for s, mine in self.train.items():
+            secs = np.array([len(c["positions"]) / c["fps"] for c in mine])
+            self.clip_p[s] = secs / secs.sum()
         self.valid_files = [c["file"] for c in clips if c["held_out"]]
         sample = np.concatenate([self._features(rng, s)[0] for s in STYLES for _ in range(200)])
         self.mean = sample.mean(axis=0)
@@ -47,8 +52,7 @@ class DanceCorpus:
 
     def _features(self, rng, style, speed=None, angle=None):
         clips = self.train[style]
-        secs = np.array([len(c["positions"]) / c["fps"] for c in clips])
-        c = clips[rng.choice(len(clips), p=secs / secs.sum())]
+        c = clips[rng.choice(len(clips), p=self.clip_p[style])]
         speed = rng.uniform(*SPEEDS) if speed is None else speed
         span = (self.window + 2) * speed / MODEL_FPS
         start = rng.uniform(0, max(1e-6, len(c["positions"]) / c["fps"] - span))
