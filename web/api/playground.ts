@@ -49,6 +49,49 @@ export interface GenerateOptions {
   refine?: boolean;
 }
 
+export interface FollowPathOptions {
+  /** The path on the ground: [x, z] pairs in metres, at least 2, 0.5–200 m long. The character starts at the first point facing along the path. */
+  points: [number, number][];
+  /** "walk" (default) or "run": picks the seed states and the pace. */
+  gait?: 'walk' | 'run';
+  /** Integer 0…2³²−1 (default 0): the same seed and path give the same motion. */
+  seed?: number;
+  /** σ_fit of the path-fit term in metres, 0.02–2 (default 0.1): smaller follows tighter. */
+  fitTolerance?: number;
+}
+
+export interface FollowPathStats {
+  /** Mean and largest distance from the root (on the ground) to the path over all frames, metres. */
+  meanError: number;
+  maxError: number;
+  /** Share of the path's length the character covered (0…1). */
+  arcProgress: number;
+  /** Wall-clock milliseconds the optimisation took. */
+  optimizeMs: number;
+}
+
+export type FollowedPathMotion = Motion & { contacts: Uint8Array; stats: FollowPathStats };
+
+export interface SimulateControlOptions {
+  /** Length of the simulated run, seconds (0 < seconds ≤ 600). */
+  seconds: number;
+  /** Targets over time: [{ t: 0, speed, heading }, …] with t in seconds, increasing; speed 0–4 m/s; heading in radians (0 faces +z). */
+  schedule: { t: number; speed: number; heading: number }[];
+  /** Integer 0…2³²−1 (default 0). */
+  seed?: number;
+  /** Seed states to start from: "walk", or "run"; default "run" when the first target speed is 2 m/s or more. */
+  gait?: 'walk' | 'run';
+}
+
+export type ControlledMotion = Motion & {
+  contacts: Uint8Array;
+  /** Per frame: achieved speed (m/s, the root's mean horizontal speed over the last 0.5 s) and facing heading (rad, in (−π, π]). */
+  speed: Float32Array;
+  heading: Float32Array;
+  /** Per frame: compute milliseconds of the optimised batch it belongs to, divided by the batch's frames. */
+  computeMs: Float32Array;
+};
+
 export const GENERATE_DEFAULT_TEMPERATURE = 0.5;
 export const GENERATE_MAX_FRAMES = 100_000;
 
@@ -88,6 +131,16 @@ export interface Playground {
    * motion. Does not show it (call `show`).
    */
   generate(options: GenerateOptions): Promise<Motion>;
+  /**
+   * A walk or run along a ground path, optimised with the generator (Wang, Chai, Xia §5.2). Does not
+   * show it (call `show`). Resolves with the motion and how well it follows the path.
+   */
+  followPath(options: FollowPathOptions): Promise<FollowedPathMotion>;
+  /**
+   * The live steering loop driven by a schedule of speed and heading targets instead of a person (the
+   * same code as the Steer mode). Does not show it.
+   */
+  simulateControl(options: SimulateControlOptions): Promise<ControlledMotion>;
 }
 
 declare global {
@@ -196,6 +249,15 @@ export function createPlayground(app: App): Playground {
     return { kind: 'lstm-gmm', model: entry.id, frames: o.frames, seed: o.seed, temperature };
   }
 
+  /** Throws unless `options` is a plain object whose keys are all in `known`. */
+  function checkKeys(options: unknown, known: string[], shape: string): Record<string, unknown> {
+    if (typeof options !== 'object' || options === null || Array.isArray(options)) throw new TypeError(`options must be an object: ${shape}`);
+    for (const k of Object.keys(options)) {
+      if (!known.includes(k)) throw new TypeError(`unknown option "${k}" (known: ${known.join(', ')})`);
+    }
+    return options as Record<string, unknown>;
+  }
+
   /** A dance as a Motion: the fitted positions, and foot contacts detected as for imported clips. */
   async function generateDance(o: DanceCall): Promise<Motion> {
     const { client } = await app.dance(o.model).load();
@@ -300,6 +362,37 @@ export function createPlayground(app: App): Playground {
           contacts: m.contacts,
         };
         return motion;
+      });
+    },
+
+    followPath(options) {
+      return guardedAsync('followPath', async () => {
+        const o = checkKeys(options, ['points', 'gait', 'seed', 'fitTolerance'], '{ points: [[x, z], …], gait?, seed?, fitTolerance? }');
+        await ready;
+        const { client } = await app.generator.load();
+        const m = await client.followPath({
+          points: o.points as [number, number][],
+          gait: (o.gait ?? 'walk') as 'walk' | 'run',
+          seed: (o.seed ?? 0) as number,
+          ...(o.fitTolerance === undefined ? {} : { fitSigma: o.fitTolerance as number }),
+        });
+        const { meanError, maxError, arcProgress, optimizeMs } = m.stats;
+        return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, stats: { meanError, maxError, arcProgress, optimizeMs } };
+      });
+    },
+
+    simulateControl(options) {
+      return guardedAsync('simulateControl', async () => {
+        const o = checkKeys(options, ['seconds', 'schedule', 'seed', 'gait'], '{ seconds, schedule: [{ t, speed, heading }, …], seed?, gait? }');
+        await ready;
+        const { client } = await app.generator.load();
+        const m = await client.simulateControl({
+          seconds: o.seconds as number,
+          schedule: o.schedule as SimulateControlOptions['schedule'],
+          seed: (o.seed ?? 0) as number,
+          ...(o.gait === undefined ? {} : { gait: o.gait as 'walk' | 'run' }),
+        });
+        return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, speed: m.speed, heading: m.heading, computeMs: m.computeMs };
       });
     },
   };

@@ -1,10 +1,33 @@
 // Main-thread handle on the generator worker: promise methods (ModelClient; requests matched to
 // replies by id: WorkerClient).
 import type { Motion } from '../motion/types';
-import type { BenchmarkResult, GeneratedChunk, GenerateParams, InitResult, ParityResult, StepInputs, StreamInfo, StreamParams } from './protocol';
+import type {
+  BenchmarkResult,
+  ControlChunkReply,
+  ControlStartParams,
+  ControlTargetParams,
+  FollowPathChunk,
+  FollowPathParams,
+  GeneratedChunk,
+  GenerateParams,
+  InitResult,
+  ParityResult,
+  SimulateControlParams,
+  SimulatedControlChunk,
+  StepInputs,
+  StreamInfo,
+  StreamParams,
+} from './protocol';
 import { ModelClient } from './workerClient';
 
-export type { BenchmarkResult, GenerateParams, InitResult, ParityResult, StepInputs, StreamInfo, StreamParams };
+export type { BenchmarkResult, ControlStartParams, ControlTargetParams, FollowPathParams, GenerateParams, InitResult, ParityResult, SimulateControlParams, StepInputs, StreamInfo, StreamParams };
+
+/** A followed path: the motion, the path as followed (x, z pairs) and how well it was followed. */
+export type FollowedPath = GeneratedMotion & Pick<FollowPathChunk, 'stats' | 'path'>;
+/** A live-control batch: the motion plus achieved speed and heading per frame. */
+export type ControlledMotion = GeneratedMotion & Pick<ControlChunkReply, 'speed' | 'heading' | 'computeMs'>;
+export type SimulatedControl = GeneratedMotion &
+  Pick<SimulatedControlChunk, 'speed' | 'heading' | 'targetSpeed' | 'targetHeading' | 'computeMs' | 'batchMs' | 'batchFrames'>;
 
 /** Generated frames as a Motion, with the generator's extras. */
 export type GeneratedMotion = Motion & {
@@ -42,6 +65,30 @@ export class GeneratorClient extends ModelClient<StreamParams, InitResult, Gener
    */
   parity(inputs?: StepInputs): Promise<ParityResult> {
     return this.parityRequest(inputs);
+  }
+
+  /** Follows a ground path (optimised in the worker); `onProgress` hears the share of the path done. */
+  async followPath(params: FollowPathParams, onProgress?: (fraction: number) => void): Promise<FollowedPath> {
+    const chunk = await this.request<FollowPathChunk>('followPath', { ...params }, undefined, onProgress);
+    return { ...this.toMotion(chunk), stats: chunk.stats, path: chunk.path };
+  }
+
+  /** Starts (or replaces) the live-control stream at the origin, facing +z. */
+  controlStart(params: ControlStartParams): Promise<StreamInfo> {
+    return this.request<StreamInfo>('controlStart', { ...params });
+  }
+
+  /** The control stream's next `frames` frames (1…12), optimised toward `target`. */
+  async controlPull(frames: number, target: ControlTargetParams): Promise<ControlledMotion> {
+    const chunk = await this.request<ControlChunkReply>('controlPull', { frames, ...target });
+    return { ...this.toMotion(chunk), speed: chunk.speed, heading: chunk.heading, computeMs: chunk.computeMs };
+  }
+
+  /** The live-control loop driven by a schedule instead of a person. */
+  async simulateControl(params: SimulateControlParams, onProgress?: (fraction: number) => void): Promise<SimulatedControl> {
+    const c = await this.request<SimulatedControlChunk>('simulateControl', { ...params }, undefined, onProgress);
+    const { speed, heading, targetSpeed, targetHeading, computeMs, batchMs, batchFrames } = c;
+    return { ...this.toMotion(c), speed, heading, targetSpeed, targetHeading, computeMs, batchMs, batchFrames };
   }
 
   protected toMotion(chunk: GeneratedChunk): GeneratedMotion {

@@ -8,7 +8,7 @@ import * as ort from 'onnxruntime-web/wasm';
 // starts its helper workers from the .mjs's own URL.
 import ortWasmUrl from 'onnxruntime-web/ort-wasm-simd-threaded.wasm?url';
 import ortGlueUrl from 'onnxruntime-web/ort-wasm-simd-threaded.mjs?url';
-import { WORKER_ERROR_ID, type ModelRequest, type WorkerReply } from './protocol';
+import { WORKER_ERROR_ID, type ModelRequest, type WorkerMessage } from './protocol';
 
 declare const self: DedicatedWorkerGlobalScope;
 
@@ -93,14 +93,17 @@ function transferables(result: unknown): Transferable[] {
  * reply with its id, an error reply (`<type>: <message>`) if `handle` throws. An unhandled rejection
  * is reported with WORKER_ERROR_ID, prefixed with `name` ("generator worker").
  */
-function serveRequests<Request extends { type: string }>(name: string, handle: (request: Request) => Promise<unknown>): void {
-  const reply = (message: WorkerReply, transfer: Transferable[] = []) => self.postMessage(message, transfer);
+/** Reports the share done of the request being handled (0…1). */
+export type Progress = (fraction: number) => void;
+
+function serveRequests<Request extends { type: string }>(name: string, handle: (request: Request, progress: Progress) => Promise<unknown>): void {
+  const reply = (message: WorkerMessage, transfer: Transferable[] = []) => self.postMessage(message, transfer);
   let queue: Promise<void> = Promise.resolve();
   self.addEventListener('message', (event: MessageEvent<{ id: number } & Request>) => {
     const request = event.data;
     queue = queue.then(async () => {
       try {
-        const result = await handle(request);
+        const result = await handle(request, (fraction) => reply({ id: request.id, progress: fraction }));
         reply({ id: request.id, ok: true, result }, transferables(result));
       } catch (err) {
         reply({ id: request.id, ok: false, error: `${request.type}: ${describe(err)}` });
@@ -134,6 +137,8 @@ export interface ModelWorker<Info, Stream, P> {
   makeCore(session: ort.InferenceSession, info: Info, threads: number): ModelCore<Stream, P>;
   /** The stream parameters of a generate or startStream request. */
   streamParams(request: P): P;
+  /** Requests of this model only (the generator's path following and control); undefined: not one of them. */
+  extra?(request: { type: string }, core: ModelCore<Stream, P>, progress: Progress): Promise<unknown> | undefined;
 }
 
 /**
@@ -172,7 +177,7 @@ export function serveModel<Info, Stream, P, StepInputs>(spec: ModelWorker<Info, 
     return core.describe(performance.now() - started);
   }
 
-  serveRequests<ModelRequest<P, StepInputs>>(`${spec.name} worker`, async (request) => {
+  serveRequests<ModelRequest<P, StepInputs>>(`${spec.name} worker`, async (request, progress) => {
     switch (request.type) {
       case 'init':
         return init(request.modelUrl, request.infoUrl, request.threads);
@@ -188,8 +193,11 @@ export function serveModel<Info, Stream, P, StepInputs>(spec: ModelWorker<Info, 
         return requireCore().benchmark(request.batch, request.steps);
       case 'parity':
         return requireCore().parity(request.inputs as never);
-      default:
+      default: {
+        const handled = spec.extra?.(request, requireCore(), progress);
+        if (handled) return handled;
         throw new Error(`unknown request type "${(request as { type?: unknown }).type}"`);
+      }
     }
   });
 }

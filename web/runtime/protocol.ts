@@ -93,7 +93,79 @@ export interface ParityResult {
 
 /** A worker's answer to one request (the same shape for every model worker). */
 export type WorkerReply = { id: number; ok: true; result: unknown } | { id: number; ok: false; error: string };
+/** Sent any number of times before a long request's reply: the share done (0…1). */
+export interface WorkerProgress {
+  id: number;
+  progress: number;
+}
+export type WorkerMessage = WorkerReply | WorkerProgress;
 export type GeneratorReply = WorkerReply;
 
 /** Id of replies that are about the worker as a whole (an uncaught error), not one request. */
 export const WORKER_ERROR_ID = -1;
+
+/** Generator worker only: follow a ground path (web/optimizer/pathFollower.ts). */
+export interface FollowPathParams {
+  /** [x, z] pairs, metres. */
+  points: [number, number][];
+  gait: 'walk' | 'run';
+  seed: number;
+  /** σ_fit (m) of the path-fit term; default 0.1. */
+  fitSigma?: number;
+  /** The points are a hand-drawn stroke: drop jitter and smooth before following. */
+  stroke?: boolean;
+}
+
+export interface FollowPathStatsReply {
+  meanError: number;
+  maxError: number;
+  arcProgress: number;
+  optimizeMs: number;
+  windows: number;
+  particleSteps: number;
+}
+
+export interface FollowPathChunk extends GeneratedChunk {
+  stats: FollowPathStatsReply;
+  /** The path as followed (resampled, and smoothed for strokes): x, z pairs. */
+  path: Float32Array;
+}
+
+/** Generator worker only: live control (web/optimizer/liveControl.ts). */
+export interface ControlStartParams {
+  seed: number;
+  gait: 'walk' | 'run';
+}
+
+export interface ControlTargetParams {
+  speed: number;
+  heading: number;
+}
+
+export interface ControlChunkReply extends GeneratedChunk {
+  /** Per frame: achieved speed (m/s, mean over the last half second) and facing heading (rad). */
+  speed: Float32Array;
+  heading: Float32Array;
+  /** Milliseconds the batch took to optimise. */
+  computeMs: number;
+}
+
+export interface SimulateControlParams {
+  seconds: number;
+  schedule: { t: number; speed: number; heading: number }[];
+  seed: number;
+  gait?: 'walk' | 'run';
+}
+
+export interface SimulatedControlChunk extends GeneratedChunk {
+  speed: Float32Array;
+  heading: Float32Array;
+  /** Per frame: the target in force. */
+  targetSpeed: Float32Array;
+  targetHeading: Float32Array;
+  /** Per frame: its batch's optimisation time divided by the batch's frames (ms per model frame). */
+  computeMs: Float32Array;
+  /** Per optimised batch: milliseconds and frames. */
+  batchMs: Float32Array;
+  batchFrames: Uint8Array;
+}

@@ -63,8 +63,9 @@ interface SessionModelInfo {
 export abstract class SessionCore<Info extends SessionModelInfo> {
   readonly info: Info;
   readonly threads: number;
-  protected readonly mean: Float32Array;
-  protected readonly std: Float32Array;
+  /** Feature normalisation: normalised = (physical − mean) / std. */
+  readonly mean: Float32Array;
+  readonly std: Float32Array;
   private readonly session: InferenceSession;
   private readonly Tensor: TensorConstructor;
 

@@ -3,12 +3,13 @@
 // message, a crashed or stalled worker rejects everything pending and every later call, and dispose
 // stops the worker.
 import type { Motion } from '../motion/types';
-import { WORKER_ERROR_ID, type BenchmarkResult, type WorkerReply } from './protocol';
+import { WORKER_ERROR_ID, type BenchmarkResult, type WorkerMessage } from './protocol';
 
 interface Pending {
   resolve: (value: unknown) => void;
   reject: (error: Error) => void;
   timer?: ReturnType<typeof setTimeout>;
+  onProgress?: (fraction: number) => void;
 }
 
 /** `label` prefixes messages ("generator" → "generator worker failed: …"). */
@@ -21,7 +22,7 @@ export class WorkerClient {
   /** `worker` must be created by the subclass with a literal `new URL('./x.worker.ts', import.meta.url)` (Vite bundles it). */
   constructor(worker: Worker, protected readonly label: string) {
     this.worker = worker;
-    worker.addEventListener('message', (event: MessageEvent<WorkerReply>) => this.onReply(event.data));
+    worker.addEventListener('message', (event: MessageEvent<WorkerMessage>) => this.onReply(event.data));
     worker.addEventListener('error', (event) => {
       event.preventDefault();
       this.fail(new Error(`${label} worker failed: ${event.message || 'could not load or run the worker script'}`));
@@ -34,12 +35,15 @@ export class WorkerClient {
     this.fail(new Error(`the ${this.label} client was disposed`));
   }
 
-  /** Sends one request; `timeoutMs` gives up on the whole worker if it has not answered by then. */
-  protected request<T>(type: string, body: object, timeoutMs?: number): Promise<T> {
+  /**
+   * Sends one request; `timeoutMs` gives up on the whole worker if it has not answered by then;
+   * `onProgress` hears the worker's progress reports for it.
+   */
+  protected request<T>(type: string, body: object, timeoutMs?: number, onProgress?: (fraction: number) => void): Promise<T> {
     if (this.failure || !this.worker) return Promise.reject(this.failure ?? new Error(`${this.label} worker is not running`));
     const id = this.nextId++;
     return new Promise<T>((resolve, reject) => {
-      const entry: Pending = { resolve: resolve as (value: unknown) => void, reject };
+      const entry: Pending = { resolve: resolve as (value: unknown) => void, reject, onProgress };
       if (timeoutMs !== undefined) {
         // A worker that stalls would hold every later request in its queue too: give up on it entirely.
         entry.timer = setTimeout(() => this.fail(new Error(`${this.label} ${type}: no answer from the worker within ${timeoutMs / 1000} s`)), timeoutMs);
@@ -49,7 +53,11 @@ export class WorkerClient {
     });
   }
 
-  private onReply(message: WorkerReply): void {
+  private onReply(message: WorkerMessage): void {
+    if ('progress' in message) {
+      this.pending.get(message.id)?.onProgress?.(message.progress);
+      return;
+    }
     if (message.id === WORKER_ERROR_ID) {
       if (!message.ok) this.fail(new Error(message.error));
       return;

@@ -1,0 +1,246 @@
+// Online control by speed and direction (Wang, Chai, Xia §5.3): each short batch of frames is optimised
+// for the speed term (eq. 22: the batch's mean speed near the asked speed) and the direction term
+// (eq. 23: the last frame's facing near the asked heading), with the prior, noise and contact terms of
+// the path follower. Particles look a little past the batch so the choice is not greedy; only the batch
+// is kept. `LiveController` is what both the live page loop and `simulateControl` run.
+import { decodeFeatures } from '../runtime/featureDecode';
+import type { GeneratorInfo } from '../runtime/generatorModel';
+import { Rng } from '../runtime/sampler';
+import { contactCost, lastToes, lowest, particleFeatures, type ToeState } from './objective';
+import { angleDifference } from './path';
+import { perturbInto, randomVariables, rollout, type RolloutResult, type SteerRequest, type StepFn, type Steering, type StreamState, type Variables } from './rollout';
+
+export interface ControlTarget {
+  /** m/s, 0…MAX_CONTROL_SPEED. */
+  speed: number;
+  /** Radians, 0 faces +z, π/2 faces +x. */
+  heading: number;
+}
+
+export const MAX_CONTROL_SPEED = 4;
+/** Frames kept per optimised batch (0.2 s at 30 fps) and frames looked at. */
+export const CONTROL_BATCH = 6;
+export const CONTROL_HORIZON = 12;
+/** Eq. (22)'s σ_speed (m/s) and a σ for eq. (23)'s direction term (rad). */
+const SPEED_SIGMA = 0.05;
+const DIRECTION_SIGMA = 0.1;
+const MAX_TURN_PER_FRAME = 0.15;
+/** Achieved speed is the root's mean horizontal speed over this many frames (half a second: about a step). */
+export const SPEED_WINDOW = 15;
+
+interface Knobs {
+  /** Share of the heading error asked for per frame. */
+  gain: number;
+  /** Speed asked for, as a multiple of the target (the model's own pace pulls back). */
+  push: number;
+  /** Authority over the step (Δtx, Δtz) and over the turn (Δry); see rollout.ts. */
+  authority: number;
+  turnAuthority: number;
+  /** Reach of a step change per frame, in model σ (rollout.ts). */
+  reach: number;
+}
+
+function randomKnobs(rng: Rng): Knobs {
+  return { gain: 0.08 + 0.2 * rng.uniform(), push: 0.8 + 0.8 * rng.uniform(), authority: 0.3 + 0.65 * rng.uniform(), turnAuthority: 0.5 + 0.5 * rng.uniform(), reach: 0.5 + 3.5 * rng.uniform() };
+}
+
+class ControlSteering implements Steering {
+  constructor(
+    private readonly knobs: Knobs[],
+    private readonly goal: ControlTarget,
+    private readonly fps: number,
+  ) {}
+
+  target(b: number, _t: number, _x: number, _z: number, heading: number, out: SteerRequest): void {
+    const k = this.knobs[b];
+    out.target[0] = 0;
+    out.target[1] = (this.goal.speed * k.push) / this.fps;
+    out.target[2] = Math.max(-MAX_TURN_PER_FRAME, Math.min(MAX_TURN_PER_FRAME, k.gain * angleDifference(this.goal.heading, heading)));
+    out.authority[0] = out.authority[1] = k.authority;
+    out.authority[2] = k.turnAuthority;
+    out.reach[0] = out.reach[1] = k.reach;
+  }
+}
+
+export interface ControlChunk {
+  frames: number;
+  /** frames × D, physical units. */
+  features: Float32Array;
+  positions: Float32Array;
+  contacts: Uint8Array;
+  rootHeading: Float32Array;
+  /** Per frame: achieved speed (mean over the last SPEED_WINDOW frames, m/s) and facing heading (rad, wrapped to (−π, π]). */
+  speed: Float32Array;
+  heading: Float32Array;
+  /** Milliseconds this batch took to optimise. */
+  computeMs: number;
+}
+
+export interface LiveControllerOptions {
+  step: StepFn;
+  info: GeneratorInfo;
+  mean: Float32Array;
+  std: Float32Array;
+  seed: number;
+  seedIndex: number;
+  /** Where the character starts (default the origin facing +z). */
+  start?: { x: number; z: number; heading: number };
+  temperature?: number;
+  particles?: number;
+  rounds?: number;
+}
+
+export class LiveController {
+  private state: StreamState;
+  private readonly rng: Rng;
+  private toes: ToeState | null = null;
+  /** Root x, z of the last SPEED_WINDOW frames, for the achieved speed. */
+  private readonly recent: [number, number][] = [];
+  frame = 0;
+
+  constructor(private readonly o: LiveControllerOptions) {
+    const seed = o.info.seeds[o.seedIndex];
+    if (!seed) throw new Error(`seedIndex ${o.seedIndex} is not one of the generator's ${o.info.seeds.length} seed states`);
+    this.state = { x: Float32Array.from(seed.x), h: Float32Array.from(seed.h), c: Float32Array.from(seed.c), root: { ...(o.start ?? { x: 0, z: 0, heading: 0 }) } };
+    this.rng = new Rng(o.seed);
+  }
+
+  get root(): { x: number; z: number; heading: number } {
+    return { ...this.state.root };
+  }
+
+  /** Optimises and keeps the next `frames` (≤ CONTROL_BATCH) frames toward `goal`. */
+  async advance(goal: ControlTarget, frames = CONTROL_BATCH): Promise<ControlChunk> {
+    checkTarget(goal);
+    if (!Number.isInteger(frames) || frames < 1 || frames > CONTROL_HORIZON) throw new RangeError(`frames must be an integer from 1 to ${CONTROL_HORIZON}, got ${frames}`);
+    const started = performance.now();
+    const { info, step, mean, std } = this.o;
+    const D = info.onnx.dim, fps = info.fps;
+    const P = this.o.particles ?? 16, rounds = this.o.rounds ?? 2;
+    const T = CONTROL_HORIZON;
+    const elites = Math.max(1, Math.round(P / 4));
+    let variables: Variables = randomVariables(P, T, D, this.rng);
+    let knobs = Array.from({ length: P }, () => randomKnobs(this.rng));
+    let best: { cost: number; result: RolloutResult; b: number } | null = null;
+    for (let round = 0; round < rounds; round++) {
+      const result = await rollout({ step, info, mean, std, start: this.state, variables, steering: new ControlSteering(knobs, goal, fps), temperature: this.o.temperature ?? 0.5, commit: frames });
+      const costs = new Float64Array(P);
+      for (let b = 0; b < P; b++) {
+        costs[b] = result.priorCost[b] + result.noiseCost[b] + controlCost(result, b, goal, this.state.root, fps) + contactCost(info, particleFeatures(result, b), this.state.root, this.toes);
+        if (!Number.isFinite(costs[b])) costs[b] = Infinity;
+        if (!best || costs[b] < best.cost) best = { cost: costs[b], result, b };
+      }
+      if (round === rounds - 1) break;
+      const top = lowest(costs, elites);
+      const next: Variables = { P, T, u: new Float64Array(P * T), z: new Float32Array(variables.z.length), d: new Float32Array(variables.d.length) };
+      knobs = Array.from({ length: P }, (_, b) => {
+        const from = top[b % top.length];
+        perturbInto(variables, from, next, b, 0.5, this.rng, D);
+        const k = knobs[from];
+        if (b < top.length) return k;
+        const r = this.rng;
+        return {
+          gain: clamp(k.gain + 0.04 * r.normal(), 0.03, 0.4),
+          push: clamp(k.push + 0.1 * r.normal(), 0.6, 2),
+          authority: clamp(k.authority + 0.1 * r.normal(), 0.05, 0.98),
+          turnAuthority: clamp(k.turnAuthority + 0.1 * r.normal(), 0.05, 1),
+          reach: clamp(k.reach + 0.4 * r.normal(), 0.2, 6),
+        };
+      });
+      variables = next;
+    }
+    const { result, b } = best!;
+    const features = particleFeatures(result, b, frames).slice();
+    const decoded = decodeFeatures(info, features, this.state.root);
+    this.toes = lastToes(info, decoded.positions, decoded.contacts);
+    this.state = result.states[b];
+    const J = info.skeleton.joints.length;
+    const speed = new Float32Array(frames), heading = new Float32Array(frames);
+    for (let f = 0; f < frames; f++) {
+      const here: [number, number] = [decoded.positions[f * J * 3], decoded.positions[f * J * 3 + 2]];
+      this.recent.push(here);
+      if (this.recent.length > SPEED_WINDOW + 1) this.recent.shift();
+      const first = this.recent[0];
+      const span = this.recent.length - 1;
+      speed[f] = span ? (Math.hypot(here[0] - first[0], here[1] - first[1]) * fps) / span : 0;
+      heading[f] = angleDifference(decoded.rootHeading[f], 0);
+    }
+    this.frame += frames;
+    return { frames, features, positions: decoded.positions, contacts: decoded.contacts, rootHeading: decoded.rootHeading, speed, heading, computeMs: performance.now() - started };
+  }
+}
+
+const clamp = (v: number, a: number, b: number) => Math.min(Math.max(v, a), b);
+
+export function checkTarget(goal: ControlTarget): void {
+  if (typeof goal?.speed !== 'number' || !Number.isFinite(goal.speed) || goal.speed < 0 || goal.speed > MAX_CONTROL_SPEED) {
+    throw new RangeError(`speed must be a number from 0 to ${MAX_CONTROL_SPEED} m/s, got ${String(goal?.speed)}`);
+  }
+  if (typeof goal.heading !== 'number' || !Number.isFinite(goal.heading)) throw new RangeError(`heading must be a finite number of radians, got ${String(goal.heading)}`);
+}
+
+/** Eqs. (22) and (23): mean horizontal speed over the horizon vs the goal, last frame's facing vs the goal. */
+function controlCost(r: RolloutResult, b: number, goal: ControlTarget, start: { x: number; z: number }, fps: number): number {
+  const last = (b * r.T + r.T - 1) * 3;
+  // Path length rather than displacement, so a turning walker is not taken for a slow one.
+  let travelled = 0, px = start.x, pz = start.z;
+  for (let t = 0; t < r.T; t++) {
+    const i = (b * r.T + t) * 3;
+    travelled += Math.hypot(r.roots[i] - px, r.roots[i + 1] - pz);
+    px = r.roots[i];
+    pz = r.roots[i + 1];
+  }
+  const speed = (travelled * fps) / r.T;
+  const direction = angleDifference(r.roots[last + 2], goal.heading);
+  return ((speed - goal.speed) / SPEED_SIGMA) ** 2 + (direction / DIRECTION_SIGMA) ** 2;
+}
+
+export interface ScheduleEntry extends ControlTarget {
+  /** Seconds from the start at which this target takes over. */
+  t: number;
+}
+
+/** Checks a control schedule: a non-empty list of { t, speed, heading }, t ≥ 0 and increasing, the first at t = 0. */
+export function checkSchedule(schedule: unknown): ScheduleEntry[] {
+  if (!Array.isArray(schedule) || schedule.length === 0) throw new TypeError('schedule must be a non-empty array of { t, speed, heading }');
+  return schedule.map((e, i) => {
+    if (typeof e !== 'object' || e === null) throw new TypeError(`schedule[${i}] must be an object { t, speed, heading }`);
+    const { t, speed, heading } = e as Record<string, unknown>;
+    if (typeof t !== 'number' || !Number.isFinite(t) || t < 0) throw new RangeError(`schedule[${i}].t must be a number of seconds ≥ 0, got ${String(t)}`);
+    if (i === 0 && t !== 0) throw new RangeError(`schedule[0].t must be 0 (the target at the start), got ${t}`);
+    if (i > 0 && t <= (schedule[i - 1] as ScheduleEntry).t) throw new RangeError(`schedule[${i}].t (${t}) must be later than schedule[${i - 1}].t`);
+    try {
+      checkTarget({ speed, heading } as ControlTarget);
+    } catch (err) {
+      throw new RangeError(`schedule[${i}].${(err as Error).message}`);
+    }
+    return { t, speed: speed as number, heading: heading as number };
+  });
+}
+
+export interface SimulatedControl {
+  chunks: ControlChunk[];
+  /** Every frame's target, for the report. */
+  targets: ControlTarget[];
+}
+
+/**
+ * The live loop driven by a script: every batch optimises toward the schedule's target in force at the
+ * batch's first frame, exactly as the page does with the user's input at that moment.
+ */
+export async function simulateControl(controller: LiveController, schedule: ScheduleEntry[], seconds: number, fps: number, onProgress?: (fraction: number) => void): Promise<SimulatedControl> {
+  const total = Math.round(seconds * fps);
+  const chunks: ControlChunk[] = [];
+  const targets: ControlTarget[] = [];
+  let done = 0;
+  while (done < total) {
+    const now = done / fps;
+    const goal = [...schedule].reverse().find((e) => e.t <= now + 1e-9) ?? schedule[0];
+    const chunk = await controller.advance({ speed: goal.speed, heading: goal.heading }, Math.min(CONTROL_BATCH, total - done));
+    chunks.push(chunk);
+    for (let f = 0; f < chunk.frames; f++) targets.push({ speed: goal.speed, heading: goal.heading });
+    done += chunk.frames;
+    onProgress?.(done / total);
+  }
+  return { chunks, targets };
+}

@@ -1,0 +1,175 @@
+// Ground paths for the path follower: a drawn polyline (x, z pairs in metres) cleaned, smoothed and
+// resampled at even arc length, with lookups by arc length and nearest-point projection.
+
+export type GroundPoint = [number, number];
+
+/** Spacing of the resampled path (m): fine enough that nearest-point error from resampling is < 1 mm. */
+export const PATH_SPACING = 0.05;
+/** A path must be at least this long to follow (m). */
+export const MIN_PATH_LENGTH = 0.5;
+/** And at most this long: 200 m is minutes of walking. */
+export const MAX_PATH_LENGTH = 200;
+export const MAX_PATH_POINTS = 20_000;
+
+/** Checks user points: an array of ≥ 2 finite [x, z] pairs. Throws with what is wrong. */
+export function checkPathPoints(points: unknown): GroundPoint[] {
+  if (!Array.isArray(points)) throw new TypeError('points must be an array of [x, z] pairs (metres)');
+  if (points.length < 2) throw new RangeError(`points needs at least 2 [x, z] pairs, got ${points.length}`);
+  if (points.length > MAX_PATH_POINTS) throw new RangeError(`points has ${points.length} pairs; at most ${MAX_PATH_POINTS} are accepted`);
+  return points.map((p, i) => {
+    if (!Array.isArray(p) || p.length !== 2 || !p.every((v) => typeof v === 'number' && Number.isFinite(v))) {
+      throw new TypeError(`points[${i}] must be a pair of finite numbers [x, z], got ${JSON.stringify(p)}`);
+    }
+    return [p[0], p[1]];
+  });
+}
+
+/** Drops points closer than `minGap` to the previous kept one (pointer jitter, repeated events). */
+function dedupe(points: GroundPoint[], minGap: number): GroundPoint[] {
+  const out: GroundPoint[] = [points[0]];
+  for (const p of points.slice(1)) {
+    const q = out[out.length - 1];
+    if (Math.hypot(p[0] - q[0], p[1] - q[1]) >= minGap) out.push(p);
+  }
+  const last = points[points.length - 1];
+  const kept = out[out.length - 1];
+  if (out.length > 1 && kept !== last) out[out.length - 1] = last; // the end is where the user stopped
+  else if (out.length === 1 && Math.hypot(last[0] - kept[0], last[1] - kept[1]) > 0) out.push(last);
+  return out;
+}
+
+/** Evenly spaced points along a polyline (every `spacing` metres, plus the end). */
+function resample(points: GroundPoint[], spacing: number): GroundPoint[] {
+  const out: GroundPoint[] = [points[0]];
+  let carried = 0; // arc length since the last emitted point
+  for (let i = 1; i < points.length; i++) {
+    const [ax, az] = points[i - 1];
+    const [bx, bz] = points[i];
+    const len = Math.hypot(bx - ax, bz - az);
+    let at = spacing - carried;
+    while (at <= len) {
+      const f = at / len;
+      out.push([ax + (bx - ax) * f, az + (bz - az) * f]);
+      at += spacing;
+    }
+    carried = len - (at - spacing);
+  }
+  const end = points[points.length - 1];
+  const last = out[out.length - 1];
+  if (Math.hypot(end[0] - last[0], end[1] - last[1]) > spacing * 0.25) out.push(end);
+  else out[out.length - 1] = end;
+  return out;
+}
+
+/** Moving average over ±`radius` points, ends held fixed (the start and end are where the user put them). */
+function smooth(points: GroundPoint[], radius: number): GroundPoint[] {
+  if (radius < 1 || points.length < 3) return points;
+  return points.map((p, i) => {
+    const r = Math.min(radius, i, points.length - 1 - i);
+    let x = 0, z = 0;
+    for (let k = i - r; k <= i + r; k++) {
+      x += points[k][0];
+      z += points[k][1];
+    }
+    return [x / (2 * r + 1), z / (2 * r + 1)];
+  });
+}
+
+/** A path resampled at even arc length. Positions along it are arc lengths s ∈ [0, length]. */
+export class GroundPath {
+  /** x, z of each resampled point. */
+  readonly xs: Float64Array;
+  readonly zs: Float64Array;
+  readonly length: number;
+  readonly spacing: number;
+
+  private constructor(points: GroundPoint[]) {
+    this.xs = Float64Array.from(points, (p) => p[0]);
+    this.zs = Float64Array.from(points, (p) => p[1]);
+    let length = 0;
+    for (let i = 1; i < points.length; i++) length += Math.hypot(this.xs[i] - this.xs[i - 1], this.zs[i] - this.zs[i - 1]);
+    this.length = length;
+    this.spacing = length / Math.max(1, points.length - 1);
+  }
+
+  /**
+   * The path through `points` as given (benchmark paths, API calls): only resampled, not smoothed.
+   * Throws if it is shorter than MIN_PATH_LENGTH or longer than MAX_PATH_LENGTH.
+   */
+  static fromPoints(points: GroundPoint[]): GroundPath {
+    const clean = dedupe(points, 1e-6);
+    const path = new GroundPath(resample(clean, PATH_SPACING));
+    if (!(path.length >= MIN_PATH_LENGTH)) throw new RangeError(`the path is ${path.length.toFixed(2)} m long; it must be at least ${MIN_PATH_LENGTH} m`);
+    if (path.length > MAX_PATH_LENGTH) throw new RangeError(`the path is ${path.length.toFixed(1)} m long; at most ${MAX_PATH_LENGTH} m is accepted`);
+    return path;
+  }
+
+  /** A hand-drawn stroke: jitter below 2 cm dropped, smoothed over ~±15 cm, then resampled. */
+  static fromStroke(points: GroundPoint[]): GroundPath {
+    const even = resample(dedupe(points, 0.02), PATH_SPACING);
+    return GroundPath.fromPoints(smooth(even, 3));
+  }
+
+  get count(): number {
+    return this.xs.length;
+  }
+
+  /** Point at arc length s (clamped to the path). */
+  pointAt(s: number): GroundPoint {
+    const n = this.count;
+    const f = Math.min(Math.max(s / this.spacing, 0), n - 1);
+    const i = Math.min(Math.floor(f), n - 2);
+    const t = f - i;
+    return [this.xs[i] + (this.xs[i + 1] - this.xs[i]) * t, this.zs[i] + (this.zs[i + 1] - this.zs[i]) * t];
+  }
+
+  /**
+   * Nearest point to (x, z) among arc lengths [from, to] (clamped): its arc length and distance. The
+   * follower searches a window around its last position so a path that crosses itself (figure eight)
+   * is not short-cut.
+   */
+  project(x: number, z: number, from = 0, to = this.length): { s: number; distance: number } {
+    const n = this.count;
+    const i0 = Math.max(0, Math.floor(from / this.spacing) - 1);
+    const i1 = Math.min(n - 2, Math.ceil(to / this.spacing));
+    let best = Infinity, bestS = 0;
+    for (let i = i0; i <= i1; i++) {
+      const ax = this.xs[i], az = this.zs[i];
+      const dx = this.xs[i + 1] - ax, dz = this.zs[i + 1] - az;
+      const len2 = dx * dx + dz * dz;
+      const t = len2 > 0 ? Math.min(Math.max(((x - ax) * dx + (z - az) * dz) / len2, 0), 1) : 0;
+      const ex = ax + dx * t - x, ez = az + dz * t - z;
+      const d2 = ex * ex + ez * ez;
+      if (d2 < best) {
+        best = d2;
+        bestS = (i + t) * this.spacing;
+      }
+    }
+    return { s: bestS, distance: Math.sqrt(best) };
+  }
+
+  /** Distance from (x, z) to the whole path. */
+  distance(x: number, z: number): number {
+    return this.project(x, z).distance;
+  }
+
+  /** Heading (radians, 0 = +z, π/2 = +x) of the path's direction at arc length s. */
+  headingAt(s: number): number {
+    const a = this.pointAt(Math.max(0, s - this.spacing));
+    const b = this.pointAt(Math.min(this.length, s + this.spacing));
+    return Math.atan2(b[0] - a[0], b[1] - a[1]);
+  }
+
+  /** The resampled points as [x, z] pairs. */
+  points(): GroundPoint[] {
+    return Array.from(this.xs, (x, i) => [x, this.zs[i]]);
+  }
+}
+
+/** Angle a − b wrapped to (−π, π]. */
+export function angleDifference(a: number, b: number): number {
+  let d = (a - b) % (2 * Math.PI);
+  if (d > Math.PI) d -= 2 * Math.PI;
+  if (d <= -Math.PI) d += 2 * Math.PI;
+  return d;
+}

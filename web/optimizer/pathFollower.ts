@@ -1,0 +1,296 @@
+// Offline path following (Wang, Chai, Xia §5.2): sliding windows of 34 frames overlapping by 17. In each
+// window a population of particles — sampling variables plus a few steering parameters — is run through
+// the generator in one batched call per frame and ranked by E = −log(P_prior · P_noise · P_curve ·
+// P_contact) (eq. 19) with a progress term; the best few seed the next rounds, which perturb them ever
+// more locally (a cross-entropy search). The best particle's first 17 frames are kept and the next
+// window starts from its state.
+import { decodeFeatures, type RootStart } from '../runtime/featureDecode';
+import type { GeneratorInfo } from '../runtime/generatorModel';
+import { Rng } from '../runtime/sampler';
+import { contactCost, lastToes, lowest, particleFeatures, type ToeState } from './objective';
+import { angleDifference, GroundPath } from './path';
+import { perturbInto, randomVariables, rollout, type RolloutResult, type SteerRequest, type StepFn, type Steering, type StreamState, type Variables } from './rollout';
+
+export type Gait = 'walk' | 'run';
+export const WINDOW_FRAMES = 34;
+export const COMMIT_FRAMES = 17;
+
+/** The speeds a gait's particles try (m/s) and the pace the progress term expects. */
+const GAITS: Record<Gait, { speeds: [number, number]; pace: number }> = {
+  walk: { speeds: [0.9, 1.5], pace: 1.1 },
+  run: { speeds: [2.0, 3.4], pace: 2.4 },
+};
+/** Largest heading change a steering target asks for in one frame (rad): 4.5 rad/s. */
+const MAX_TURN_PER_FRAME = 0.15;
+/** Progress shortfall of 10 cm over a window costs 1. */
+const PROGRESS_SIGMA = 0.1;
+
+export interface FollowPathOptions {
+  step: StepFn;
+  info: GeneratorInfo;
+  mean: Float32Array;
+  std: Float32Array;
+  path: GroundPath;
+  gait: Gait;
+  seed: number;
+  /** σ_fit of eq. (17), metres (default 0.1). */
+  fitSigma?: number;
+  temperature?: number;
+  /** Particles per round and rounds per window (defaults 32 and 3). */
+  particles?: number;
+  rounds?: number;
+  /** Called after each window with the share of the path covered (0…1). */
+  onProgress?: (fraction: number) => void;
+}
+
+export interface FollowPathStats {
+  /** Mean and largest distance from the root (on the ground) to the path, over all frames (m). */
+  meanError: number;
+  maxError: number;
+  /** How far along the path the character got, as a share of its length. */
+  arcProgress: number;
+  optimizeMs: number;
+  windows: number;
+  /** Generator evaluations (particles × frames) spent. */
+  particleSteps: number;
+}
+
+export interface FollowPathResult {
+  features: Float32Array;
+  positions: Float32Array;
+  contacts: Uint8Array;
+  rootHeading: Float32Array;
+  seedIndex: number;
+  frames: number;
+  stats: FollowPathStats;
+}
+
+/** A particle's steering parameters. */
+interface Knobs {
+  /** Share of the heading error to the look-ahead point asked for per frame. */
+  gain: number;
+  /** Look-ahead along the path (m). */
+  look: number;
+  /** Speed asked for (m/s). */
+  speed: number;
+  /** Authority of the steering over the step (Δtx, Δtz) and the turn (Δry), 0…1, and the step's reach in model σ (rollout.ts). */
+  authority: number;
+  turnAuthority: number;
+  reach: number;
+}
+
+function randomKnobs(rng: Rng, gait: Gait): Knobs {
+  const [lo, hi] = GAITS[gait].speeds;
+  return {
+    gain: 0.08 + 0.22 * rng.uniform(),
+    look: (gait === 'run' ? 0.6 : 0.35) + 0.6 * rng.uniform(),
+    speed: lo + (hi - lo) * rng.uniform(),
+    authority: 0.3 + 0.65 * rng.uniform(),
+    turnAuthority: 0.5 + 0.5 * rng.uniform(),
+    reach: 0.5 + 3.5 * rng.uniform(),
+  };
+}
+
+function jitterKnobs(k: Knobs, scale: number, rng: Rng, gait: Gait): Knobs {
+  const [lo, hi] = GAITS[gait].speeds;
+  const clamp = (v: number, a: number, b: number) => Math.min(Math.max(v, a), b);
+  return {
+    gain: clamp(k.gain + 0.05 * scale * rng.normal(), 0.03, 0.4),
+    look: clamp(k.look + 0.15 * scale * rng.normal(), 0.2, 1.6),
+    speed: clamp(k.speed + 0.15 * scale * rng.normal(), lo * 0.8, hi * 1.1),
+    authority: clamp(k.authority + 0.1 * scale * rng.normal(), 0.05, 0.98),
+    turnAuthority: clamp(k.turnAuthority + 0.1 * scale * rng.normal(), 0.05, 1),
+    reach: clamp(k.reach + 0.4 * scale * rng.normal(), 0.2, 6),
+  };
+}
+
+/** Steers each particle toward a point `look` metres ahead of where it stands on the path. */
+class PathSteering implements Steering {
+  readonly arcs: Float64Array;
+
+  constructor(
+    private readonly path: GroundPath,
+    private readonly knobs: Knobs[],
+    startArc: number,
+    private readonly fps: number,
+  ) {
+    this.arcs = new Float64Array(knobs.length).fill(startArc);
+  }
+
+  target(b: number, _t: number, x: number, z: number, heading: number, out: SteerRequest): void {
+    const k = this.knobs[b];
+    const s = (this.arcs[b] = trackArc(this.path, x, z, this.arcs[b]));
+    const [lx, lz] = this.path.pointAt(s + k.look);
+    let dx = lx - x, dz = lz - z;
+    const far = Math.hypot(dx, dz);
+    const remaining = this.path.length - s;
+    // At the end, stop asking for a turn and let the pace run out.
+    const want = far > 0.05 ? Math.atan2(dx, dz) : heading;
+    if (far > 1e-6) {
+      dx /= far;
+      dz /= far;
+    } else {
+      dx = Math.sin(heading);
+      dz = Math.cos(heading);
+    }
+    const step = Math.min(k.speed / this.fps, Math.max(remaining, 0));
+    const wx = dx * step, wz = dz * step;
+    const cs = Math.cos(heading), sn = Math.sin(heading);
+    out.target[0] = cs * wx - sn * wz; // the step in the previous frame's heading frame (inverse of featureDecode)
+    out.target[1] = sn * wx + cs * wz;
+    out.target[2] = Math.max(-MAX_TURN_PER_FRAME, Math.min(MAX_TURN_PER_FRAME, k.gain * angleDifference(want, heading)));
+    out.authority[0] = out.authority[1] = k.authority;
+    out.authority[2] = k.turnAuthority;
+    out.reach[0] = out.reach[1] = k.reach;
+  }
+}
+
+/** Where a walker at (x, z) is along the path, searched near its last arc length so self-crossing paths are not short-cut. */
+export function trackArc(path: GroundPath, x: number, z: number, previous: number): number {
+  return path.project(x, z, previous - 0.3, previous + 1.2).s;
+}
+
+/** Path cost of particle b: eq. (17) per frame plus the progress shortfall, from arc `startArc`. */
+function pathCost(r: RolloutResult, b: number, path: GroundPath, startArc: number, fitSigma: number, pace: number, fps: number): number {
+  let s = startArc, cost = 0;
+  for (let t = 0; t < r.T; t++) {
+    const i = (b * r.T + t) * 3;
+    s = trackArc(path, r.roots[i], r.roots[i + 1], s);
+    const near = path.pointAt(s);
+    const e2 = (r.roots[i] - near[0]) ** 2 + (r.roots[i + 1] - near[1]) ** 2;
+    cost += e2 / (fitSigma * fitSigma);
+  }
+  const expected = Math.min((pace * r.T) / fps, path.length - startArc);
+  const shortfall = Math.max(0, expected - (s - startArc));
+  return cost + (shortfall / PROGRESS_SIGMA) ** 2;
+}
+
+/** Seed states of a gait: those whose names start with it ("walk 02_01"). */
+export function gaitSeeds(info: GeneratorInfo, gait: Gait): number[] {
+  const found = info.seeds.flatMap((s, i) => (s.name.startsWith(gait) ? [i] : []));
+  if (!found.length) throw new Error(`the generator has no "${gait}" seed states (it has ${info.seeds.map((s) => s.name).join(', ')})`);
+  return found;
+}
+
+export async function followPath(o: FollowPathOptions): Promise<FollowPathResult> {
+  const started = performance.now();
+  const { info, path, gait } = o;
+  const D = info.onnx.dim;
+  const fps = info.fps;
+  const P = o.particles ?? 32;
+  const rounds = o.rounds ?? 3;
+  const fitSigma = o.fitSigma ?? 0.1;
+  const temperature = o.temperature ?? 0.5;
+  const elites = Math.max(1, Math.round(P / 8));
+  const rng = new Rng(o.seed);
+  const seeds = gaitSeeds(info, gait);
+  const seedIndex = seeds[(o.seed >>> 0) % seeds.length];
+  const seed = info.seeds[seedIndex];
+  const start: RootStart = { x: path.xs[0], z: path.zs[0], heading: path.headingAt(0) };
+  let state: StreamState = { x: Float32Array.from(seed.x), h: Float32Array.from(seed.h), c: Float32Array.from(seed.c), root: { ...start } };
+  // A slow walker still gets 2.5× the time the pace needs before the follower gives up.
+  const maxFrames = Math.ceil(((path.length / GAITS[gait].pace) * 2.5 + 2) * fps);
+
+  const kept: Float32Array[] = [];
+  let frames = 0, arc = 0, windows = 0, particleSteps = 0;
+  let toes: ToeState | null = null;
+
+  while (frames < maxFrames) {
+    let variables: Variables = randomVariables(P, WINDOW_FRAMES, D, rng);
+    let knobs = Array.from({ length: P }, () => randomKnobs(rng, gait));
+    let best: { cost: number; result: RolloutResult; b: number } | null = null;
+    for (let round = 0; round < rounds; round++) {
+      const steering = new PathSteering(path, knobs, arc, fps);
+      const result = await rollout({ step: o.step, info, mean: o.mean, std: o.std, start: state, variables, steering, temperature, commit: COMMIT_FRAMES });
+      particleSteps += P * WINDOW_FRAMES;
+      const costs = new Float64Array(P);
+      for (let b = 0; b < P; b++) {
+        costs[b] =
+          result.priorCost[b] +
+          result.noiseCost[b] +
+          pathCost(result, b, path, arc, fitSigma, GAITS[gait].pace, fps) +
+          contactCost(info, particleFeatures(result, b), state.root, toes);
+        if (!Number.isFinite(costs[b])) costs[b] = Infinity;
+        if (!best || costs[b] < best.cost) best = { cost: costs[b], result, b };
+      }
+      if (round === rounds - 1) break;
+      // Next round: every particle a perturbation of one of the elites, ever more local.
+      const top = lowest(costs, elites);
+      const beta = 0.6 / (round + 1);
+      const next: Variables = { P, T: WINDOW_FRAMES, u: new Float64Array(P * WINDOW_FRAMES), z: new Float32Array(variables.z.length), d: new Float32Array(variables.d.length) };
+      const nextKnobs: Knobs[] = [];
+      for (let b = 0; b < P; b++) {
+        const from = top[b % top.length];
+        perturbInto(variables, from, next, b, beta, rng, D);
+        nextKnobs.push(b < top.length ? knobs[from] : jitterKnobs(knobs[from], 1 / (round + 1), rng, gait));
+      }
+      variables = next;
+      knobs = nextKnobs;
+    }
+    if (!best) throw new Error('followPath: no particle was evaluated');
+    windows++;
+
+    // Keep the first 17 frames, or fewer if the best particle reaches the end before.
+    const { result, b } = best;
+    let keep = COMMIT_FRAMES, s = arc, finished = false;
+    for (let t = 0; t < WINDOW_FRAMES; t++) {
+      const i = (b * WINDOW_FRAMES + t) * 3;
+      s = trackArc(path, result.roots[i], result.roots[i + 1], s);
+      const [ex, ez] = path.pointAt(path.length);
+      if (s >= path.length - 0.05 || (path.length - s < 0.3 && Math.hypot(result.roots[i] - ex, result.roots[i + 1] - ez) < 0.1)) {
+        if (t < COMMIT_FRAMES) {
+          keep = t + 1;
+          finished = true;
+        }
+        break;
+      }
+      if (t === COMMIT_FRAMES - 1) arc = s;
+    }
+    const chunk = particleFeatures(result, b, keep);
+    kept.push(chunk.slice());
+    // Toe state for the next window's contact term.
+    const decoded = decodeFeatures(info, chunk, state.root);
+    toes = lastToes(info, decoded.positions, decoded.contacts);
+    frames += keep;
+    if (finished) {
+      arc = s;
+      o.onProgress?.(1);
+      break;
+    }
+    state = result.states[b];
+    o.onProgress?.(Math.min(1, arc / path.length));
+  }
+
+  const features = new Float32Array(frames * D);
+  let at = 0;
+  for (const chunk of kept) {
+    features.set(chunk, at);
+    at += chunk.length;
+  }
+  const decoded = decodeFeatures(info, features, start);
+  const J = info.skeleton.joints.length;
+  let sum = 0, worst = 0, s = 0;
+  for (let f = 0; f < frames; f++) {
+    const x = decoded.positions[f * J * 3], z = decoded.positions[f * J * 3 + 2];
+    const e = path.distance(x, z);
+    sum += e;
+    worst = Math.max(worst, e);
+    s = trackArc(path, x, z, s);
+  }
+  return {
+    features,
+    positions: decoded.positions,
+    contacts: decoded.contacts,
+    rootHeading: decoded.rootHeading,
+    seedIndex,
+    frames,
+    stats: {
+      meanError: frames ? sum / frames : NaN,
+      maxError: worst,
+      arcProgress: s / path.length,
+      optimizeMs: performance.now() - started,
+      windows,
+      particleSteps,
+    },
+  };
+}

@@ -1,0 +1,125 @@
+// The generator worker's optimiser requests: path following, and live control by speed and heading
+// (one live stream at a time, and its scripted twin simulateControl). The algorithms live in
+// web/optimizer/; this file checks the requests and packs results for the page.
+import { followPath, gaitSeeds, type Gait } from '../optimizer/pathFollower';
+import { checkSchedule, LiveController, simulateControl, checkTarget, CONTROL_HORIZON } from '../optimizer/liveControl';
+import { checkPathPoints, GroundPath } from '../optimizer/path';
+import type { GeneratorCore } from './generatorCore';
+import type { ControlChunkReply, ControlStartParams, ControlTargetParams, FollowPathChunk, FollowPathParams, SimulateControlParams, SimulatedControlChunk, StreamInfo } from './protocol';
+
+const MAX_SIMULATED_SECONDS = 600;
+
+function checkGait(gait: unknown): Gait {
+  if (gait !== 'walk' && gait !== 'run') throw new TypeError(`gait must be "walk" or "run", got ${JSON.stringify(gait)}`);
+  return gait;
+}
+
+function checkSeed(seed: unknown): number {
+  if (typeof seed !== 'number' || !Number.isInteger(seed) || seed < 0 || seed > 0xffffffff) throw new RangeError(`seed must be an integer from 0 to 4294967295, got ${String(seed)}`);
+  return seed;
+}
+
+export class OptimizerRequests {
+  private live: { controller: LiveController; seedIndex: number } | undefined;
+
+  constructor(private readonly core: GeneratorCore) {}
+
+  private step = (batch: number, x: Float32Array, h: Float32Array, c: Float32Array) => this.core.step(batch, x, h, c);
+
+  private controller(seed: number, gait: Gait): { controller: LiveController; seedIndex: number } {
+    const info = this.core.info;
+    const seeds = gaitSeeds(info, gait);
+    const seedIndex = seeds[seed % seeds.length];
+    return { controller: new LiveController({ step: this.step, info, mean: this.core.mean, std: this.core.std, seed, seedIndex }), seedIndex };
+  }
+
+  /** Handles one optimiser request; undefined when `request` is not one. */
+  handle(request: { type: string } & Record<string, unknown>, progress: (fraction: number) => void): Promise<unknown> | undefined {
+    switch (request.type) {
+      case 'followPath':
+        return this.followPath(request as unknown as FollowPathParams, progress);
+      case 'controlStart':
+        return Promise.resolve(this.controlStart(request as unknown as ControlStartParams));
+      case 'controlPull':
+        return this.controlPull(request as unknown as ControlTargetParams & { frames: number });
+      case 'simulateControl':
+        return this.simulate(request as unknown as SimulateControlParams, progress);
+      default:
+        return undefined;
+    }
+  }
+
+  async followPath(p: FollowPathParams, progress: (fraction: number) => void): Promise<FollowPathChunk> {
+    const points = checkPathPoints(p.points);
+    const gait = checkGait(p.gait);
+    const seed = checkSeed(p.seed);
+    const fitSigma = p.fitSigma ?? 0.1;
+    if (typeof fitSigma !== 'number' || !(fitSigma >= 0.02 && fitSigma <= 2)) throw new RangeError(`fitSigma must be a number from 0.02 to 2 m, got ${String(p.fitSigma)}`);
+    const path = p.stroke ? GroundPath.fromStroke(points) : GroundPath.fromPoints(points);
+    const info = this.core.info;
+    const r = await followPath({ step: this.step, info, mean: this.core.mean, std: this.core.std, path, gait, seed, fitSigma, onProgress: progress });
+    const flat = new Float32Array(path.count * 2);
+    for (let i = 0; i < path.count; i++) {
+      flat[2 * i] = path.xs[i];
+      flat[2 * i + 1] = path.zs[i];
+    }
+    return { frames: r.frames, features: r.features, positions: r.positions, contacts: r.contacts, rootHeading: r.rootHeading, seedIndex: r.seedIndex, startFrame: 0, stats: r.stats, path: flat };
+  }
+
+  controlStart(p: ControlStartParams): StreamInfo {
+    this.live = undefined;
+    this.live = this.controller(checkSeed(p.seed), checkGait(p.gait));
+    return { seedIndex: this.live.seedIndex, seedName: this.core.info.seeds[this.live.seedIndex].name };
+  }
+
+  async controlPull(p: ControlTargetParams & { frames: number }): Promise<ControlChunkReply> {
+    const live = this.live;
+    if (!live) throw new Error('no control stream: send controlStart first');
+    checkTarget(p);
+    if (!Number.isInteger(p.frames) || p.frames < 1 || p.frames > CONTROL_HORIZON) throw new RangeError(`frames must be an integer from 1 to ${CONTROL_HORIZON}, got ${p.frames}`);
+    const startFrame = live.controller.frame;
+    const chunk = await live.controller.advance({ speed: p.speed, heading: p.heading }, p.frames);
+    return { ...chunk, seedIndex: live.seedIndex, startFrame };
+  }
+
+  async simulate(p: SimulateControlParams, progress: (fraction: number) => void): Promise<SimulatedControlChunk> {
+    if (typeof p.seconds !== 'number' || !(p.seconds > 0 && p.seconds <= MAX_SIMULATED_SECONDS)) throw new RangeError(`seconds must be a number above 0 and at most ${MAX_SIMULATED_SECONDS}, got ${String(p.seconds)}`);
+    const schedule = checkSchedule(p.schedule);
+    const seed = checkSeed(p.seed);
+    const gait = p.gait === undefined ? (schedule[0].speed >= 2 ? 'run' : 'walk') : checkGait(p.gait);
+    const { controller, seedIndex } = this.controller(seed, gait);
+    const fps = this.core.info.fps;
+    const sim = await simulateControl(controller, schedule, p.seconds, fps, progress);
+    const frames = sim.targets.length;
+    const D = this.core.info.onnx.dim;
+    const J = this.core.info.skeleton.joints.length;
+    const out: SimulatedControlChunk = {
+      frames,
+      features: new Float32Array(frames * D),
+      positions: new Float32Array(frames * J * 3),
+      contacts: new Uint8Array(frames * 2),
+      rootHeading: new Float32Array(frames),
+      seedIndex,
+      startFrame: 0,
+      speed: new Float32Array(frames),
+      heading: new Float32Array(frames),
+      targetSpeed: Float32Array.from(sim.targets, (t) => t.speed),
+      targetHeading: Float32Array.from(sim.targets, (t) => t.heading),
+      computeMs: new Float32Array(frames),
+      batchMs: Float32Array.from(sim.chunks, (c) => c.computeMs),
+      batchFrames: Uint8Array.from(sim.chunks, (c) => c.frames),
+    };
+    let at = 0;
+    for (const c of sim.chunks) {
+      out.features.set(c.features, at * D);
+      out.positions.set(c.positions, at * J * 3);
+      out.contacts.set(c.contacts, at * 2);
+      out.rootHeading.set(c.rootHeading, at);
+      out.speed.set(c.speed, at);
+      out.heading.set(c.heading, at);
+      out.computeMs.fill(c.computeMs / c.frames, at, at + c.frames);
+      at += c.frames;
+    }
+    return out;
+  }
+}
