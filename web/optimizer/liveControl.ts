@@ -22,9 +22,17 @@ export const MAX_CONTROL_SPEED = 4;
 export const CONTROL_BATCH = 6;
 export const CONTROL_HORIZON = 12;
 /** Eq. (22)'s σ_speed (m/s) and a σ for eq. (23)'s direction term (rad). */
-const SPEED_SIGMA = 0.05;
-const DIRECTION_SIGMA = 0.1;
+const SPEED_SIGMA = 0.015;
+const DIRECTION_SIGMA = 0.05;
 const MAX_TURN_PER_FRAME = 0.15;
+/**
+ * σ_con for live control (m per frame): looser than the path follower's 1 cm, because with 1 cm the
+ * generator's own planted-foot jitter (≈ 4 cm per frame) outweighs the speed and direction terms and
+ * the character will not change pace.
+ */
+const LIVE_CONTACT_SIGMA = 0.01;
+/** Input-noise draws at a quarter of σ_noise (rollout.ts noiseScale): the control terms then decide the ranking. */
+const NOISE_SCALE = 0.25;
 /** Achieved speed is the root's mean horizontal speed over this many frames (half a second: about a step). */
 export const SPEED_WINDOW = 15;
 
@@ -36,12 +44,12 @@ interface Knobs {
   /** Authority over the step (Δtx, Δtz) and over the turn (Δry); see rollout.ts. */
   authority: number;
   turnAuthority: number;
-  /** Reach of a step change per frame, in model σ (rollout.ts). */
+  /** Reach of a change to the step per frame, in model σ (rollout.ts); the turn has none (see below). */
   reach: number;
 }
 
 function randomKnobs(rng: Rng): Knobs {
-  return { gain: 0.08 + 0.2 * rng.uniform(), push: 0.8 + 0.8 * rng.uniform(), authority: 0.3 + 0.65 * rng.uniform(), turnAuthority: 0.5 + 0.5 * rng.uniform(), reach: 0.5 + 3.5 * rng.uniform() };
+  return { gain: 0.08 + 0.2 * rng.uniform(), push: 0.8 + 1.2 * rng.uniform(), authority: 0.3 + 0.65 * rng.uniform(), turnAuthority: 0.5 + 0.5 * rng.uniform(), reach: 0.5 + 3.5 * rng.uniform() };
 }
 
 class ControlSteering implements Steering {
@@ -58,6 +66,8 @@ class ControlSteering implements Steering {
     out.target[2] = Math.max(-MAX_TURN_PER_FRAME, Math.min(MAX_TURN_PER_FRAME, k.gain * angleDifference(this.goal.heading, heading)));
     out.authority[0] = out.authority[1] = k.authority;
     out.authority[2] = k.turnAuthority;
+    // The turn is left unclipped: the model is so sure of its next heading change that a reach of even
+    // 10 σ per frame kept 90° turns above 1.5 s (measured); quick turns need the steering's authority.
     out.reach[0] = out.reach[1] = k.reach;
   }
 }
@@ -116,17 +126,17 @@ export class LiveController {
     const started = performance.now();
     const { info, step, mean, std } = this.o;
     const D = info.onnx.dim, fps = info.fps;
-    const P = this.o.particles ?? 16, rounds = this.o.rounds ?? 2;
+    const P = this.o.particles ?? 24, rounds = this.o.rounds ?? 2;
     const T = CONTROL_HORIZON;
     const elites = Math.max(1, Math.round(P / 4));
     let variables: Variables = randomVariables(P, T, D, this.rng);
     let knobs = Array.from({ length: P }, () => randomKnobs(this.rng));
     let best: { cost: number; result: RolloutResult; b: number } | null = null;
     for (let round = 0; round < rounds; round++) {
-      const result = await rollout({ step, info, mean, std, start: this.state, variables, steering: new ControlSteering(knobs, goal, fps), temperature: this.o.temperature ?? 0.5, commit: frames });
+      const result = await rollout({ step, info, mean, std, start: this.state, variables, steering: new ControlSteering(knobs, goal, fps), temperature: this.o.temperature ?? 0.5, commit: frames, noiseScale: NOISE_SCALE });
       const costs = new Float64Array(P);
       for (let b = 0; b < P; b++) {
-        costs[b] = result.priorCost[b] + result.noiseCost[b] + controlCost(result, b, goal, this.state.root, fps) + contactCost(info, particleFeatures(result, b), this.state.root, this.toes);
+        costs[b] = result.priorCost[b] + result.noiseCost[b] + controlCost(result, b, goal, this.state.root, fps) + contactCost(info, particleFeatures(result, b), this.state.root, this.toes, LIVE_CONTACT_SIGMA);
         if (!Number.isFinite(costs[b])) costs[b] = Infinity;
         if (!best || costs[b] < best.cost) best = { cost: costs[b], result, b };
       }

@@ -4,7 +4,7 @@ import { decodeFeatures, type RootStart } from '../runtime/featureDecode';
 import type { GeneratorInfo } from '../runtime/generatorModel';
 import type { RolloutResult } from './rollout';
 
-/** Eq. (18)'s σ_con: a planted toe moving 1 cm in a frame (0.3 m/s) costs 1. */
+/** Eq. (18)'s σ_con for the path follower: a planted toe moving 1 cm in a frame (0.3 m/s) costs 1. */
 export const CONTACT_SIGMA = 0.01;
 
 /** Indices of the toe joints the contact bits describe (left, right). */
@@ -23,10 +23,10 @@ export function particleFeatures(r: RolloutResult, b: number, frames = r.T): Flo
 
 /**
  * Contact term (eq. 18), horizontal part: Σ over frames where a foot is planted in this frame and the
- * previous one of |Δ toe (x, z)|² / σ_con². `previousToes` (x, z of left and right toe before the
- * window) links the window to what came before; pass null to start fresh.
+ * previous one of |Δ toe (x, z)|² / σ_con². `previous` (the toes at the end of what came before) links
+ * the window to it; null starts fresh.
  */
-export function contactCost(info: GeneratorInfo, features: Float32Array, start: RootStart, previous: ToeState | null, toes = toeJoints(info)): number {
+export function contactCost(info: GeneratorInfo, features: Float32Array, start: RootStart, previous: ToeState | null, sigma = CONTACT_SIGMA, toes = toeJoints(info)): number {
   const decoded = decodeFeatures(info, features, start);
   const J = info.skeleton.joints.length;
   const D = info.onnx.dim;
@@ -38,7 +38,7 @@ export function contactCost(info: GeneratorInfo, features: Float32Array, start: 
     for (let f = 0; f < frames; f++) {
       const x = decoded.positions[(f * J + j) * 3], z = decoded.positions[(f * J + j) * 3 + 2];
       const on = decoded.contacts[f * 2 + side] === 1;
-      if (on && planted && Number.isFinite(px)) cost += ((x - px) ** 2 + (z - pz) ** 2) / (CONTACT_SIGMA * CONTACT_SIGMA);
+      if (on && planted && Number.isFinite(px)) cost += ((x - px) ** 2 + (z - pz) ** 2) / (sigma * sigma);
       px = x;
       pz = z;
       planted = on;

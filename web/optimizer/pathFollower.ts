@@ -36,7 +36,7 @@ export interface FollowPathOptions {
   /** σ_fit of eq. (17), metres (default 0.1). */
   fitSigma?: number;
   temperature?: number;
-  /** Particles per round and rounds per window (defaults 32 and 3). */
+  /** Particles per round and rounds per window (defaults 24 and 2: measured 3× faster than real time on one core, docs/models/control.md). */
   particles?: number;
   rounds?: number;
   /** Called after each window with the share of the path covered (0…1). */
@@ -177,8 +177,8 @@ export async function followPath(o: FollowPathOptions): Promise<FollowPathResult
   const { info, path, gait } = o;
   const D = info.onnx.dim;
   const fps = info.fps;
-  const P = o.particles ?? 32;
-  const rounds = o.rounds ?? 3;
+  const P = o.particles ?? 24;
+  const rounds = o.rounds ?? 2;
   const fitSigma = o.fitSigma ?? 0.1;
   const temperature = o.temperature ?? 0.5;
   const elites = Math.max(1, Math.round(P / 8));

@@ -106,6 +106,12 @@ export interface RolloutOptions {
   temperature: number;
   /** Frames after which each particle's state is kept (1…T). */
   commit: number;
+  /**
+   * Scale of the input-noise draws (default 1: d = σ_noise·N(0, 1)). Below 1 the search explores closer
+   * to the noise prior's mode: with hundreds of noise dimensions per particle, full-size draws make the
+   * noise term's spread across particles (σ ≈ 20 over 12 frames) swamp the control terms.
+   */
+  noiseScale?: number;
 }
 
 /** Copies one batch row of the L×B×H state layout. */
@@ -122,6 +128,7 @@ export async function rollout(o: RolloutOptions): Promise<RolloutResult> {
   const { layers: L, hidden: H, mixtures: M, dim: D } = info.onnx;
   if (!(commit >= 1 && commit <= T)) throw new Error(`rollout: commit ${commit} is outside 1…${T}`);
   const tau = Math.max(temperature, 1e-3);
+  const noiseScale = o.noiseScale ?? 1;
 
   // Every particle starts from the same state.
   let h: Float32Array = new Float32Array(L * P * H), c: Float32Array = new Float32Array(L * P * H);
@@ -151,10 +158,10 @@ export async function rollout(o: RolloutOptions): Promise<RolloutResult> {
       const dz = v.d.subarray((b * T + t) * D, (b * T + t + 1) * D);
       let n2 = 0;
       for (let k = 0; k < D; k++) {
-        input[b * D + k] = x[b * D + k] + INPUT_NOISE_SIGMA * dz[k];
+        input[b * D + k] = x[b * D + k] + INPUT_NOISE_SIGMA * noiseScale * dz[k];
         n2 += dz[k] * dz[k];
       }
-      noiseCost[b] += 0.5 * n2; // = Σ d²/(2σ²) with d = σ·dz
+      noiseCost[b] += 0.5 * noiseScale * noiseScale * n2; // = Σ d²/(2σ²) with d = σ·noiseScale·dz
     }
     const out = await o.step(P, input, h, c);
     for (let b = 0; b < P; b++) {

@@ -1,0 +1,109 @@
+// The optimiser over the shipped generator, run by onnxruntime-web's Node build: the steered rollout
+// reduces to free generation when steering has no authority, imposes its target with full authority,
+// and the path follower and live controller do what they are for on short runs.
+import { afterAll, beforeAll, describe, expect, it } from 'vitest';
+import { GeneratorCore } from '../../web/runtime/generatorCore';
+import { parseGeneratorInfo } from '../../web/runtime/generatorModel';
+import { footSkating } from '../../web/motion/footSkating';
+import { checkSchedule, LiveController, simulateControl } from '../../web/optimizer/liveControl';
+import { angleDifference, GroundPath } from '../../web/optimizer/path';
+import { followPath } from '../../web/optimizer/pathFollower';
+import { rollout, type SteerRequest, type Variables } from '../../web/optimizer/rollout';
+import { readRepoFile } from './corpus';
+import { bytes, ort, shippedSession } from './shippedModel';
+
+const info = parseGeneratorInfo(JSON.parse(readRepoFile('public/models/generator.json')), 'public/models/generator.json');
+const D = info.onnx.dim;
+let core: GeneratorCore;
+const step = (b: number, x: Float32Array, h: Float32Array, c: Float32Array) => core.step(b, x, h, c);
+
+beforeAll(async () => {
+  core = new GeneratorCore(await shippedSession(info.file), info, ort.Tensor);
+});
+afterAll(() => core?.release());
+
+function seedState(i: number) {
+  const s = info.seeds[i];
+  return { x: Float32Array.from(s.x), h: Float32Array.from(s.h), c: Float32Array.from(s.c), root: { x: 0, z: 0, heading: 0 } };
+}
+
+/** All-zero sampling variables: the heaviest component's mean, no input noise. */
+function zeroVariables(P: number, T: number): Variables {
+  return { P, T, u: new Float64Array(P * T), z: new Float32Array(P * T * D), d: new Float32Array(P * T * D) };
+}
+
+const steer = (target: number[], authority: number) => ({
+  target(_b: number, _t: number, _x: number, _z: number, _h: number, out: SteerRequest) {
+    out.target.set(target);
+    out.authority.fill(authority);
+  },
+});
+
+describe('rollout', () => {
+  it('without authority and noise is free generation at temperature 0', async () => {
+    const free = await core.generate({ frames: 20, seed: 0, temperature: 0, seedIndex: 0 });
+    const r = await rollout({ step, info, mean: core.mean, std: core.std, start: seedState(0), variables: zeroVariables(2, 20), steering: steer([0, 0, 0], 0), temperature: 0, commit: 20 });
+    const row0 = r.features.subarray(0, 20 * D);
+    let worst = 0;
+    for (let i = 0; i < row0.length; i++) worst = Math.max(worst, Math.abs(row0[i] - free.features[i]));
+    expect(worst).toBeLessThan(1e-5);
+    expect(bytes(r.features.subarray(20 * D))).toEqual(bytes(row0)); // identical particles stay identical
+    expect(r.noiseCost[0]).toBe(0);
+    expect(Number.isFinite(r.priorCost[0])).toBe(true);
+  });
+
+  it('with full authority imposes the root target, and costs more prior than free frames', async () => {
+    const target = [0.01, 0.05, 0.02]; // a 1.5 m/s sidestepping, turning step
+    const free = await rollout({ step, info, mean: core.mean, std: core.std, start: seedState(0), variables: zeroVariables(1, 10), steering: steer(target, 0), temperature: 0, commit: 10 });
+    const forced = await rollout({ step, info, mean: core.mean, std: core.std, start: seedState(0), variables: zeroVariables(1, 10), steering: steer(target, 1), temperature: 0, commit: 10 });
+    for (let t = 0; t < 10; t++) for (let k = 0; k < 3; k++) expect(forced.features[t * D + k]).toBeCloseTo(target[k], 5);
+    expect(forced.roots[9 * 3 + 2]).toBeCloseTo(0.2, 5); // ten 0.02 rad turns
+    expect(forced.priorCost[0]).toBeGreaterThan(free.priorCost[0]);
+  });
+});
+
+describe('followPath', () => {
+  const path = GroundPath.fromPoints([[0, 0], [0, 2], [1.5, 3.5]]);
+  const run = (seed: number) => followPath({ step, info, mean: core.mean, std: core.std, path, gait: 'walk', seed, particles: 16, rounds: 2 });
+
+  it('follows a short path with a bend to its end, deterministically for a seed', async () => {
+    const progress: number[] = [];
+    const a = await followPath({ step, info, mean: core.mean, std: core.std, path, gait: 'walk', seed: 3, particles: 16, rounds: 2, onProgress: (f) => progress.push(f) });
+    expect(a.stats.meanError).toBeLessThan(0.1);
+    expect(a.stats.maxError).toBeLessThan(0.3);
+    expect(a.stats.arcProgress).toBeGreaterThan(0.95);
+    expect(a.positions.every(Number.isFinite)).toBe(true);
+    expect(progress.at(-1)).toBe(1);
+    expect(progress).toEqual([...progress].sort((x, y) => x - y));
+    // Starts on the path's first point, facing along it.
+    expect(Math.hypot(a.positions[0], a.positions[2])).toBeLessThan(0.1);
+    const b = await run(3);
+    expect(bytes(b.features)).toEqual(bytes(a.features));
+    const m = { fps: 30, frames: a.frames, joints: info.skeleton.joints, parents: info.skeleton.parents, positions: a.positions, contacts: a.contacts };
+    expect(footSkating(m)).toBeLessThan(2); // m/s; a sliding, unconstrained root would be far above
+  }, 60000);
+});
+
+describe('LiveController', () => {
+  it('turns toward a new heading and keeps a requested speed', async () => {
+    const controller = new LiveController({ step, info, mean: core.mean, std: core.std, seed: 5, seedIndex: 0 });
+    const schedule = checkSchedule([{ t: 0, speed: 1.2, heading: 0 }, { t: 1, speed: 1.2, heading: Math.PI / 2 }]);
+    const sim = await simulateControl(controller, schedule, 3, 30);
+    const frames = sim.chunks.reduce((n, c) => n + c.frames, 0);
+    expect(frames).toBe(90);
+    const last = sim.chunks.at(-1)!;
+    expect(Math.abs(angleDifference(last.heading[last.frames - 1], Math.PI / 2))).toBeLessThan(0.3);
+    expect(Math.abs(last.speed[last.frames - 1] - 1.2)).toBeLessThan(0.35);
+    expect(sim.targets[29].heading).toBe(0);
+    expect(sim.targets[30].heading).toBe(Math.PI / 2);
+  }, 60000);
+
+  it('refuses bad schedules and targets with messages saying why', async () => {
+    expect(() => checkSchedule([])).toThrow(/non-empty array/);
+    expect(() => checkSchedule([{ t: 1, speed: 1, heading: 0 }])).toThrow(/schedule\[0\]\.t must be 0/);
+    expect(() => checkSchedule([{ t: 0, speed: 1, heading: 0 }, { t: 0, speed: 1, heading: 0 }])).toThrow(/must be later/);
+    expect(() => checkSchedule([{ t: 0, speed: 9, heading: 0 }])).toThrow(/schedule\[0\]\.speed must be a number from 0 to 4/);
+    const controller = new LiveController({ step, info, mean: core.mean, std: core.std, seed: 5, seedIndex: 0 });
+    await expect(controller.advance({ speed: 1, heading: NaN })).rejects.toThrow(/heading must be a finite number/);
+  });
+});
