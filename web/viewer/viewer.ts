@@ -252,24 +252,49 @@ export class Viewer {
 
   /** Fits the whole root trajectory in view (and stops following the root). */
   frameAll(): void {
-    if (!this.motion) return;
-    const m = this.motion, J = m.joints.length;
+    if (this.motion) this.frameGround([]);
+  }
+
+  /**
+   * Fits ground points (x, z pairs) and the shown root trajectory in view, seen from at least
+   * `minElevation` (the view direction's least y before normalising), and stops following the root. Works with
+   * nothing shown (Path mode's drawing view).
+   */
+  frameGround(xz: ArrayLike<number>, minElevation = 0.35): void {
     const box = new THREE.Box3();
-    for (let f = 0; f < m.frames; f++) {
-      const o = (f * J + this.root) * 3;
-      box.expandByPoint(this.tmp.set(m.positions[o], 0, m.positions[o + 2]));
+    for (let i = 0; i + 1 < xz.length; i += 2) box.expandByPoint(this.tmp.set(xz[i], 0, xz[i + 1]));
+    const m = this.motion;
+    if (m) {
+      const J = m.joints.length;
+      for (let f = 0; f < m.frames; f++) {
+        const o = (f * J + this.root) * 3;
+        box.expandByPoint(this.tmp.set(m.positions[o], 0, m.positions[o + 2]));
+      }
     }
+    if (box.isEmpty()) return;
     box.expandByScalar(0.6);
     box.max.y = this.figureHeight;
     const center = box.getCenter(new THREE.Vector3());
     const radius = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 1.5);
     const dist = radius / Math.sin(THREE.MathUtils.degToRad(this.camera.fov / 2)) * 0.9;
     const dir = this.camera.position.clone().sub(this.controls.target).normalize();
-    if (dir.y < 0.35) { dir.y = 0.35; dir.normalize(); }
+    if (dir.y < minElevation) { dir.y = minElevation; dir.normalize(); }
     this.follow = false;
     this.controls.target.copy(center).setY(this.targetY * 0.6);
     this.camera.position.copy(this.controls.target).addScaledVector(dir, dist);
     this.controls.update();
+    this.dirty = true;
+  }
+
+  /** The root's ground position at the playhead, or null with nothing shown. */
+  rootPosition(): { x: number; z: number } | null {
+    if (!this.motion) return null;
+    const r = this.rootNow();
+    return { x: r.x, z: r.z };
+  }
+
+  /** Asks for a render: for things other modules add to the scene (ground overlays). */
+  invalidate(): void {
     this.dirty = true;
   }
 
