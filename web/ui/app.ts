@@ -14,7 +14,9 @@ import { DanceMode } from './danceMode';
 import type { LiveChunk, LiveMode } from './liveMode';
 import { BusyIndicator, ModelHost, pageThreads } from './modelHost';
 import { Panel } from './panel';
+import { PathMode } from './pathMode';
 import { RandomWalk } from './randomWalk';
+import { SteerMode } from './steerMode';
 import { Toasts } from './toast';
 
 function $(id: string): HTMLElement {
@@ -28,8 +30,8 @@ export function errorMessage(e: unknown): string {
   return String(e);
 }
 
-export type Mode = 'clip' | 'walk' | 'dance';
-const MODES: Mode[] = ['clip', 'walk', 'dance'];
+export type Mode = 'clip' | 'walk' | 'dance' | 'path' | 'steer';
+const MODES: Mode[] = ['clip', 'walk', 'dance', 'path', 'steer'];
 
 export class App {
   readonly viewer: Viewer;
@@ -45,8 +47,10 @@ export class App {
   private readonly exportBtn = $('export-btn') as HTMLButtonElement;
   readonly walk: RandomWalk;
   readonly danceMode: DanceMode;
+  readonly pathMode: PathMode;
+  readonly steerMode: SteerMode;
   private mode: Mode = 'clip';
-  /** The clip shown before a live mode (Random walk, Dance), restored when switching back. */
+  /** The clip shown before another mode (Random walk, Dance, Path, Steer), restored when switching back. */
   private clip: { motion: Motion; name: string } | null = null;
 
   constructor() {
@@ -67,6 +71,8 @@ export class App {
 
     this.walk = new RandomWalk(this);
     this.danceMode = new DanceMode(this);
+    this.pathMode = new PathMode(this);
+    this.steerMode = new SteerMode(this);
     for (const m of MODES) {
       $(`mode-${m}`).addEventListener('click', () => this.setMode(m));
       const live = this.liveMode(m);
@@ -89,21 +95,22 @@ export class App {
   }
 
   private liveMode(mode: Mode): LiveMode<LiveChunk> | null {
-    return mode === 'walk' ? this.walk : mode === 'dance' ? this.danceMode : null;
+    return mode === 'walk' ? this.walk : mode === 'dance' ? this.danceMode : mode === 'steer' ? this.steerMode : null;
   }
 
   /**
-   * Clip mode shows the imported clip; Random walk and Dance modes stream from their models (loaded on
-   * first use). Leaving a live mode for Clip restores the clip shown before it.
+   * Clip mode shows the imported clip; Random walk, Dance and Steer modes stream from their models
+   * (loaded on first use); Path mode shows walks along drawn paths. Leaving any of them for Clip
+   * restores the clip shown before.
    */
   setMode(mode: Mode): void {
     if (mode === this.mode) return;
     const previous = this.mode;
     this.mode = mode;
     for (const m of MODES) $(`mode-${m}`).setAttribute('aria-pressed', String(mode === m));
-    document.body.classList.toggle('walk-mode', mode === 'walk');
-    document.body.classList.toggle('dance-mode', mode === 'dance');
+    for (const m of MODES) if (m !== 'clip') document.body.classList.toggle(`${m}-mode`, mode === m);
     this.liveMode(previous)?.stop();
+    if (previous === 'path') this.pathMode.leave();
     if (mode === 'clip') {
       this.exportBtn.title = 'Download the shown motion as BVH';
       const clip = this.clip;
@@ -116,9 +123,17 @@ export class App {
       const m = this.viewer.current;
       this.clip = m ? { motion: m, name: this.name } : null;
     }
+    if (mode === 'path') {
+      this.exportBtn.title = 'Download the walk along the path as BVH';
+      this.pathMode.enter();
+      return;
+    }
     if (mode === 'walk') {
       this.setLiveLabel('Random walk', 'generator · 30 fps · live');
       this.exportBtn.title = 'Download the last 20 s of the walk as BVH';
+    } else if (mode === 'steer') {
+      this.setLiveLabel('Steer', 'generator · 30 fps · live control');
+      this.exportBtn.title = 'Download the last 20 s of steering as BVH';
     } else {
       this.setLiveLabel('Dance', 'loading…');
       this.exportBtn.title = 'Download the last 20 s of the dance as BVH';
@@ -140,7 +155,8 @@ export class App {
     document.body.classList.add('has-motion');
   }
 
-  private clearMotion(): void {
+  /** An empty stage ("No motion"). */
+  clearMotion(): void {
     this.viewer.clear();
     this.name = '';
     this.exportBtn.disabled = true;
@@ -167,13 +183,18 @@ export class App {
     this.toasts.show(message, 'info');
   }
 
-  /** Shows an already validated motion. Contacts are detected when the motion has none. */
+  /** Shows an already validated motion in Clip mode. Contacts are detected when the motion has none. */
   show(motion: Motion, name = 'motion'): void {
     if (this.mode !== 'clip') {
-      // Showing a clip ends the live mode; the new clip replaces the one remembered from before it.
+      // Showing a clip ends the other mode; the new clip replaces the one remembered from before it.
       this.clip = null;
       this.setMode('clip');
     }
+    this.showInMode(motion, name);
+  }
+
+  /** Shows a motion like `show` but stays in the current mode (Path mode's results); `name` names exports. */
+  showInMode(motion: Motion, name: string): void {
     let contacts = motion.contacts;
     if (!contacts) {
       try {

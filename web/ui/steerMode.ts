@@ -1,0 +1,359 @@
+// Steer mode: live control of the generator by speed and heading (Wang, Chai, Xia §5.3, Fig. 9). The
+// live controller in the generator worker optimises 6 frames at a time toward the current target, a
+// little ahead of the playhead (LiveMode). Inputs: keyboard (turn and speed), a gamepad's left stick or
+// the on-screen stick (direction relative to the camera, push further to go faster), the speed slider.
+// A mint arrow on the ground at the character shows the target heading; the readout at the top left
+// compares target and achieved speed.
+
+import type { ControlledMotion, GeneratorClient } from '../runtime/generatorClient';
+import { GroundArrow, TARGET_COLOR } from '../viewer/groundPath';
+import type { App } from './app';
+import { $, LiveMode, type LiveStream } from './liveMode';
+
+type Gait = 'walk' | 'run';
+
+/** Frames per optimised batch, and frames kept ready beyond the playhead (0.4 s at 30 fps). */
+const BATCH = 6;
+const AHEAD = 12;
+/** Turn rate of the left / right keys (rad/s) and speed change of up / down (m/s per second). */
+const TURN_RATE = Math.PI / 2;
+const SPEED_RATE = 1;
+const MAX_SPEED = 3;
+/** Speed the slider starts at per gait (set when the gait changes). */
+const GAIT_SPEED: Record<Gait, number> = { walk: 1.2, run: 2.5 };
+const STICK_DEAD_ZONE = 0.2;
+/**
+ * The camera swings round behind the character's facing, a little to its side (rad), at this rate
+ * (1/s), from this far and this high (direction's y before normalising); a drag of the view pauses
+ * the swing for CHASE_PAUSE ms.
+ */
+const CHASE_SIDE = 0.45;
+const CHASE_RATE = 0.9;
+const CHASE_DISTANCE = 6.5;
+const CHASE_RISE = 0.5;
+const CHASE_PAUSE = 2500;
+/** Achieved speed and heading are kept for this many stream frames behind the newest. */
+const HISTORY = 900;
+
+const KEYS: Record<string, 'left' | 'right' | 'up' | 'down'> = {
+  ArrowLeft: 'left', a: 'left', A: 'left',
+  ArrowRight: 'right', d: 'right', D: 'right',
+  ArrowUp: 'up', w: 'up', W: 'up',
+  ArrowDown: 'down', s: 'down', S: 'down',
+};
+
+/** Angle wrapped to (−π, π]. */
+function wrap(a: number): number {
+  return a - 2 * Math.PI * Math.ceil((a - Math.PI) / (2 * Math.PI));
+}
+
+const degrees = (a: number) => Math.round((wrap(a) * 180) / Math.PI);
+
+export class SteerMode extends LiveMode<ControlledMotion> {
+  private readonly gait = $<HTMLSelectElement>('steer-gait');
+  private readonly speed = $<HTMLInputElement>('steer-speed');
+  private readonly speedOut = $('steer-speed-out');
+  private readonly readout = $('steer-readout');
+  private readonly targetBar = $('steer-target-bar');
+  private readonly achievedBar = $('steer-achieved-bar');
+  private readonly targetText = $('steer-target-speed');
+  private readonly achievedText = $('steer-achieved-speed');
+  private readonly headingText = $('steer-heading');
+  private readonly joystick = $('steer-joystick');
+  private readonly knob = $('steer-knob');
+  private readonly arrow = new GroundArrow(TARGET_COLOR, 0.85);
+  private client: GeneratorClient | undefined;
+  private seedName = '';
+
+  /**
+   * The target: heading (rad, world), the cruising speed (the slider's, kept unrounded so held keys
+   * change it smoothly) and a throttle 0…1 on it (sticks set it; keys and the slider reset it to 1).
+   */
+  private heading = 0;
+  private cruise = GAIT_SPEED.walk;
+  private throttle = 1;
+  private readonly held = new Set<'left' | 'right' | 'up' | 'down'>();
+  /** The on-screen stick while pressed: its pointer and offset (−1…1, y down). */
+  private pad: { id: number; x: number; y: number } | null = null;
+  /** A gamepad stick was out of its dead zone last frame. */
+  private gamepadActive = false;
+  private frameRequest = 0;
+  private lastTick = 0;
+  private readoutAt = 0;
+  /** What the arrow shows (x, z, heading, length), to redraw only on change. */
+  private arrowShown = '';
+  /** Achieved speed and heading per stream frame from `historyStart`; batch times for the status. */
+  private history = { start: 0, speed: [] as number[], heading: [] as number[] };
+  private computeMs = 0;
+  /** Until when the camera is left where the user turned it. */
+  private chasePausedUntil = 0;
+
+  constructor(app: App) {
+    // 20 s kept behind the playhead.
+    super(app, $('steer-status'), { chunk: BATCH, ahead: AHEAD, keep: 600, label: 'Steer', name: 'steer' });
+    app.viewer.scene.add(this.arrow.mesh);
+    this.setSpeed(GAIT_SPEED.walk);
+    this.speed.addEventListener('input', () => {
+      this.throttle = 1;
+      this.setSpeed(Number(this.speed.value), false);
+    });
+    this.gait.addEventListener('change', () => {
+      this.setSpeed(GAIT_SPEED[this.gaitValue]);
+      this.restartIfActive();
+    });
+    // On the document, so it runs before the page's own shortcuts (on window), which it then skips.
+    document.addEventListener('keydown', (e) => this.onKey(e, true));
+    document.addEventListener('keyup', (e) => this.onKey(e, false));
+    window.addEventListener('blur', () => this.held.clear());
+    app.viewer.controls.addEventListener('start', () => (this.chasePausedUntil = Infinity));
+    app.viewer.controls.addEventListener('end', () => (this.chasePausedUntil = performance.now() + CHASE_PAUSE));
+    this.joystick.addEventListener('pointerdown', (e) => this.onPad(e, 'down'));
+    this.joystick.addEventListener('pointermove', (e) => this.onPad(e, 'move'));
+    this.joystick.addEventListener('pointerup', (e) => this.onPad(e, 'up'));
+    this.joystick.addEventListener('pointercancel', (e) => this.onPad(e, 'up'));
+  }
+
+  private get gaitValue(): Gait {
+    return this.gait.value === 'run' ? 'run' : 'walk';
+  }
+
+  /** The speed asked for now (m/s). */
+  get targetSpeed(): number {
+    return this.cruise * this.throttle;
+  }
+
+  get targetHeading(): number {
+    return this.heading;
+  }
+
+  private setSpeed(v: number, moveSlider = true): void {
+    this.cruise = Math.min(Math.max(v, 0), MAX_SPEED);
+    if (moveSlider) this.speed.value = String(this.cruise);
+    this.speedOut.textContent = `${this.cruise.toFixed(1)} m/s`;
+    this.speed.style.setProperty('--p', `${(this.cruise / MAX_SPEED) * 100}%`);
+  }
+
+  override async begin(): Promise<void> {
+    const viewer = this.app.viewer;
+    viewer.setLayers({ follow: true });
+    this.app.panel.syncLayers();
+    this.lastTick = performance.now();
+    cancelAnimationFrame(this.frameRequest);
+    this.frameRequest = requestAnimationFrame((t) => this.tick(t));
+    await super.begin();
+  }
+
+  override stop(): void {
+    super.stop();
+    cancelAnimationFrame(this.frameRequest);
+    this.held.clear();
+    this.releasePad();
+    this.arrow.hide();
+    this.arrowShown = '';
+    this.app.viewer.invalidate();
+  }
+
+  protected async open(): Promise<LiveStream<ControlledMotion>> {
+    const { client, info } = await this.app.generator.load();
+    this.client = client;
+    const stream = await client.controlStart({ seed: 0, gait: this.gaitValue });
+    this.seedName = stream.seedName;
+    // The stream starts at the origin facing +z, at the slider's speed.
+    this.heading = 0;
+    this.throttle = 1;
+    this.history = { start: 0, speed: [], heading: [] };
+    this.computeMs = 0;
+    this.app.setLiveLabel('Steer', `generator · ${info.fps} fps · live control · ${this.gaitValue}`);
+    return { skeleton: info, pull: (frames) => client.controlPull(frames, { speed: this.targetSpeed, heading: this.heading }) };
+  }
+
+  protected forget(): void {
+    this.app.generator.reset(this.client);
+  }
+
+  protected received(chunk: ControlledMotion, first: boolean): void {
+    if (first) this.placeCamera();
+    const h = this.history;
+    const at = chunk.startFrame - h.start;
+    h.speed.length = h.heading.length = Math.max(0, at);
+    h.speed.push(...chunk.speed);
+    h.heading.push(...chunk.heading);
+    if (h.speed.length > HISTORY + 300) {
+      h.speed.splice(0, 300);
+      h.heading.splice(0, 300);
+      h.start += 300;
+    }
+    this.computeMs = this.computeMs ? this.computeMs * 0.8 + chunk.computeMs * 0.2 : chunk.computeMs;
+  }
+
+  protected describe(frame: number, fps: number): string {
+    return `frame ${frame} · ${(frame / fps).toFixed(1)} s · ${this.seedName} · ${Math.round(this.computeMs)} ms per ${BATCH} frames`;
+  }
+
+  // ---------- camera ----------
+
+  /** A new stream: the camera behind the character (facing +z), a little to its side, a little further back than for a clip. */
+  private placeCamera(): void {
+    const { camera, controls } = this.app.viewer;
+    const a = Math.PI + CHASE_SIDE; // behind a +z facing, turned toward its side
+    const dir = { x: Math.sin(a), z: Math.cos(a) };
+    const l = Math.hypot(1, CHASE_RISE);
+    camera.position.set(
+      controls.target.x + (dir.x / l) * CHASE_DISTANCE,
+      controls.target.y + (CHASE_RISE / l) * CHASE_DISTANCE,
+      controls.target.z + (dir.z / l) * CHASE_DISTANCE,
+    );
+    controls.update();
+    this.chasePausedUntil = 0;
+  }
+
+  /** Swings the camera's compass direction toward behind the character's facing. */
+  private chase(dt: number, facing: number, now: number): void {
+    if (!Number.isFinite(facing) || now < this.chasePausedUntil || !this.app.viewer.layers().follow) return;
+    const { camera, controls } = this.app.viewer;
+    const ox = camera.position.x - controls.target.x, oz = camera.position.z - controls.target.z;
+    const current = Math.atan2(ox, oz);
+    const wanted = facing + Math.PI + CHASE_SIDE;
+    const turn = wrap(wanted - current) * (1 - Math.exp(-dt * CHASE_RATE));
+    if (Math.abs(turn) < 1e-5) return;
+    const c = Math.cos(turn), s = Math.sin(turn);
+    // A turn about +y by `turn`: (x, z) → (x cos + z sin, −x sin + z cos).
+    camera.position.x = controls.target.x + ox * c + oz * s;
+    camera.position.z = controls.target.z - ox * s + oz * c;
+    camera.lookAt(controls.target);
+    this.app.viewer.invalidate();
+  }
+
+  // ---------- inputs ----------
+
+  private onKey(e: KeyboardEvent, down: boolean): void {
+    if (!this.running || e.altKey || e.ctrlKey || e.metaKey) return;
+    const key = KEYS[e.key];
+    if (!key) return;
+    const t = e.target as HTMLElement | null;
+    // Typing in a number field keeps its keys.
+    if (t && (t.tagName === 'TEXTAREA' || (t.tagName === 'INPUT' && !['range', 'checkbox', 'button'].includes((t as HTMLInputElement).type)))) return;
+    e.preventDefault();
+    if (down) {
+      this.held.add(key);
+      if (key === 'up' || key === 'down') this.throttle = 1;
+    } else {
+      this.held.delete(key);
+    }
+  }
+
+  private onPad(e: PointerEvent, kind: 'down' | 'move' | 'up'): void {
+    if (kind === 'down') {
+      if (this.pad) return;
+      this.joystick.setPointerCapture(e.pointerId);
+      this.pad = { id: e.pointerId, x: 0, y: 0 };
+      this.joystick.classList.add('active');
+    }
+    if (!this.pad || e.pointerId !== this.pad.id) return;
+    e.preventDefault();
+    if (kind === 'up') {
+      this.releasePad();
+      return;
+    }
+    const r = this.joystick.getBoundingClientRect();
+    const radius = r.width / 2;
+    let x = (e.clientX - (r.left + radius)) / radius, y = (e.clientY - (r.top + r.height / 2)) / radius;
+    const l = Math.hypot(x, y);
+    if (l > 1) { x /= l; y /= l; }
+    this.pad.x = x;
+    this.pad.y = y;
+    const reach = radius - this.knob.offsetWidth / 2;
+    this.knob.style.transform = `translate(${x * reach}px, ${y * reach}px)`;
+  }
+
+  /** Letting go of a stick stops the character (throttle 0), as a stick should. */
+  private releasePad(): void {
+    if (!this.pad) return;
+    this.pad = null;
+    this.throttle = 0;
+    this.knob.style.transform = '';
+    this.joystick.classList.remove('active');
+  }
+
+  /** A stick offset (x right, y down, magnitude ≤ 1) → heading relative to the camera (up = away from it) and throttle. */
+  private applyStick(x: number, y: number): void {
+    const l = Math.hypot(x, y);
+    if (l < STICK_DEAD_ZONE) return;
+    const cam = this.app.viewer.camera.position, target = this.app.viewer.controls.target;
+    let fx = target.x - cam.x, fz = target.z - cam.z;
+    const fl = Math.hypot(fx, fz) || 1;
+    fx /= fl;
+    fz /= fl;
+    // Screen right on the ground is forward × up = (−fz, fx).
+    const dx = fx * -y + -fz * x, dz = fz * -y + fx * x;
+    this.heading = Math.atan2(dx, dz);
+    this.throttle = Math.min(1, (l - STICK_DEAD_ZONE) / (1 - STICK_DEAD_ZONE));
+  }
+
+  private pollGamepad(): void {
+    const pads = navigator.getGamepads?.() ?? [];
+    let x = 0, y = 0;
+    for (const gp of pads) {
+      if (gp && gp.connected && gp.axes.length >= 2) {
+        x = gp.axes[0];
+        y = gp.axes[1];
+        break;
+      }
+    }
+    const active = Math.hypot(x, y) >= STICK_DEAD_ZONE;
+    if (active) this.applyStick(x, y);
+    else if (this.gamepadActive) this.throttle = 0;
+    this.gamepadActive = active;
+  }
+
+  private tick(now: number): void {
+    if (!this.running) return;
+    this.frameRequest = requestAnimationFrame((t) => this.tick(t));
+    const dt = Math.min(Math.max((now - this.lastTick) / 1000, 0), 0.1);
+    this.lastTick = now;
+    const turn = (this.held.has('left') ? 1 : 0) - (this.held.has('right') ? 1 : 0);
+    // Left turns the character to its own left: from +z toward +x, a growing heading.
+    if (turn) this.heading = wrap(this.heading + turn * TURN_RATE * dt);
+    const faster = (this.held.has('up') ? 1 : 0) - (this.held.has('down') ? 1 : 0);
+    if (faster) this.setSpeed(this.cruise + faster * SPEED_RATE * dt);
+    this.pollGamepad();
+    if (this.pad) this.applyStick(this.pad.x, this.pad.y);
+
+    const root = this.app.viewer.rootPosition();
+    const length = 0.35 + 0.3 * this.targetSpeed;
+    const shown = root ? `${root.x},${root.z},${this.heading},${length}` : '';
+    if (root && shown !== this.arrowShown) {
+      this.arrow.setLength(length);
+      this.arrow.place(root.x, root.z, this.heading);
+      this.app.viewer.invalidate();
+    }
+    this.arrowShown = shown;
+    const { speed: achieved, heading: facing } = this.achieved();
+    this.chase(dt, facing, now);
+    if (now - this.readoutAt > 100) {
+      this.readoutAt = now;
+      this.showReadout(achieved, facing);
+    }
+  }
+
+  /** Achieved speed and facing at the playhead (NaN before the first frames). */
+  private achieved(): { speed: number; heading: number } {
+    const i = this.frame - this.history.start;
+    const ok = i >= 0 && i < this.history.speed.length;
+    return { speed: ok ? this.history.speed[i] : NaN, heading: ok ? this.history.heading[i] : NaN };
+  }
+
+  private showReadout(achieved: number, facing: number): void {
+    const target = this.targetSpeed;
+    const d = this.readout.dataset;
+    d.targetSpeed = target.toFixed(3);
+    d.targetHeading = this.heading.toFixed(4);
+    d.speed = Number.isFinite(achieved) ? achieved.toFixed(3) : '';
+    d.heading = Number.isFinite(facing) ? facing.toFixed(4) : '';
+    this.targetText.textContent = target.toFixed(2);
+    this.achievedText.textContent = Number.isFinite(achieved) ? achieved.toFixed(2) : '—';
+    this.targetBar.style.width = `${(Math.min(target, MAX_SPEED) / MAX_SPEED) * 100}%`;
+    this.achievedBar.style.width = `${Number.isFinite(achieved) ? (Math.min(achieved, MAX_SPEED) / MAX_SPEED) * 100 : 0}%`;
+    this.headingText.textContent = `heading ${degrees(this.heading)}° · facing ${Number.isFinite(facing) ? `${degrees(facing)}°` : '—'}`;
+  }
+}
