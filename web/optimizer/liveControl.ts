@@ -23,7 +23,7 @@ export const CONTROL_BATCH = 6;
 export const CONTROL_HORIZON = 12;
 /** Eq. (22)'s σ_speed (m/s) and a σ for eq. (23)'s direction term (rad). */
 const SPEED_SIGMA = 0.015;
-const DIRECTION_SIGMA = 0.05;
+const DIRECTION_SIGMA = 0.03;
 const MAX_TURN_PER_FRAME = 0.15;
 /**
  * σ_con for live control (m per frame): looser than the path follower's 1 cm, because with 1 cm the

@@ -24,6 +24,13 @@ const GAITS: Record<Gait, { speeds: [number, number]; pace: number }> = {
 const MAX_TURN_PER_FRAME = 0.15;
 /** Progress shortfall of 10 cm over a window costs 1. */
 const PROGRESS_SIGMA = 0.1;
+/**
+ * Beyond this distance from the path (m) each frame pays an extra ((e − margin) / 3 cm)²: eq. (17)'s
+ * squared error alone ranks a window that overshoots a sharp corner by 35 cm for a few frames above
+ * one that stays within 15 cm but is a little off everywhere.
+ */
+const FIT_MARGIN = 0.15;
+const FIT_MARGIN_SIGMA = 0.03;
 
 export interface FollowPathOptions {
   step: StepFn;
@@ -83,7 +90,7 @@ function randomKnobs(rng: Rng, gait: Gait): Knobs {
   const [lo, hi] = GAITS[gait].speeds;
   return {
     gain: 0.08 + 0.22 * rng.uniform(),
-    look: (gait === 'run' ? 0.6 : 0.35) + 0.6 * rng.uniform(),
+    look: (gait === 'run' ? 0.5 : 0.25) + 0.8 * rng.uniform(),
     speed: lo + (hi - lo) * rng.uniform(),
     authority: 0.3 + 0.65 * rng.uniform(),
     turnAuthority: 0.5 + 0.5 * rng.uniform(),
@@ -96,7 +103,7 @@ function jitterKnobs(k: Knobs, scale: number, rng: Rng, gait: Gait): Knobs {
   const clamp = (v: number, a: number, b: number) => Math.min(Math.max(v, a), b);
   return {
     gain: clamp(k.gain + 0.05 * scale * rng.normal(), 0.03, 0.4),
-    look: clamp(k.look + 0.15 * scale * rng.normal(), 0.2, 1.6),
+    look: clamp(k.look + 0.15 * scale * rng.normal(), 0.15, 1.4),
     speed: clamp(k.speed + 0.15 * scale * rng.normal(), lo * 0.8, hi * 1.1),
     authority: clamp(k.authority + 0.1 * scale * rng.normal(), 0.05, 0.98),
     turnAuthority: clamp(k.turnAuthority + 0.1 * scale * rng.normal(), 0.05, 1),
@@ -150,7 +157,7 @@ export function trackArc(path: GroundPath, x: number, z: number, previous: numbe
   return path.project(x, z, previous - 0.3, previous + 1.2).s;
 }
 
-/** Path cost of particle b: eq. (17) per frame plus the progress shortfall, from arc `startArc`. */
+/** Path cost of particle b: eq. (17) per frame, the margin penalty and the progress shortfall, from arc `startArc`. */
 function pathCost(r: RolloutResult, b: number, path: GroundPath, startArc: number, fitSigma: number, pace: number, fps: number): number {
   let s = startArc, cost = 0;
   for (let t = 0; t < r.T; t++) {
@@ -159,6 +166,8 @@ function pathCost(r: RolloutResult, b: number, path: GroundPath, startArc: numbe
     const near = path.pointAt(s);
     const e2 = (r.roots[i] - near[0]) ** 2 + (r.roots[i + 1] - near[1]) ** 2;
     cost += e2 / (fitSigma * fitSigma);
+    const over = Math.sqrt(e2) - FIT_MARGIN;
+    if (over > 0) cost += (over / FIT_MARGIN_SIGMA) ** 2;
   }
   const expected = Math.min((pace * r.T) / fps, path.length - startArc);
   const shortfall = Math.max(0, expected - (s - startArc));

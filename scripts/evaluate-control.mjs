@@ -1,0 +1,240 @@
+// Path following and live control, measured in headless Chromium through the public API (the same
+// code the page runs): writes docs/models/control.{md,json}.
+//
+//   npm run evaluate:control            # 3 seeds per case
+//   SEEDS=5 npm run evaluate:control
+//
+// Path fit, arc progress and optimisation time come from followPath's stats; foot skating (planted toe
+// speed, as training/metrics.py foot_skating) and the control responses are computed here from the
+// returned motions, against unconstrained generation (generate, temperature 0.5) from the same seed
+// states.
+import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
+import path from 'node:path';
+import { launchBrowser, openPlayground, ROOT, startServer } from '../tests/e2e/harness.mjs';
+
+const SEEDS = Number(process.env.SEEDS ?? 3);
+const OUT = path.join(ROOT, 'docs/models');
+const PATHS = JSON.parse(readFileSync(path.join(ROOT, 'tests/fixtures/benchmark_paths.json'), 'utf8')).paths;
+const TARGETS = { meanError: 0.1, maxError: 0.3, arcProgress: 0.95, realtime: 2, heading90: 1.0, heading180: 1.5, speedError: 0.2, p95ms: 33, skatingRatio: 1.5 };
+const DEG = Math.PI / 180;
+
+/** Control scenarios: a change at t = 3 s from a steady start. */
+const SCENARIOS = {
+  'turn 90°': { kind: 'heading', change: 90, schedule: [{ t: 0, speed: 1.2, heading: 0 }, { t: 3, speed: 1.2, heading: Math.PI / 2 }] },
+  'turn 180°': { kind: 'heading', change: 180, schedule: [{ t: 0, speed: 1.2, heading: 0 }, { t: 3, speed: 1.2, heading: Math.PI }] },
+  'speed 0.8 → 1.5 m/s': { kind: 'speed', schedule: [{ t: 0, speed: 0.8, heading: 0 }, { t: 3, speed: 1.5, heading: 0 }] },
+  'speed 1.5 → 0.8 m/s': { kind: 'speed', schedule: [{ t: 0, speed: 1.5, heading: 0 }, { t: 3, speed: 0.8, heading: 0 }] },
+  'run 2.5 → 3.2 m/s': { kind: 'speed', gait: 'run', schedule: [{ t: 0, speed: 2.5, heading: 0 }, { t: 3, speed: 3.2, heading: 0 }] },
+};
+const SIM_SECONDS = 6;
+
+const wrap = (a) => {
+  let d = a % (2 * Math.PI);
+  if (d > Math.PI) d -= 2 * Math.PI;
+  if (d <= -Math.PI) d += 2 * Math.PI;
+  return d;
+};
+const mean = (v) => v.reduce((a, b) => a + b, 0) / v.length;
+const percentile = (v, p) => {
+  const s = [...v].sort((a, b) => a - b);
+  return s[Math.min(s.length - 1, Math.floor((p / 100) * s.length))];
+};
+const fmt = (v, d = 2) => (Number.isFinite(v) ? v.toFixed(d) : String(v));
+
+/** Planted toe speed (m/s), as training/metrics.py foot_skating; also the planted-frame count. */
+function skating(m) {
+  const J = m.joints.length;
+  const toes = ['LeftToeBase', 'RightToeBase'].map((n) => m.joints.indexOf(n));
+  let sum = 0, count = 0;
+  for (let f = 1; f < m.frames; f++) {
+    for (let s = 0; s < 2; s++) {
+      if (!m.contacts[f * 2 + s] || !m.contacts[(f - 1) * 2 + s]) continue;
+      const a = ((f - 1) * J + toes[s]) * 3, b = (f * J + toes[s]) * 3;
+      sum += Math.hypot(m.positions[b] - m.positions[a], m.positions[b + 2] - m.positions[a + 2]) * m.fps;
+      count++;
+    }
+  }
+  return count ? sum / count : NaN;
+}
+
+/** Mean root speed (m/s) over the whole motion. */
+function rootSpeed(m) {
+  const J = m.joints.length;
+  let d = 0;
+  for (let f = 1; f < m.frames; f++) d += Math.hypot(m.positions[f * J * 3] - m.positions[(f - 1) * J * 3], m.positions[f * J * 3 + 2] - m.positions[(f - 1) * J * 3 + 2]);
+  return (d * m.fps) / Math.max(1, m.frames - 1);
+}
+
+/** Runs `fn` in the page on plain data and brings back motions as plain arrays. */
+async function inPage(page, fn, arg) {
+  return page.evaluate(fn, arg);
+}
+
+async function followOne(page, name, gait, seed) {
+  return inPage(
+    page,
+    async ({ points, gait, seed }) => {
+      const m = await window.playground.followPath({ points, gait, seed });
+      return { fps: m.fps, frames: m.frames, joints: m.joints, positions: Array.from(m.positions), contacts: Array.from(m.contacts), stats: m.stats };
+    },
+    { points: PATHS[name].points, gait, seed },
+  );
+}
+
+async function freeOne(page, seed, frames) {
+  return inPage(
+    page,
+    async ({ seed, frames }) => {
+      const m = await window.playground.generate({ model: 'generator', frames, seed, temperature: 0.5 });
+      return { fps: m.fps, frames: m.frames, joints: m.joints, positions: Array.from(m.positions), contacts: Array.from(m.contacts) };
+    },
+    { seed, frames },
+  );
+}
+
+async function simulateOne(page, scenario, seed) {
+  return inPage(
+    page,
+    async ({ schedule, seed, seconds, gait }) => {
+      const m = await window.playground.simulateControl({ seconds, schedule, seed, ...(gait ? { gait } : {}) });
+      return { fps: m.fps, frames: m.frames, joints: m.joints, positions: Array.from(m.positions), contacts: Array.from(m.contacts), speed: Array.from(m.speed), heading: Array.from(m.heading), computeMs: Array.from(m.computeMs) };
+    },
+    { schedule: scenario.schedule, seed, seconds: SIM_SECONDS, gait: scenario.gait },
+  );
+}
+
+/** Seconds after the change until the heading is within 15° of the new target (Infinity if never). */
+function headingResponse(sim, change) {
+  const f0 = Math.round(change.t * sim.fps);
+  for (let f = f0; f < sim.frames; f++) if (Math.abs(wrap(sim.heading[f] - change.heading)) <= 15 * DEG) return (f - f0) / sim.fps;
+  return Infinity;
+}
+
+async function main() {
+  const { server, url } = await startServer();
+  const browser = await launchBrowser();
+  const report = { date: new Date().toISOString().slice(0, 10), seeds: SEEDS, targets: TARGETS, paths: [], control: [] };
+  try {
+    const { page, problems } = await openPlayground(browser, url);
+    const threads = await page.evaluate(async () => (await window.playground.generate({ model: 'generator', frames: 2, seed: 0 }), globalThis.crossOriginIsolated));
+    report.crossOriginIsolated = threads;
+    for (const gait of ['walk', 'run']) {
+      for (const name of Object.keys(PATHS)) {
+        for (let seed = 0; seed < SEEDS; seed++) {
+          const m = await followOne(page, name, gait, seed);
+          // Free generation from the same seed state (generate's seed mod 8 = followPath's walk seed for seeds 0–5).
+          const free = gait === 'walk' ? await freeOne(page, seed, m.frames) : null;
+          const seconds = m.frames / m.fps;
+          const row = {
+            gait, path: name, seed, frames: m.frames, seconds,
+            ...m.stats,
+            realtime: (seconds * 1000) / m.stats.optimizeMs,
+            speed: rootSpeed(m),
+            skating: skating(m),
+            freeSkating: free ? skating(free) : null,
+          };
+          report.paths.push(row);
+          console.log(JSON.stringify(row));
+        }
+      }
+    }
+    for (const [name, scenario] of Object.entries(SCENARIOS)) {
+      for (let seed = 0; seed < SEEDS; seed++) {
+        const sim = await simulateOne(page, scenario, seed);
+        const change = scenario.schedule[1];
+        const f1 = Math.min(sim.frames - 1, Math.round((change.t + 1) * sim.fps));
+        const row = {
+          scenario: name, seed, kind: scenario.kind,
+          headingResponse: scenario.kind === 'heading' ? headingResponse(sim, change) : null,
+          speedAt1s: sim.speed[f1],
+          speedError: Math.abs(sim.speed[f1] - change.speed),
+          p95ms: percentile(sim.computeMs, 95),
+          maxMs: Math.max(...sim.computeMs),
+          skating: skating(sim),
+        };
+        if (scenario.kind === 'heading') row.limit = scenario.change === 90 ? TARGETS.heading90 : TARGETS.heading180;
+        report.control.push(row);
+        console.log(JSON.stringify(row));
+      }
+    }
+    // Unconstrained skating for the control runs: free generation from the same seed states, same length.
+    const freeControl = [];
+    for (let seed = 0; seed < SEEDS; seed++) freeControl.push(skating(await freeOne(page, seed, SIM_SECONDS * 30)));
+    report.freeControlSkating = mean(freeControl);
+    report.problems = problems;
+  } finally {
+    await browser.close();
+    await server.close();
+  }
+  mkdirSync(OUT, { recursive: true });
+  writeFileSync(path.join(OUT, 'control.json'), JSON.stringify(report, null, 1) + '\n');
+  writeFileSync(path.join(OUT, 'control.md'), markdown(report));
+  console.log(`wrote ${path.join(OUT, 'control.md')}`);
+}
+
+function markdown(r) {
+  const T = r.targets;
+  const lines = [];
+  const walk = r.paths.filter((p) => p.gait === 'walk');
+  const run = r.paths.filter((p) => p.gait === 'run');
+  const pass = (ok) => (ok ? 'yes' : '**no**');
+  lines.push('# Path following and live control', '');
+  lines.push(
+    `Made by \`npm run evaluate:control\` (${r.date}) in headless Chromium through \`playground.followPath\` and \`playground.simulateControl\`, ${r.seeds} seeds per case, one onnxruntime-web thread (cross-origin isolated: ${r.crossOriginIsolated}). ` +
+      'The optimiser is `web/optimizer/` over the shipped generator (see [generator.md](generator.md)); paths are `tests/fixtures/benchmark_paths.json`.',
+    '',
+  );
+  lines.push('## Path following', '');
+  lines.push(`Targets: mean error ≤ ${T.meanError} m, max ≤ ${T.maxError} m, arc progress ≥ ${T.arcProgress * 100}%, optimisation ≥ ${T.realtime}× faster than the motion lasts, skating ≤ ${T.skatingRatio}× unconstrained generation. Error = distance from the root (on the ground) to the path, every frame.`, '');
+  const table = (rows, withFree) => {
+    const out = ['| path | gait | mean error (m) | max error (m) | arc progress | motion (s) | optimise (s) | × real time | speed (m/s) | skating (m/s) |' + (withFree ? ' unconstrained skating (m/s) |' : ''),
+      '|---|---|---|---|---|---|---|---|---|---|' + (withFree ? '---|' : '')];
+    for (const name of Object.keys(PATHS)) {
+      const g = rows.filter((p) => p.path === name);
+      if (!g.length) continue;
+      const worst = (k) => Math.max(...g.map((p) => p[k]));
+      const least = (k) => Math.min(...g.map((p) => p[k]));
+      out.push(
+        `| ${name} | ${g[0].gait} | ${fmt(mean(g.map((p) => p.meanError)), 3)} (worst ${fmt(worst('meanError'), 3)}) | ${fmt(worst('maxError'), 3)} | ${fmt(least('arcProgress') * 100, 1)}% (least) | ${fmt(mean(g.map((p) => p.seconds)), 1)} | ${fmt(mean(g.map((p) => p.optimizeMs)) / 1000, 1)} | ${fmt(least('realtime'), 2)} (least) | ${fmt(mean(g.map((p) => p.speed)))} | ${fmt(mean(g.map((p) => p.skating)), 3)} |` +
+          (withFree ? ` ${fmt(mean(g.map((p) => p.freeSkating)), 3)} |` : ''),
+      );
+    }
+    return out;
+  };
+  lines.push(...table(walk, true), '');
+  const ok = (rows) => rows.every((p) => p.meanError <= T.meanError && p.maxError <= T.maxError && p.arcProgress >= T.arcProgress && p.realtime >= T.realtime);
+  const skateRatio = mean(walk.map((p) => p.skating)) / mean(walk.map((p) => p.freeSkating));
+  lines.push(`Walking: every run within the fit, progress and speed targets: ${pass(ok(walk))}. Skating of the optimised walks ÷ unconstrained generation from the same seed states: ${fmt(skateRatio, 2)} (target ≤ ${T.skatingRatio}): ${pass(skateRatio <= T.skatingRatio)}.`, '');
+  lines.push('Running (`gait: "run"`, run seed states; not part of the targets, shown for completeness):', '');
+  lines.push(...table(run, false), '');
+  lines.push(`Running: every run within the targets: ${pass(ok(run))}.`, '');
+
+  lines.push('## Live control', '');
+  lines.push(
+    `\`simulateControl\` runs the Steer mode's loop from a script: batches of 6 frames (0.2 s) optimised toward the target in force at the batch's start, ${SIM_SECONDS} s per run, the change at 3 s. ` +
+      'Heading is the root\'s facing; speed is the root\'s mean horizontal speed over the last 0.5 s (about one step), read 1 s after the change. Compute is the optimisation time of each batch divided by its frames.',
+    '',
+  );
+  lines.push('| scenario | heading within 15° after (s) | speed 1 s after the change (m/s) | |speed − target| (m/s) | compute p95 / max (ms per frame) | skating (m/s) |', '|---|---|---|---|---|---|');
+  for (const name of Object.keys(SCENARIOS)) {
+    const g = r.control.filter((c) => c.scenario === name);
+    const head = g[0].kind === 'heading' ? g.map((c) => fmt(c.headingResponse)).join(', ') : '—';
+    lines.push(`| ${name} | ${head} | ${g.map((c) => fmt(c.speedAt1s)).join(', ')} | ${fmt(Math.max(...g.map((c) => c.speedError)))} (worst) | ${fmt(Math.max(...g.map((c) => c.p95ms)), 1)} / ${fmt(Math.max(...g.map((c) => c.maxMs)), 1)} | ${fmt(mean(g.map((c) => c.skating)), 3)} |`);
+  }
+  lines.push('');
+  const heads = r.control.filter((c) => c.kind === 'heading');
+  const walkSpeeds = r.control.filter((c) => c.kind === 'speed' && !c.scenario.startsWith('run'));
+  const allP95 = Math.max(...r.control.map((c) => c.p95ms));
+  const controlSkate = mean(r.control.filter((c) => !c.scenario.startsWith('run')).map((c) => c.skating));
+  lines.push(`- Heading response within the limit (90°: ${T.heading90} s, 180°: ${T.heading180} s) in every run: ${pass(heads.every((c) => c.headingResponse <= c.limit))}.`);
+  lines.push(`- Walking speed within ${T.speedError} m/s of the target 1 s after a change in every run: ${pass(walkSpeeds.every((c) => c.speedError <= T.speedError))}.`);
+  lines.push(`- Compute per model frame, p95 over each run (worst run): ${fmt(allP95, 1)} ms (target < ${T.p95ms}): ${pass(allP95 < T.p95ms)}.`);
+  lines.push(`- Skating of the walking control runs ${fmt(controlSkate, 3)} m/s vs unconstrained ${fmt(r.freeControlSkating, 3)} m/s: ratio ${fmt(controlSkate / r.freeControlSkating, 2)} (target ≤ ${T.skatingRatio}).`);
+  lines.push('');
+  return lines.join('\n') + '\n';
+}
+
+main().catch((err) => {
+  console.error(err);
+  process.exit(1);
+});
