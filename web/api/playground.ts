@@ -9,6 +9,9 @@ import type { Motion } from '../motion/types';
 import type { PlaybackState } from '../viewer/playback';
 import type { RenderStats } from '../viewer/viewer';
 import { errorMessage, type App } from '../ui/app';
+import { checkSchedule } from '../optimizer/liveControl';
+import { checkPathPoints, GroundPath } from '../optimizer/path';
+import { checkFitSigma, checkGait, checkSeconds, checkSeed } from '../runtime/optimizerRequests';
 
 declare const __APP_VERSION__: string;
 
@@ -368,14 +371,15 @@ export function createPlayground(app: App): Playground {
     followPath(options) {
       return guardedAsync('followPath', async () => {
         const o = checkKeys(options, ['points', 'gait', 'seed', 'fitTolerance'], '{ points: [[x, z], …], gait?, seed?, fitTolerance? }');
+        // Checked here too (the worker checks again), so bad input fails fast and without a worker prefix.
+        const points = checkPathPoints(o.points);
+        GroundPath.fromPoints(points);
+        const gait = checkGait(o.gait ?? 'walk');
+        const seed = checkSeed(o.seed ?? 0);
+        const fitSigma = checkFitSigma(o.fitTolerance ?? 0.1, 'fitTolerance');
         await ready;
         const { client } = await app.generator.load();
-        const m = await client.followPath({
-          points: o.points as [number, number][],
-          gait: (o.gait ?? 'walk') as 'walk' | 'run',
-          seed: (o.seed ?? 0) as number,
-          ...(o.fitTolerance === undefined ? {} : { fitSigma: o.fitTolerance as number }),
-        });
+        const m = await client.followPath({ points, gait, seed, fitSigma });
         const { meanError, maxError, arcProgress, optimizeMs } = m.stats;
         return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, stats: { meanError, maxError, arcProgress, optimizeMs } };
       });
@@ -384,14 +388,13 @@ export function createPlayground(app: App): Playground {
     simulateControl(options) {
       return guardedAsync('simulateControl', async () => {
         const o = checkKeys(options, ['seconds', 'schedule', 'seed', 'gait'], '{ seconds, schedule: [{ t, speed, heading }, …], seed?, gait? }');
+        const seconds = checkSeconds(o.seconds);
+        const schedule = checkSchedule(o.schedule);
+        const seed = checkSeed(o.seed ?? 0);
+        const gait = o.gait === undefined ? undefined : checkGait(o.gait);
         await ready;
         const { client } = await app.generator.load();
-        const m = await client.simulateControl({
-          seconds: o.seconds as number,
-          schedule: o.schedule as SimulateControlOptions['schedule'],
-          seed: (o.seed ?? 0) as number,
-          ...(o.gait === undefined ? {} : { gait: o.gait as 'walk' | 'run' }),
-        });
+        const m = await client.simulateControl({ seconds, schedule, seed, ...(gait ? { gait } : {}) });
         return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, speed: m.speed, heading: m.heading, computeMs: m.computeMs };
       });
     },

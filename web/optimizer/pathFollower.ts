@@ -23,7 +23,7 @@ const GAITS: Record<Gait, { speeds: [number, number]; pace: number }> = {
 /** Largest heading change a steering target asks for in one frame (rad): 4.5 rad/s. */
 const MAX_TURN_PER_FRAME = 0.15;
 /** Progress shortfall of 10 cm over a window costs 1. */
-const PROGRESS_SIGMA = 0.1;
+const PROGRESS_SIGMA = 0.05;
 /**
  * Beyond this distance from the path (m) each frame pays an extra ((e − margin) / 3 cm)²: eq. (17)'s
  * squared error alone ranks a window that overshoots a sharp corner by 35 cm for a few frames above

@@ -7,16 +7,26 @@ import { checkPathPoints, GroundPath } from '../optimizer/path';
 import type { GeneratorCore } from './generatorCore';
 import type { ControlChunkReply, ControlStartParams, ControlTargetParams, FollowPathChunk, FollowPathParams, SimulateControlParams, SimulatedControlChunk, StreamInfo } from './protocol';
 
-const MAX_SIMULATED_SECONDS = 600;
+export const MAX_SIMULATED_SECONDS = 600;
 
-function checkGait(gait: unknown): Gait {
+export function checkGait(gait: unknown): Gait {
   if (gait !== 'walk' && gait !== 'run') throw new TypeError(`gait must be "walk" or "run", got ${JSON.stringify(gait)}`);
   return gait;
 }
 
-function checkSeed(seed: unknown): number {
+export function checkSeed(seed: unknown): number {
   if (typeof seed !== 'number' || !Number.isInteger(seed) || seed < 0 || seed > 0xffffffff) throw new RangeError(`seed must be an integer from 0 to 4294967295, got ${String(seed)}`);
   return seed;
+}
+
+export function checkFitSigma(value: unknown, name = 'fitSigma'): number {
+  if (typeof value !== 'number' || !(value >= 0.02 && value <= 2)) throw new RangeError(`${name} must be a number from 0.02 to 2 m, got ${String(value)}`);
+  return value;
+}
+
+export function checkSeconds(seconds: unknown): number {
+  if (typeof seconds !== 'number' || !(seconds > 0 && seconds <= MAX_SIMULATED_SECONDS)) throw new RangeError(`seconds must be a number above 0 and at most ${MAX_SIMULATED_SECONDS}, got ${String(seconds)}`);
+  return seconds;
 }
 
 export class OptimizerRequests {
@@ -53,8 +63,7 @@ export class OptimizerRequests {
     const points = checkPathPoints(p.points);
     const gait = checkGait(p.gait);
     const seed = checkSeed(p.seed);
-    const fitSigma = p.fitSigma ?? 0.1;
-    if (typeof fitSigma !== 'number' || !(fitSigma >= 0.02 && fitSigma <= 2)) throw new RangeError(`fitSigma must be a number from 0.02 to 2 m, got ${String(p.fitSigma)}`);
+    const fitSigma = checkFitSigma(p.fitSigma ?? 0.1);
     const path = p.stroke ? GroundPath.fromStroke(points) : GroundPath.fromPoints(points);
     const info = this.core.info;
     const r = await followPath({ step: this.step, info, mean: this.core.mean, std: this.core.std, path, gait, seed, fitSigma, onProgress: progress });
@@ -83,7 +92,7 @@ export class OptimizerRequests {
   }
 
   async simulate(p: SimulateControlParams, progress: (fraction: number) => void): Promise<SimulatedControlChunk> {
-    if (typeof p.seconds !== 'number' || !(p.seconds > 0 && p.seconds <= MAX_SIMULATED_SECONDS)) throw new RangeError(`seconds must be a number above 0 and at most ${MAX_SIMULATED_SECONDS}, got ${String(p.seconds)}`);
+    checkSeconds(p.seconds);
     const schedule = checkSchedule(p.schedule);
     const seed = checkSeed(p.seed);
     const gait = p.gait === undefined ? (schedule[0].speed >= 2 ? 'run' : 'walk') : checkGait(p.gait);

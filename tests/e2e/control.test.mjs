@@ -1,0 +1,114 @@
+// End-to-end tests of the optimiser through the public API in the page: playground.followPath and
+// playground.simulateControl (the code the Path and Steer modes run), with their error handling.
+import assert from 'node:assert/strict';
+import { after, before, describe, test } from 'node:test';
+import { launchBrowser, openPlayground, startServer } from './harness.mjs';
+
+const BEND = [[0, 0], [0, 2], [1.5, 3.5]];
+
+/** In-page followPath, returned as plain data. */
+function followPath(page, options) {
+  return page.evaluate(async (o) => {
+    const m = await window.playground.followPath(o);
+    return { fps: m.fps, frames: m.frames, joints: m.joints, positions: Array.from(m.positions), contacts: Array.from(m.contacts), stats: m.stats };
+  }, options);
+}
+
+/** The error message a call rejects with (null if it resolves), plus lastError and whether a motion is shown. */
+function failure(page, method, options) {
+  return page.evaluate(
+    async ({ method, options }) => {
+      try {
+        await window.playground[method](options);
+        return { message: null };
+      } catch (e) {
+        return { message: e.message, lastError: window.playground.lastError(), shown: window.playground.current()?.frames ?? null };
+      }
+    },
+    { method, options },
+  );
+}
+
+describe('path following and live control in the page', { timeout: 300_000 }, () => {
+  let server, url, browser, page, problems;
+
+  before(async () => {
+    ({ server, url } = await startServer());
+    browser = await launchBrowser();
+    ({ page, problems } = await openPlayground(browser, url));
+  });
+
+  after(async () => {
+    await browser?.close();
+    await server?.close();
+  });
+
+  test('followPath walks a bent path to its end, close to it, the same way for the same seed', async () => {
+    const a = await followPath(page, { points: BEND, gait: 'walk', seed: 4 });
+    assert.equal(a.fps, 30);
+    assert.ok(a.frames > 60, `a 3.6 m walk takes more than 2 s (got ${a.frames} frames)`);
+    assert.equal(a.positions.length, a.frames * a.joints.length * 3);
+    assert.equal(a.contacts.length, a.frames * 2);
+    assert.ok(a.positions.every(Number.isFinite));
+    assert.ok(a.stats.meanError < 0.1, `mean error ${a.stats.meanError}`);
+    assert.ok(a.stats.maxError < 0.3, `max error ${a.stats.maxError}`);
+    assert.ok(a.stats.arcProgress > 0.95, `arc progress ${a.stats.arcProgress}`);
+    assert.ok(a.stats.optimizeMs > 0);
+    // The root ends near the path's end, having started at its beginning.
+    const last = (a.frames - 1) * a.joints.length * 3;
+    assert.ok(Math.hypot(a.positions[0], a.positions[2]) < 0.1);
+    assert.ok(Math.hypot(a.positions[last] - 1.5, a.positions[last + 2] - 3.5) < 0.35, `ends at ${a.positions[last]}, ${a.positions[last + 2]}`);
+    const b = await followPath(page, { points: BEND, gait: 'walk', seed: 4 });
+    assert.deepEqual(b.positions, a.positions);
+    const c = await followPath(page, { points: BEND, gait: 'walk', seed: 5 });
+    assert.notDeepEqual(c.positions, a.positions);
+  });
+
+  test('followPath refuses bad input with a message and leaves the scene as it was', async () => {
+    await page.evaluate(async () => {
+      const m = await window.playground.generate({ model: 'generator', frames: 40, seed: 1 });
+      window.playground.show(m, 'before');
+    });
+    const short = await failure(page, 'followPath', { points: [[0, 0], [0, 0.2]] });
+    assert.match(short.message, /^followPath: the path is 0\.20 m long; it must be at least 0\.5 m/);
+    assert.equal(short.lastError, short.message);
+    assert.equal(short.shown, 40);
+    const bad = await failure(page, 'followPath', { points: [[0, 0], [1, null]] });
+    assert.match(bad.message, /points\[1\] must be a pair of finite numbers/);
+    const gait = await failure(page, 'followPath', { points: BEND, gait: 'crawl' });
+    assert.match(gait.message, /gait must be "walk" or "run"/);
+    const option = await failure(page, 'followPath', { points: BEND, speed: 2 });
+    assert.match(option.message, /unknown option "speed"/);
+  });
+
+  test('simulateControl turns to a new heading and holds the speed; compute is reported per frame', async () => {
+    const m = await page.evaluate(async () => {
+      const r = await window.playground.simulateControl({ seconds: 4, seed: 2, schedule: [{ t: 0, speed: 1.2, heading: 0 }, { t: 1, speed: 1.2, heading: Math.PI / 2 }] });
+      return { frames: r.frames, speed: Array.from(r.speed), heading: Array.from(r.heading), computeMs: Array.from(r.computeMs), positions: Array.from(r.positions), joints: r.joints.length, contacts: r.contacts.length };
+    });
+    assert.equal(m.frames, 120);
+    assert.equal(m.speed.length, 120);
+    assert.equal(m.heading.length, 120);
+    assert.equal(m.contacts, 240);
+    assert.ok(m.positions.every(Number.isFinite));
+    assert.ok(m.computeMs.every((v) => v > 0 && Number.isFinite(v)));
+    assert.ok(Math.abs(m.heading[20]) < 0.3, `facing +z before the change (${m.heading[20]})`);
+    const end = m.heading[119];
+    assert.ok(Math.abs(end - Math.PI / 2) < 0.26, `facing +x at the end (${end})`);
+    assert.ok(Math.abs(m.speed[119] - 1.2) < 0.35, `speed ${m.speed[119]}`);
+    // It walked: the root moved about speed × time.
+    const last = 119 * m.joints * 3;
+    const travelled = Math.hypot(m.positions[last] - m.positions[0], m.positions[last + 2] - m.positions[2]);
+    assert.ok(travelled > 2.5, `travelled ${travelled} m`);
+  });
+
+  test('simulateControl refuses bad schedules', async () => {
+    const late = await failure(page, 'simulateControl', { seconds: 2, schedule: [{ t: 0.5, speed: 1, heading: 0 }] });
+    assert.match(late.message, /^simulateControl: schedule\[0\]\.t must be 0/);
+    const fast = await failure(page, 'simulateControl', { seconds: 2, schedule: [{ t: 0, speed: 12, heading: 0 }] });
+    assert.match(fast.message, /speed must be a number from 0 to 4/);
+    const long = await failure(page, 'simulateControl', { seconds: 6000, schedule: [{ t: 0, speed: 1, heading: 0 }] });
+    assert.match(long.message, /seconds must be a number above 0 and at most 600/);
+    assert.deepEqual(problems, []);
+  });
+});
