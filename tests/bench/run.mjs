@@ -7,7 +7,9 @@
 //
 // Add a benchmark by appending { name, description, run(ctx) } to BENCHMARKS; run() returns an object
 // of metrics. ctx gives the browser, the served URL and corpus access.
-import { corpusText, launchBrowser, openPlayground, startServer } from '../e2e/harness.mjs';
+import { readFileSync } from 'node:fs';
+import path from 'node:path';
+import { corpusText, launchBrowser, openPlayground, ROOT, startServer } from '../e2e/harness.mjs';
 
 const SECONDS = Number(process.env.BENCH_SECONDS ?? 5);
 const WARMUP_SECONDS = Number(process.env.BENCH_WARMUP ?? 4);
@@ -191,6 +193,61 @@ const GENERATOR_BENCHMARKS = [1, 2].flatMap((threads) => [
   },
 ]);
 
+const BENCHMARK_PATHS = JSON.parse(readFileSync(path.join(ROOT, 'tests/fixtures/benchmark_paths.json'), 'utf8')).paths;
+
+/** followPath on each benchmark path (walk, seed 0): optimisation time against the motion's duration. */
+async function pathFollowBenchmark(ctx) {
+  const { context, page, problems } = await openPlayground(ctx.browser, ctx.url, VIEWPORT);
+  try {
+    const rows = {};
+    // Warm-up (model load, first wasm calls), as the raw-step benchmarks do.
+    await page.evaluate(() => window.playground.followPath({ points: [[0, 0], [0, 1]], seed: 0 }));
+    for (const [name, { points }] of Object.entries(BENCHMARK_PATHS)) {
+      const r = await page.evaluate(async (points) => {
+        const m = await window.playground.followPath({ points, gait: 'walk', seed: 0 });
+        return { seconds: m.frames / m.fps, optimizeMs: m.stats.optimizeMs };
+      }, points);
+      rows[name] = +((r.seconds * 1000) / r.optimizeMs).toFixed(2);
+    }
+    return { realtime_factor: rows, least_realtime_factor: Math.min(...Object.values(rows)), target_realtime_factor: 2, page_errors: problems.length };
+  } finally {
+    await context.close();
+  }
+}
+
+/** simulateControl (the live loop, scripted): compute per model frame while turning and changing speed. */
+async function liveControlBenchmark(ctx) {
+  const { context, page, problems } = await openPlayground(ctx.browser, ctx.url, VIEWPORT);
+  try {
+    const ms = await page.evaluate(async () => {
+      await window.playground.simulateControl({ seconds: 0.5, schedule: [{ t: 0, speed: 1, heading: 0 }], seed: 0 }); // warm-up
+      const schedule = [{ t: 0, speed: 1.2, heading: 0 }, { t: 2, speed: 1.5, heading: Math.PI / 2 }, { t: 4, speed: 0.8, heading: -Math.PI / 2 }];
+      const m = await window.playground.simulateControl({ seconds: 6, schedule, seed: 0 });
+      return Array.from(m.computeMs);
+    });
+    const sorted = [...ms].sort((a, b) => a - b);
+    const pct = (p) => +sorted[Math.min(sorted.length - 1, Math.floor((p / 100) * sorted.length))].toFixed(2);
+    return { frames: ms.length, p50_ms_per_frame: pct(50), p95_ms_per_frame: pct(95), max_ms_per_frame: +sorted.at(-1).toFixed(2), target_p95_ms: 33, page_errors: problems.length };
+  } finally {
+    await context.close();
+  }
+}
+
+const OPTIMIZER_BENCHMARKS = [
+  {
+    name: 'path-follow',
+    description: 'followPath on the five benchmark paths (walk, seed 0) — target: optimisation ≥ 2× faster than the motion lasts',
+    kind: 'path',
+    run: pathFollowBenchmark,
+  },
+  {
+    name: 'live-control',
+    description: 'simulateControl, 6 s with speed and heading changes: compute per model frame — target p95 < 33 ms',
+    kind: 'control',
+    run: liveControlBenchmark,
+  },
+];
+
 export const BENCHMARKS = [
   {
     name: 'playback-auto',
@@ -215,6 +272,13 @@ export const BENCHMARKS = [
     description: 'Dance mode streaming acLSTM at 60 fps (default threads), skeleton fit and pose-change plot, default quality — target 60 fps',
     kind: 'live',
     run: (ctx) => liveModeBenchmark(ctx, '#mode-dance', 'dance-status'),
+  },
+  ...OPTIMIZER_BENCHMARKS,
+  {
+    name: 'steer-mode',
+    description: 'Steer mode: live control streaming (no input: straight ahead at 1.2 m/s), default quality — target 60 fps',
+    kind: 'live',
+    run: (ctx) => liveModeBenchmark(ctx, '#mode-steer', 'steer-status'),
   },
 ];
 
@@ -262,6 +326,14 @@ async function main() {
     if (b.kind === 'generator') {
       const target = r.batch === 1 ? `${r.steps_per_s} steps/s (target ≥ 1,000)` : `${r.particle_steps_per_s} particle-steps/s (target ≥ 20,000)`;
       console.log(`  ${b.name}: ${target}, ${r.ms_per_call} ms/call, ${r.threads} thread(s)${r.isolated ? '' : ' (not isolated)'}\n    ${b.description}`);
+      continue;
+    }
+    if (b.kind === 'path') {
+      console.log(`  ${b.name}: least ${r.least_realtime_factor}× real time (target ≥ 2×): ${JSON.stringify(r.realtime_factor)}\n    ${b.description}`);
+      continue;
+    }
+    if (b.kind === 'control') {
+      console.log(`  ${b.name}: ${r.p95_ms_per_frame} ms per frame p95 (target < 33), p50 ${r.p50_ms_per_frame}, max ${r.max_ms_per_frame}\n    ${b.description}`);
       continue;
     }
     if (b.kind === 'live') {
