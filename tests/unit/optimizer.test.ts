@@ -105,5 +105,9 @@ describe('LiveController', () => {
     expect(() => checkSchedule([{ t: 0, speed: 9, heading: 0 }])).toThrow(/schedule\[0\]\.speed must be a number from 0 to 4/);
     const controller = new LiveController({ step, info, mean: core.mean, std: core.std, seed: 5, seedIndex: 0 });
     await expect(controller.advance({ speed: 1, heading: NaN })).rejects.toThrow(/heading must be a finite number/);
+    await expect(controller.advance({ speed: 1, heading: 0 }, 6, 2)).rejects.toThrow(/particles must be an integer from 4 to 64/);
+    const cheap = await controller.advance({ speed: 1, heading: 0 }, 6, 8); // the page's budget when the machine is busy
+    expect(cheap.frames).toBe(6);
+    expect(cheap.positions.every(Number.isFinite)).toBe(true);
   });
 });

@@ -18,6 +18,10 @@ export interface ControlTarget {
 }
 
 export const MAX_CONTROL_SPEED = 4;
+/** Particles per round: the default (what simulateControl and the report use) and the range allowed. */
+export const DEFAULT_CONTROL_PARTICLES = 24;
+export const MIN_CONTROL_PARTICLES = 4;
+export const MAX_CONTROL_PARTICLES = 64;
 /** Frames kept per optimised batch (0.2 s at 30 fps) and frames looked at. */
 export const CONTROL_BATCH = 6;
 export const CONTROL_HORIZON = 12;
@@ -119,14 +123,20 @@ export class LiveController {
     return { ...this.state.root };
   }
 
-  /** Optimises and keeps the next `frames` (≤ CONTROL_BATCH) frames toward `goal`. */
-  async advance(goal: ControlTarget, frames = CONTROL_BATCH): Promise<ControlChunk> {
+  /**
+   * Optimises and keeps the next `frames` (≤ CONTROL_HORIZON) frames toward `goal`, with `particles`
+   * per round (default the controller's; the page lowers it when a batch takes longer than it lasts).
+   */
+  async advance(goal: ControlTarget, frames = CONTROL_BATCH, particles?: number): Promise<ControlChunk> {
     checkTarget(goal);
     if (!Number.isInteger(frames) || frames < 1 || frames > CONTROL_HORIZON) throw new RangeError(`frames must be an integer from 1 to ${CONTROL_HORIZON}, got ${frames}`);
     const started = performance.now();
     const { info, step, mean, std } = this.o;
     const D = info.onnx.dim, fps = info.fps;
-    const P = this.o.particles ?? 24, rounds = this.o.rounds ?? 2;
+    const P = particles ?? this.o.particles ?? DEFAULT_CONTROL_PARTICLES, rounds = this.o.rounds ?? 2;
+    if (!Number.isInteger(P) || P < MIN_CONTROL_PARTICLES || P > MAX_CONTROL_PARTICLES) {
+      throw new RangeError(`particles must be an integer from ${MIN_CONTROL_PARTICLES} to ${MAX_CONTROL_PARTICLES}, got ${P}`);
+    }
     const T = CONTROL_HORIZON;
     const elites = Math.max(1, Math.round(P / 4));
     let variables: Variables = randomVariables(P, T, D, this.rng);

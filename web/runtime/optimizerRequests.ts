@@ -51,7 +51,7 @@ export class OptimizerRequests {
       case 'controlStart':
         return Promise.resolve(this.controlStart(request as unknown as ControlStartParams));
       case 'controlPull':
-        return this.controlPull(request as unknown as ControlTargetParams & { frames: number });
+        return this.controlPull(request as unknown as ControlTargetParams & { frames: number; particles?: number });
       case 'simulateControl':
         return this.simulate(request as unknown as SimulateControlParams, progress);
       default:
@@ -81,13 +81,13 @@ export class OptimizerRequests {
     return { seedIndex: this.live.seedIndex, seedName: this.core.info.seeds[this.live.seedIndex].name };
   }
 
-  async controlPull(p: ControlTargetParams & { frames: number }): Promise<ControlChunkReply> {
+  async controlPull(p: ControlTargetParams & { frames: number; particles?: number }): Promise<ControlChunkReply> {
     const live = this.live;
     if (!live) throw new Error('no control stream: send controlStart first');
     checkTarget(p);
     if (!Number.isInteger(p.frames) || p.frames < 1 || p.frames > CONTROL_HORIZON) throw new RangeError(`frames must be an integer from 1 to ${CONTROL_HORIZON}, got ${p.frames}`);
     const startFrame = live.controller.frame;
-    const chunk = await live.controller.advance({ speed: p.speed, heading: p.heading }, p.frames);
+    const chunk = await live.controller.advance({ speed: p.speed, heading: p.heading }, p.frames, p.particles);
     return { ...chunk, seedIndex: live.seedIndex, startFrame };
   }
 

@@ -140,6 +140,8 @@ export interface ControlStartParams {
 export interface ControlTargetParams {
   speed: number;
   heading: number;
+  /** Particles per round for this batch (default 24): fewer is cheaper and steers less precisely. */
+  particles?: number;
 }
 
 export interface ControlChunkReply extends GeneratedChunk {
