@@ -2,6 +2,7 @@
 
     python -m training.evaluate generator [--frames 10000] [--seeds 5]
     python -m training.evaluate aclstm [--frames 20000] [--seeds 5]     (see training/evaluate_aclstm.py)
+    python -m training.evaluate refiner [--frames 3000] [--seeds 8]     (see training/evaluate_refiner.py)
 
 The generator report compares sampled motion with the generator's held-out validation clips:
 foot skating, root speed and turning-rate distributions, NPSS, and a long stability run.
@@ -237,9 +238,9 @@ def write_markdown(report: dict) -> None:
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("model", choices=["generator", "aclstm"])
-    parser.add_argument("--frames", type=int, default=None, help="frames per seed (generator 10000, aclstm 20000)")
-    parser.add_argument("--seeds", type=int, default=5)
+    parser.add_argument("model", choices=["generator", "aclstm", "refiner"])
+    parser.add_argument("--frames", type=int, default=None, help="frames per seed (generator 10000, aclstm 20000, refiner 3000)")
+    parser.add_argument("--seeds", type=int, default=None, help="seeds (5; refiner: 8, all of the generator's)")
     parser.add_argument("--temperature", type=float, default=0.5, help="the playground's default")
     parser.add_argument("--sweep", default="1.0,0.5,0.25", help="temperatures for the comparison table ('' to skip)")
     parser.add_argument("--sweep-frames", type=int, default=3000)
@@ -248,6 +249,11 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--also", action="append", default=[], metavar="LABEL=JSON",
                         help="aclstm: another exported dance model to compare (not shipped), e.g. 'acLSTM v=20=/tmp/x/aclstm.json'")
     args = parser.parse_args(argv)
+    if args.model == "refiner":
+        from . import evaluate_refiner
+        evaluate_refiner.run_and_write(args.frames or 3000, args.seeds or 8, args.mocap, args.models)
+        return
+    args.seeds = args.seeds or 5
     if args.model == "aclstm":
         from . import evaluate_aclstm
         evaluate_aclstm.run(args.frames or 20000, args.seeds, args.mocap, args.models, args.also)

@@ -1,0 +1,252 @@
+"""Refiner pieces: torch decoding + FK against numpy, streaming step = sequence forward, foot lock, ONNX parity."""
+import json
+
+import numpy as np
+import onnxruntime as ort
+import pytest
+import torch
+
+from training.dataset import clip_contacts, load_clip, read_index
+from training.export_generator import MODELS_DIR
+from training.export_refiner import FIXTURE, OUTPUTS, export_onnx, parity_error, step_parity, stream_inputs
+from training.features import FeatureCodec
+from training.footlock import BLEND_IN, TOE_GROUND_HEIGHT, FootLock, foot_lock, two_bone_ik
+from training.models.refiner import (FeatureGeometry, Refiner, RefinerStep, rotvec_to_matrix, straight_through_bits)
+from training.rotations import axis_rotation
+from training.skeleton import canonical_skeleton
+from training.train_refiner import root_loss
+
+SKEL = canonical_skeleton()
+
+
+@pytest.fixture(scope="module")
+def walk(mocap):
+    info = next(i for i in read_index(mocap) if i.file.endswith("16_22.amc.gz"))  # walk with a turn
+    clip = load_clip(mocap, info, 30)
+    codec = FeatureCodec()
+    codec.fit_references(clip.rotations)
+    x = codec.encode(clip.root, clip.rotations, clip_contacts(clip))
+    return codec, x
+
+
+def random_refiner(codec, x, hidden=24, seed=0) -> Refiner:
+    torch.manual_seed(seed)
+    mean, std = x.mean(0), np.maximum(x.std(0), 1e-2)
+    rng = np.random.default_rng(seed)
+    model = Refiner(mean, std, codec.references, hidden, end_mean=rng.normal(size=42) * 0.1,
+                    end_std=1 + rng.random(42), fps=30.0).eval()
+    with torch.no_grad():
+        for p in model.parameters():
+            p.add_(torch.randn_like(p) * 0.2)  # FC2 starts at zero: make the residual branch matter
+    return model
+
+
+def normalised(model, x):
+    return ((x - model.mean.numpy()) / model.std.numpy()).astype(np.float32)
+
+
+def test_rotvec_matches_numpy_and_is_finite_at_zero():
+    from training.features import rotvec_to_matrix as np_rotvec
+    v = np.random.default_rng(1).normal(size=(50, 3)) * 1.5
+    v[0] = 0
+    v[1] = 1e-7
+    got = rotvec_to_matrix(torch.from_numpy(v)).numpy()
+    assert np.abs(got - np_rotvec(v)).max() < 1e-10
+    t = torch.zeros(3, dtype=torch.float64, requires_grad=True)
+    rotvec_to_matrix(t).sum().backward()
+    assert torch.isfinite(t.grad).all()
+
+
+def test_torch_fk_matches_numpy_decoder(walk):
+    codec, x = walk
+    geo = FeatureGeometry(codec.references).double()
+    pos_world = codec.positions(x)  # start at the origin, heading 0
+    root, _, _ = codec.decode(x)
+    yaw = np.cumsum(x[:, 2])
+    expected = np.einsum("fji,fkj->fki", axis_rotation("y", yaw), pos_world - root[:, None] * [1, 0, 1])
+    got = geo.root_frame_positions(torch.from_numpy(x))
+    assert len(geo.needed) >= 20
+    for j in geo.needed:
+        assert np.abs(got[j].numpy() - expected[:, j]).max() < 1e-7, SKEL.joints[j]  # sqrt(t^2 + 1e-12) in Rodrigues
+    # end-effector velocities: world velocities in the previous frame's heading frame
+    p, v = geo.end_effectors(torch.from_numpy(x[None, 1:]), torch.from_numpy(x[None, 0]))
+    world_v = np.einsum("fji,fkj->fki", axis_rotation("y", yaw[:-1]), np.diff(pos_world, axis=0)) * 30
+    assert np.abs(v[0].numpy() - world_v[:, geo.end_index]).max() < 1e-5
+    assert np.abs(p[0].numpy() - expected[1:, geo.end_index]).max() < 1e-7
+    assert np.abs(geo.root_trajectory(torch.from_numpy(x[None]))[0].numpy() - root).max() < 1e-9
+    # the clip turns, so the heading terms are really exercised
+    assert np.abs(x[:, 2]).sum() > 0.5
+
+
+def test_refiner_starts_as_identity_and_root_loss_sees_root_changes(walk):
+    codec, x = walk
+    model = Refiner(x.mean(0), np.maximum(x.std(0), 1e-2), codec.references, 16)
+    xn = torch.from_numpy(normalised(model, x))[None]
+    y, _ = model(xn[:, 1:], xn[:, 0])
+    assert torch.equal(y, xn[:, 1:])
+    assert float(root_loss(model, xn, xn)) == 0.0
+    bent = xn.clone()
+    bent[..., 2] += 0.5  # turn a bit more each frame: the integrated root path moves away
+    assert float(root_loss(model, xn, bent)) > 1e-3
+
+
+def test_straight_through_bits():
+    c = torch.tensor([0.2, 0.7, 0.51], requires_grad=True)
+    b = straight_through_bits(c)
+    assert b.tolist() == [0.0, 1.0, 1.0]
+    b.sum().backward()
+    assert c.grad.tolist() == [1.0, 1.0, 1.0]
+
+
+def test_streaming_step_equals_sequence_forward(walk):
+    codec, x = walk
+    model = random_refiner(codec, x)
+    xn = normalised(model, x[None, :60])
+    with torch.no_grad():
+        ref, _ = model(torch.from_numpy(xn[:, 1:]), torch.from_numpy(xn[:, 0]))
+    q = stream_inputs(model, xn)
+    step = RefinerStep(model).eval()
+    h = torch.zeros(1, 1, model.hidden)
+    c = torch.zeros(1, 1, model.hidden)
+    outs = []
+    with torch.no_grad():
+        for t in range(1, xn.shape[1]):
+            out, h, c = step(torch.from_numpy(xn[:, t]), torch.from_numpy(q[:, t]), torch.from_numpy(q[:, t - 1]), h, c)
+            outs.append(out)
+    got = torch.stack(outs, 1)
+    assert (got - ref).abs().max() < 1e-5
+    assert (ref - torch.from_numpy(xn[:, 1:])).abs().max() > 0.1  # the refiner really changes the frames
+
+
+def test_onnx_step_parity(walk, tmp_path):
+    codec, x = walk
+    model = random_refiner(codec, x, hidden=32, seed=4)
+    path = tmp_path / "r.onnx"
+    export_onnx(model, path)
+    xn = normalised(model, x)
+    frames = np.stack([xn[a:a + 21] for a in np.linspace(0, len(xn) - 21, 8).astype(int)])
+    assert parity_error(model, path, frames) < 1e-4
+    assert step_parity(model, path, frames) < 1e-4
+    # dynamic batch
+    session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
+    q = stream_inputs(model, frames)
+    out = session.run(OUTPUTS, {"x": frames[:3, 1], "ends": q[:3, 1], "ends_prev": q[:3, 0],
+                                "h": np.zeros((1, 3, 32), np.float32), "c": np.zeros((1, 3, 32), np.float32)})
+    assert out[0].shape == (3, model.dim) and out[1].shape == (1, 3, 32)
+
+
+def test_shipped_refiner_matches_its_fixture():
+    path = MODELS_DIR / "refiner.onnx"
+    if not path.exists():
+        pytest.skip("no shipped refiner yet")
+    info = json.loads((MODELS_DIR / "refiner.json").read_text())
+    fx = json.loads(FIXTURE.read_text())
+    assert path.stat().st_size <= 8e6 and info["bytes"] == path.stat().st_size
+    session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
+    b, d, h, e3 = fx["batch"], fx["dim"], fx["hidden"], info["onnx"]["ends"]
+    shapes = {"x": (b, d), "ends": (b, e3), "ends_prev": (b, e3), "h": (1, b, h), "c": (1, b, h)}
+    for step in fx["steps"]:
+        feed = {k: np.array(v, np.float32).reshape(shapes[k]) for k, v in step["inputs"].items()}
+        out = session.run(OUTPUTS, feed)
+        for name, got in zip(OUTPUTS, out):
+            assert np.abs(got.ravel() - np.array(step["outputs"][name])).max() < 1e-4, name
+    # The fixture's ends are the torch geometry of its frames (the convention the browser must reproduce).
+    geo = FeatureGeometry(np.array(fx_references(info)), fps=info["fps"]).double()
+    frames = torch.tensor(fx["frames_physical"], dtype=torch.float64).reshape(b, fx["frames"], d)
+    ends = geo.end_positions(frames).flatten(-2).numpy().ravel()
+    assert np.abs(ends - np.array(fx["ends"])).max() < 1e-5
+
+
+def fx_references(info):
+    from training.rotations import quat_to_matrix
+    gen = json.loads((MODELS_DIR / "generator.json").read_text())
+    return quat_to_matrix(np.array(gen["features"]["references"]))
+
+
+# ---- foot lock ------------------------------------------------------------------------------------
+
+def bone_lengths(pos):
+    return np.stack([np.linalg.norm(pos[:, j] - pos[:, p], axis=-1) for j, p in enumerate(SKEL.parents) if p >= 0], 1)
+
+
+@pytest.fixture(scope="module")
+def sliding_walk(walk):
+    """The real walk decoded, with its planted feet made to slide: the leg below the hip is swung by a smooth
+    rotation about the hip (bone lengths kept), so the toe moves while the contact bit says planted."""
+    codec, x = walk
+    pos = codec.positions(x)
+    contacts = (x[:, -2:] > 0.5).astype(np.uint8)
+    out = pos.copy()
+    t = np.arange(len(pos)) / 30.0
+    for side, names in enumerate([("LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase", "LeftToeBase_end"),
+                                  ("RightUpLeg", "RightLeg", "RightFoot", "RightToeBase", "RightToeBase_end")]):
+        hip = SKEL.index(names[0])
+        rot = axis_rotation("x", 0.08 * np.sin(2 * np.pi * 1.3 * t + side))  # +-0.08 rad: about +-7 cm at the toe
+        for n in names[1:]:
+            j = SKEL.index(n)
+            out[:, j] = pos[:, hip] + np.einsum("fij,fj->fi", rot, pos[:, j] - pos[:, hip])
+    return out, contacts
+
+
+def planted_toe_steps(pos, contacts):
+    steps = []
+    for side, name in enumerate(("LeftToeBase", "RightToeBase")):
+        toe = pos[:, SKEL.index(name)][:, [0, 2]]
+        planted = (contacts[1:, side] > 0) & (contacts[:-1, side] > 0)
+        steps.append(np.linalg.norm(np.diff(toe, axis=0), axis=-1)[planted])
+    return np.concatenate(steps)
+
+
+def test_foot_lock_keeps_planted_toes_fixed_and_bones_rigid(sliding_walk):
+    pos, contacts = sliding_walk
+    out = foot_lock(pos, contacts)
+    raw_steps, locked_steps = planted_toe_steps(pos, contacts), planted_toe_steps(out, contacts)
+    assert raw_steps.mean() > 3e-3  # the input really slides (m per frame)
+    assert np.percentile(locked_steps, 95) < 1e-6 and locked_steps.max() < 5e-3
+    assert np.abs(bone_lengths(out) - bone_lengths(pos)).max() < 1e-9
+    # hips and the upper body never move
+    upper = [j for j, n in enumerate(SKEL.joints) if not n.startswith(("LeftLeg", "LeftFoot", "LeftToe", "RightLeg", "RightFoot", "RightToe"))]
+    assert np.abs(out[:, upper] - pos[:, upper]).max() == 0.0
+
+
+def test_foot_lock_puts_planted_toes_on_the_ground_without_popping(sliding_walk):
+    pos, contacts = sliding_walk
+    out = foot_lock(pos, contacts)
+    for side, name in enumerate(("LeftToeBase", "RightToeBase")):
+        j = SKEL.index(name)
+        c = contacts[:, side] > 0
+        settled = c.copy()
+        for k in range(BLEND_IN):  # frames at least BLEND_IN into a contact
+            settled &= np.roll(c, k + 1)
+        assert np.abs(out[settled, j, 1] - TOE_GROUND_HEIGHT).max() < 1e-9
+    # No popping: the largest frame-to-frame change of velocity (second difference, m/frame^2) of the cleaned
+    # leg stays moderate, and well below what switching the lock on and off without blending gives.
+    def jerk(p):
+        legs = [SKEL.index(n) for n in ("LeftLeg", "LeftFoot", "LeftToeBase", "RightLeg", "RightFoot", "RightToeBase")]
+        return np.linalg.norm(np.diff(p[:, legs], 2, axis=0), axis=-1).max()
+    unblended = foot_lock(pos, contacts, blend_in=1, blend_out=1)
+    assert jerk(out) < 0.12
+    assert jerk(out) < 0.5 * jerk(unblended)
+
+
+def test_foot_lock_leaves_free_feet_alone():
+    pos = np.random.default_rng(0).normal(size=(10, len(SKEL.joints), 3))
+    out = foot_lock(pos, np.zeros((10, 2), np.uint8))
+    assert np.array_equal(out, pos)
+
+
+def test_two_bone_ik_reaches_and_keeps_lengths():
+    hip, knee = np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.6, 0.1])
+    for target in (np.array([0.1, 0.3, 0.2]), np.array([0.0, -2.0, 0.0])):
+        k, a = two_bone_ik(hip, knee, target, 0.4, 0.43)
+        assert abs(np.linalg.norm(k - hip) - 0.4) < 1e-9 and abs(np.linalg.norm(a - k) - 0.43) < 1e-9
+        assert np.dot(k - hip, [0, 0, 1]) > 0  # the knee bends to the raw knee's side
+    k, a = two_bone_ik(hip, knee, np.array([0.1, 0.3, 0.2]), 0.4, 0.43)
+    assert np.linalg.norm(a - [0.1, 0.3, 0.2]) < 1e-9
+
+
+def test_streaming_foot_lock_equals_batch(sliding_walk):
+    pos, contacts = sliding_walk
+    lock = FootLock()
+    streamed = np.stack([lock.step(p, c) for p, c in zip(pos[:80], contacts[:80] > 0)])
+    assert np.array_equal(streamed, foot_lock(pos[:80], contacts[:80]))

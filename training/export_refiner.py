@@ -1,0 +1,328 @@
+"""Export the trained refiner R as a causal streaming step (ONNX) plus its JSON, parity-checked.
+
+    python -m training.export_refiner [--checkpoint runs/refiner/best.pt]
+
+public/models/refiner.onnx: one step, inputs
+    x          (B, D)    the generator's newest frame, normalised (generator.json normalisation), contacts
+                         as the generator feeds them back (clean 0/1 bits, normalised);
+    ends       (B, 3E)   root-frame positions (metres) of the E end effectors of that raw frame;
+    ends_prev  (B, 3E)   the same for the raw frame before it (for the first generated frame: the seed frame);
+    h, c       (1, B, H) R's LSTM state (zeros at the start of a stream);
+outputs x_refined (B, D) normalised (same layout, contacts included), h_out, c_out. The batch is dynamic.
+"Root frame": q = R_y(-yaw) (p - (root_x, 0, root_z)) for world positions p of the decoded frame, with
+yaw the frame's heading (after its own dry), i.e. positions relative to the root's ground point with the
+heading removed and y the height above the floor (models/refiner.py FeatureGeometry.end_positions).
+
+The graph is written directly with onnx.helper (step_graph): the velocities v = fps (step + R_y(dry) q - q_prev)
+and the input normalisation are folded into FC1's weights (FC1 acts on [x, q, q_prev, cos(dry) q, sin(dry) q]),
+the LSTM is written at gate level, and the residual is FC2's Gemm plus x. Also writes public/models/refiner.json,
+the manifest entry and tests/fixtures/refiner_reference.json (a few streamed steps at batch 2, for the
+browser's parity test and its end-effector computation).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+import onnx
+import onnxruntime as ort
+import torch
+from onnx import TensorProto, helper, numpy_helper
+
+from .export_generator import MODELS_DIR
+from .footlock import BLEND_IN, BLEND_OUT, REACH, TOE_GROUND_HEIGHT
+from .manifest import register_model
+from .models.refiner import Refiner, RefinerStep
+from .paths import REPO_ROOT
+from .runs import RUNS_DIR
+
+INPUTS, OUTPUTS = ["x", "ends", "ends_prev", "h", "c"], ["x_refined", "h_out", "c_out"]
+PARITY_TOLERANCE = 1e-4
+OPSET = 17
+GATE_ORDER = [0, 1, 3, 2]  # graph gate blocks (i, f, o, g) from PyTorch's (i, f, g, o)
+FIXTURE = REPO_ROOT / "tests" / "fixtures" / "refiner_reference.json"
+
+
+def load_refiner(checkpoint: Path) -> tuple[Refiner, dict, dict]:
+    state = torch.load(checkpoint, weights_only=False)
+    meta = state["meta"]
+    model = Refiner(np.array(meta["mean"]), np.array(meta["std"]), np.array(meta["references"]), meta["hidden"],
+                    np.array(meta["end_mean"]), np.array(meta["end_std"]), fps=meta["fps"])
+    model.load_state_dict(state["refiner"])
+    return model.eval(), meta, state
+
+
+def folded_fc1(model: Refiner) -> tuple[np.ndarray, np.ndarray]:
+    """FC1 over z = [x, q, q_prev, cos(dry) q, sin(dry) q] (D + 12E inputs): weights (H, D + 12E), bias (H,).
+
+    FC1(x, e) with e = ([q, v] - end_mean) / end_std and v = fps (P step + cos * Mc q + sin * Ms q + My q - q_prev),
+    step = (dtx, dtz) = x[0:2] * std[0:2] + mean[0:2], is linear in each block of z."""
+    g = model.geometry
+    E3 = 3 * model.ends
+    w = model.fc1.weight.detach().double().numpy()
+    b = model.fc1.bias.detach().double().numpy()
+    std, mean = model.std.double().numpy(), model.mean.double().numpy()
+    em, es = model.end_mean.double().numpy(), model.end_std.double().numpy()
+    D, fps = model.dim, g.fps
+    wx, wq, wv = w[:, :D], w[:, D:D + E3] / es[:E3], w[:, D + E3:] / es[E3:]
+    P = np.zeros((E3, 2))
+    P[0::3, 0], P[2::3, 1] = 1.0, 1.0                       # (dtx, 0, dtz) per end effector
+    Mc, Ms, My = np.zeros((E3, E3)), np.zeros((E3, E3)), np.zeros((E3, E3))
+    for k in range(model.ends):
+        x_, y_, z_ = 3 * k, 3 * k + 1, 3 * k + 2
+        Mc[x_, x_], Mc[z_, z_] = 1.0, 1.0                   # cos part of R_y(dry) q
+        Ms[x_, z_], Ms[z_, x_] = 1.0, -1.0                  # sin part: (qz, ., -qx)
+        My[y_, y_] = 1.0
+    wx = wx.copy()
+    wx[:, 0:2] += fps * wv @ P * std[0:2]
+    bias = b - wq @ em[:E3] - wv @ em[E3:] + fps * wv @ P @ mean[0:2]
+    weights = np.concatenate([wx, wq + fps * wv @ My, -fps * wv, fps * wv @ Mc, fps * wv @ Ms], axis=1)
+    return weights.astype(np.float32), bias.astype(np.float32)
+
+
+def step_graph(model: Refiner) -> onnx.ModelProto:
+    H, D, E3 = model.hidden, model.dim, 3 * model.ends
+    sd = {k: v.detach().cpu().numpy().astype(np.float32) for k, v in model.state_dict().items()}
+    inits, nodes = [], []
+
+    def const(name, value):
+        inits.append(numpy_helper.from_array(np.ascontiguousarray(value), name))
+        return name
+
+    def node(op, inputs, outputs, **attrs):
+        nodes.append(helper.make_node(op, inputs, outputs, **attrs))
+        return outputs[0] if len(outputs) == 1 else outputs
+
+    def gates(w):
+        return w.reshape(4, H, *w.shape[1:])[GATE_ORDER].reshape(4 * H, *w.shape[1:])
+
+    # dry (physical) as a one-column Gemm of x, then its cosine and sine
+    pick = np.zeros((D, 1), np.float32)
+    pick[2, 0] = model.std[2].item()
+    dry = node("Gemm", ["x", const("dry_pick", pick), const("dry_mean", np.array([model.mean[2].item()], np.float32))], ["dry"])
+    cq = node("Mul", ["ends", node("Cos", [dry], ["cos_dry"])], ["cos_q"])
+    sq = node("Mul", ["ends", node("Sin", [dry], ["sin_dry"])], ["sin_q"])
+    z = node("Concat", ["x", "ends", "ends_prev", cq, sq], ["fc1_in"], axis=1)
+    w1, b1 = folded_fc1(model)
+    y = node("Relu", [node("Gemm", [z, const("fc1.weight_t", w1.T), const("fc1.bias", b1)], ["fc1"])], ["fc1_relu"])
+    rows = const("rows", np.array([-1, H], np.int64))
+    h0 = node("Reshape", ["h", rows], ["h_rows"])
+    c0 = node("Reshape", ["c", rows], ["c_rows"])
+    b = sd["lstm.bias_ih_l0"] + sd["lstm.bias_hh_l0"]
+    rec = node("Gemm", [h0, const("lstm_hh.weight_t", gates(sd["lstm.weight_hh_l0"]).T), const("lstm.bias", gates(b))], ["rec"])
+    pre = node("Gemm", [y, const("lstm_ih.weight_t", gates(sd["lstm.weight_ih_l0"]).T), rec], ["gates"])
+    sig_in, tanh_in = node("Split", [pre, const("gate_split", np.array([3 * H, H], np.int64))], ["sig_in", "tanh_in"], axis=1)
+    i, f, o = node("Split", [node("Sigmoid", [sig_in], ["sig"]), const("ifo_split", np.array([H, H, H], np.int64))],
+                   ["i", "f", "o"], axis=1)
+    g = node("Tanh", [tanh_in], ["g"])
+    c2 = node("Add", [node("Mul", [f, c0], ["f_c"]), node("Mul", [i, g], ["i_g"])], ["c_new"])
+    h2 = node("Mul", [o, node("Tanh", [c2], ["tanh_c"])], ["h_new"])
+    state = const("state_shape", np.array([1, -1, H], np.int64))
+    node("Reshape", [h2, state], ["h_out"])
+    node("Reshape", [c2, state], ["c_out"])
+    delta = node("Gemm", [h2, const("fc2.weight_t", sd["fc2.weight"].T), "x"], ["fc2_plus_x"])
+    node("Add", [delta, const("fc2.bias", sd["fc2.bias"])], ["x_refined"])
+
+    def value(name, shape):
+        return helper.make_tensor_value_info(name, TensorProto.FLOAT, shape)
+
+    graph = helper.make_graph(
+        nodes, "refiner_step",
+        [value("x", ["batch", D]), value("ends", ["batch", E3]), value("ends_prev", ["batch", E3]),
+         value("h", [1, "batch", H]), value("c", [1, "batch", H])],
+        [value("x_refined", ["batch", D]), value("h_out", [1, "batch", H]), value("c_out", [1, "batch", H])], inits)
+    m = helper.make_model(graph, opset_imports=[helper.make_opsetid("", OPSET)], producer_name="training.export_refiner")
+    m.ir_version = 8
+    onnx.checker.check_model(m, full_check=True)
+    return m
+
+
+def export_onnx(model: Refiner, path: Path) -> None:
+    onnx.save(step_graph(model.eval()), str(path))
+
+
+def stream_inputs(model: Refiner, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Root-frame end positions (B, T, 3E) of normalised frames x (B, T, D): what the caller computes."""
+    with torch.no_grad():
+        q = model.geometry.end_positions(model.physical(torch.from_numpy(x.astype(np.float32))))
+    return q.flatten(-2).numpy()
+
+
+def parity_error(model: Refiner, path: Path, frames: np.ndarray, batches=(1, 7)) -> float:
+    """Largest |torch - onnxruntime| / max(1, |torch|) over all outputs, streaming `frames` (N, T + 1, D)
+    (normalised, frame 0 = the frame before) step by step from a zero state: torch's full-sequence forward
+    (nn.LSTM, FK in torch) against the ONNX step fed the same ends."""
+    session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
+    worst = 0.0
+    for batch in batches:
+        x = frames[:batch]
+        q = stream_inputs(model, x)
+        with torch.no_grad():
+            ref, _ = model(torch.from_numpy(x[:, 1:]), torch.from_numpy(x[:, 0]))
+        ref = ref.numpy()
+        h = np.zeros((1, batch, model.hidden), np.float32)
+        c = h.copy()
+        for t in range(1, x.shape[1]):
+            out, h, c = session.run(OUTPUTS, {"x": x[:, t], "ends": q[:, t], "ends_prev": q[:, t - 1], "h": h, "c": c})
+            worst = max(worst, float((np.abs(out - ref[:, t - 1]) / np.maximum(1.0, np.abs(ref[:, t - 1]))).max()))
+    return worst
+
+
+def step_parity(model: Refiner, path: Path, frames: np.ndarray) -> float:
+    """The same against torch's RefinerStep (the step form) with states fed forward from torch."""
+    session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
+    step = RefinerStep(model).eval()
+    x = frames[:5]
+    q = stream_inputs(model, x)
+    h = np.zeros((1, len(x), model.hidden), np.float32)
+    c = h.copy()
+    worst = 0.0
+    for t in range(1, x.shape[1]):
+        feed = {"x": x[:, t], "ends": q[:, t], "ends_prev": q[:, t - 1], "h": h, "c": c}
+        with torch.no_grad():
+            ref = [a.numpy() for a in step(*(torch.from_numpy(feed[k]) for k in INPUTS))]
+        got = session.run(OUTPUTS, feed)
+        worst = max(worst, max(float(np.abs(a - b).max()) for a, b in zip(ref, got)))
+        h, c = ref[1], ref[2]
+    return worst
+
+
+def time_steps(path: Path, batch: int, inputs_fn, repeats: int = 3000) -> float:
+    """Median over 5 runs of the mean ms per session.run at one thread."""
+    options = ort.SessionOptions()
+    options.intra_op_num_threads = 1
+    session = ort.InferenceSession(str(path), options, providers=["CPUExecutionProvider"])
+    feed = inputs_fn(batch)
+    for _ in range(200):
+        session.run(None, feed)
+    runs = []
+    for _ in range(5):
+        t0 = time.perf_counter()
+        for _ in range(repeats // 5):
+            session.run(None, feed)
+        runs.append((time.perf_counter() - t0) / (repeats // 5) * 1e3)
+    return float(np.median(runs))
+
+
+def measure_cost(refiner_path: Path, generator_path: Path, model: Refiner, gen_hidden: int) -> dict:
+    rng = np.random.default_rng(0)
+    D, E3, H = model.dim, 3 * model.ends, model.hidden
+    r_in = lambda b: {"x": rng.normal(size=(b, D)).astype(np.float32), "ends": rng.normal(size=(b, E3)).astype(np.float32),
+                      "ends_prev": rng.normal(size=(b, E3)).astype(np.float32),
+                      "h": np.zeros((1, b, H), np.float32), "c": np.zeros((1, b, H), np.float32)}
+    g_in = lambda b: {"x": rng.normal(size=(b, D)).astype(np.float32), "h": np.zeros((2, b, gen_hidden), np.float32),
+                      "c": np.zeros((2, b, gen_hidden), np.float32)}
+    out = {"measure": "onnxruntime Python, 1 thread, mean ms per session.run (median of 5 runs, interleaved)"}
+    for b in (1, 64):
+        r, g = [], []
+        for _ in range(2):  # interleaved, so both see the same machine load
+            r.append(time_steps(refiner_path, b, r_in))
+            g.append(time_steps(generator_path, b, g_in))
+        out[f"batch{b}"] = {"refiner_ms": min(r), "generator_ms": min(g), "ratio": min(r) / min(g)}
+    return out
+
+
+def write_fixture(model: Refiner, path: Path, frames: np.ndarray, info: dict) -> None:
+    """Two streams of 4 steps: inputs (x, ends, ends_prev, h, c) and outputs per step, plus the physical frames
+    the ends come from (for testing the browser's end-effector computation)."""
+    session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
+    x = frames[:2, :5]
+    q = stream_inputs(model, x)
+    mean, std = model.mean.numpy(), model.std.numpy()
+    h = np.zeros((1, 2, model.hidden), np.float32)
+    c = h.copy()
+    steps = []
+    for t in range(1, x.shape[1]):
+        feed = {"x": x[:, t], "ends": q[:, t], "ends_prev": q[:, t - 1], "h": h, "c": c}
+        out, h2, c2 = session.run(OUTPUTS, feed)
+        steps.append({"inputs": {k: np.asarray(v).ravel().tolist() for k, v in feed.items()},
+                      "outputs": {"x_refined": out.ravel().tolist(), "h_out": h2.ravel().tolist(), "c_out": c2.ravel().tolist()}})
+        h, c = h2, c2
+    FIXTURE.write_text(json.dumps({
+        "model": info["file"], "batch": 2, "hidden": model.hidden, "dim": model.dim, "end_effectors": info["end_effectors"]["names"],
+        "frames_normalised": x.ravel().tolist(), "frames_physical": (x * std + mean).ravel().tolist(), "frames": x.shape[1],
+        "ends": q.ravel().tolist(), "steps": steps,
+        "note": "frames_* are (batch 2, 5 frames, dim); ends (2, 5, 3E) are their root-frame end-effector positions; "
+                "step k feeds frame k + 1 with ends_prev from frame k, states from step k - 1 (zeros first)."}) + "\n")
+    print(f"wrote {FIXTURE}")
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--checkpoint", type=Path, default=RUNS_DIR / "refiner" / "best.pt")
+    parser.add_argument("--out", type=Path, default=MODELS_DIR)
+    args = parser.parse_args(argv)
+    if not args.checkpoint.exists():
+        raise SystemExit(f"error: no checkpoint at {args.checkpoint}; train first with python -m training.train_refiner")
+    model, meta, state = load_refiner(args.checkpoint)
+    gen_info = json.loads((MODELS_DIR / "generator.json").read_text())
+    if np.abs(np.array(gen_info["normalisation"]["mean"]) - np.array(meta["mean"])).max() > 1e-4:
+        raise SystemExit("error: the refiner was trained with a different normalisation than the shipped generator's")
+    args.out.mkdir(parents=True, exist_ok=True)
+    onnx_path = args.out / "refiner.onnx"
+    export_onnx(model, onnx_path)
+
+    # Parity on generator-like frames: the validation streams cached by train_refiner when present, else noise.
+    cached = sorted((REPO_ROOT / "cache").glob("refiner_generated_*_s101.npz"))
+    frames = np.load(cached[0])["x"][:8, :21] if cached else \
+        np.random.default_rng(0).normal(scale=0.5, size=(8, 21, model.dim)).astype(np.float32)
+    worst = parity_error(model, onnx_path, frames)
+    worst_step = step_parity(model, onnx_path, frames)
+    if max(worst, worst_step) > PARITY_TOLERANCE:
+        raise SystemExit(f"error: ONNX parity failed: {worst:.2e} (sequence), {worst_step:.2e} (step) > {PARITY_TOLERANCE:.0e}")
+    print(f"parity ok: streaming vs torch sequence {worst:.2e}, vs torch step {worst_step:.2e}")
+    cost = measure_cost(onnx_path, MODELS_DIR / "generator.onnx", model, gen_info["onnx"]["hidden"])
+    print(f"cost: {json.dumps(cost)}")
+
+    g = model.geometry
+    s = state.get("state", {})
+    info = {
+        "id": "refiner", "kind": "refiner", "fps": meta["fps"], "file": "refiner.onnx", "bytes": onnx_path.stat().st_size,
+        "pairs_with": "generator",
+        "description": "Adversarial refiner (Wang, Chai, Xia §4.2): FC + LSTM + FC with a residual connection over the "
+                       "generator's frames and their end-effector positions and velocities; causal, one step per frame.",
+        "onnx": {"inputs": INPUTS, "outputs": OUTPUTS, "opset": OPSET, "hidden": model.hidden, "dim": model.dim,
+                 "ends": 3 * model.ends, "state_shape": [1, "batch", model.hidden],
+                 "graph": "FC1 over [x, ends, ends_prev, cos(dry) ends, sin(dry) ends] (velocities and normalisation folded "
+                          "in), gate-level LSTM, FC2 + x"},
+        "end_effectors": {
+            "names": g.end_names, "joints": g.end_index,
+            "frame": "root frame: q = R_y(-yaw) (p - (root_x, 0, root_z)) per end effector, p the world position of the "
+                     "decoded raw generator frame, yaw its heading (after its dry); q[1] = height above the floor. "
+                     "Equivalently: FK with the root at (0, ty, 0) and the root rotation = reference[0] * exp(tilt) "
+                     "(no heading).",
+            "ends": "ends = concat of q over `names` (x, y, z each), metres, of the raw frame x_t; "
+                    "ends_prev = the same of the raw frame x_(t-1) (for the first frame after a seed: the seed frame).",
+            "velocity_in_graph": "v = fps * ((dtx, 0, dtz) + R_y(dry) q_t - q_(t-1)), R_y(a) q = (cos a qx + sin a qz, qy, "
+                                 "-sin a qx + cos a qz), with dtx, dtz, dry of x_t",
+        },
+        "usage": "per frame, after the generator sampled x_t (normalised, contacts snapped to 0/1 as fed back): "
+                 "ends = rootFrameEnds(decode(x_t)); x_ref = refiner(x_t, ends, ends_prev, h, c); ends_prev = ends; "
+                 "feed x_t (not x_ref) back to the generator; decode x_ref for display (contact on when its physical "
+                 "value > 0.5), then the foot lock (training/footlock.py) on the decoded positions.",
+        "normalisation": {"mean": [round(float(v), 7) for v in meta["mean"]], "std": [round(float(v), 7) for v in meta["std"]],
+                          "note": "the generator's (generator.json)"},
+        "contact_threshold": 0.5,
+        "footlock": {"toe_ground_height": TOE_GROUND_HEIGHT, "blend_in_frames": BLEND_IN, "blend_out_frames": BLEND_OUT,
+                     "reach": REACH, "implementation": "training/footlock.py (positions, two-bone IK, causal)"},
+        "training": {"r_updates": s.get("r_updates"), "d_updates": s.get("d_updates"), "minutes": s.get("elapsed", 0) / 60,
+                     "valid": state.get("valid"), "temperature": meta["temperature"], "args": meta["args"],
+                     "checkpoint": str(args.checkpoint.relative_to(REPO_ROOT)) if args.checkpoint.is_relative_to(REPO_ROOT) else str(args.checkpoint)},
+        "parity": {"max_abs_diff": worst, "step_max_abs_diff": worst_step, "measure": "|a - b| / max(1, |a|)",
+                   "tolerance": PARITY_TOLERANCE, "batches": [1, 7], "steps": frames.shape[1] - 1,
+                   "reference": "torch full-sequence forward (nn.LSTM, torch FK) and torch RefinerStep"},
+        "cost": cost,
+    }
+    (args.out / "refiner.json").write_text(json.dumps(info) + "\n")
+    if args.out == MODELS_DIR:
+        write_fixture(model, onnx_path, frames, info)
+        register_model({"id": "refiner", "kind": "refiner", "skeleton": "cmu-canonical", "fps": info["fps"],
+                        "bytes": info["bytes"], "file": info["file"]})
+    print(f"wrote {onnx_path} ({onnx_path.stat().st_size / 1e6:.2f} MB) and refiner.json")
+
+
+if __name__ == "__main__":
+    main()
