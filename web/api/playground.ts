@@ -48,7 +48,10 @@ export interface GenerateOptions {
   style?: string;
   /** Generator only. Sampling temperature 0…2 (default 0.5): 0 = each step's most likely mixture mean, 1 = the trained distribution. */
   temperature?: number;
-  /** Generator only. Clean-up by the refiner model: not available yet (only `false` is accepted). */
+  /**
+   * Generator only (default false). true: the same sampled frames run through the refiner model (loaded on
+   * first use) and the foot-contact clean-up; the result is the refined, foot-locked motion with the refined contacts.
+   */
   refine?: boolean;
 }
 
@@ -205,7 +208,7 @@ export function createPlayground(app: App): Playground {
     }
   }
 
-  type GeneratorCall = { kind: 'lstm-gmm'; model: string; frames: number; seed: number; temperature: number };
+  type GeneratorCall = { kind: 'lstm-gmm'; model: string; frames: number; seed: number; temperature: number; refine: boolean };
   type DanceCall = { kind: 'aclstm'; model: string; frames: number; seed: number; style: string };
 
   /** Checks generate's options against the model they name; the error says what is wrong. */
@@ -247,9 +250,10 @@ export function createPlayground(app: App): Playground {
     if (typeof temperature !== 'number' || !Number.isFinite(temperature) || temperature < 0 || temperature > 2) {
       throw new RangeError(`temperature must be a number from 0 to 2, got ${String(o.temperature)}`);
     }
-    if (o.refine === true) throw new Error('refine: the refiner is not available yet (pass refine: false or leave it out)');
-    if (o.refine !== undefined && o.refine !== false) throw new TypeError(`refine must be true or false, got ${String(o.refine)}`);
-    return { kind: 'lstm-gmm', model: entry.id, frames: o.frames, seed: o.seed, temperature };
+    if (o.refine !== undefined && typeof o.refine !== 'boolean') throw new TypeError(`refine must be true or false, got ${String(o.refine)}`);
+    const refine = o.refine === true;
+    if (refine && !models.some((m) => m.kind === 'refiner')) throw new Error('refine is not available: no refiner model is listed in models/index.json');
+    return { kind: 'lstm-gmm', model: entry.id, frames: o.frames, seed: o.seed, temperature, refine };
   }
 
   /** Throws unless `options` is a plain object whose keys are all in `known`. */
@@ -355,14 +359,16 @@ export function createPlayground(app: App): Playground {
         const o = checkGenerate(options);
         if (o.kind === 'aclstm') return generateDance(o);
         const { client } = await app.generator.load();
-        const m = await client.generate({ frames: o.frames, seed: o.seed, temperature: o.temperature });
+        const m = await client.generate({ frames: o.frames, seed: o.seed, temperature: o.temperature, ...(o.refine ? { refine: true } : {}) });
+        const shown = o.refine ? m.refined : m;
+        if (!shown) throw new Error('the generator worker returned no refined frames');
         const motion: Motion = {
           fps: m.fps,
           frames: m.frames,
           joints: [...m.joints],
           parents: [...m.parents],
-          positions: m.positions,
-          contacts: m.contacts,
+          positions: shown.positions,
+          contacts: shown.contacts,
         };
         return motion;
       });

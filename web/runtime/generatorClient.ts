@@ -12,6 +12,9 @@ import type {
   GenerateParams,
   InitResult,
   ParityResult,
+  RefinedFrames,
+  RefinerParityResult,
+  RefinerStepInputs,
   SimulateControlParams,
   SimulatedControlChunk,
   StepInputs,
@@ -20,7 +23,22 @@ import type {
 } from './protocol';
 import { ModelClient } from './workerClient';
 
-export type { BenchmarkResult, ControlStartParams, ControlTargetParams, FollowPathParams, GenerateParams, InitResult, ParityResult, SimulateControlParams, StepInputs, StreamInfo, StreamParams };
+export type {
+  BenchmarkResult,
+  ControlStartParams,
+  ControlTargetParams,
+  FollowPathParams,
+  GenerateParams,
+  InitResult,
+  ParityResult,
+  RefinedFrames,
+  RefinerParityResult,
+  RefinerStepInputs,
+  SimulateControlParams,
+  StepInputs,
+  StreamInfo,
+  StreamParams,
+};
 
 /** A followed path: the motion, the path as followed (x, z pairs) and how well it was followed. */
 export type FollowedPath = GeneratedMotion & Pick<FollowPathChunk, 'stats' | 'path'>;
@@ -38,6 +56,8 @@ export type GeneratedMotion = Motion & {
   seedIndex: number;
   /** Index of the first frame within its stream (0 for `generate`). */
   startFrame: number;
+  /** With `refine`: the same frames refined and foot-locked (the Motion fields above stay the raw frames). */
+  refined?: RefinedFrames;
 };
 
 export interface GeneratorClientOptions {
@@ -65,6 +85,14 @@ export class GeneratorClient extends ModelClient<StreamParams, InitResult, Gener
    */
   parity(inputs?: StepInputs): Promise<ParityResult> {
     return this.parityRequest(inputs);
+  }
+
+  /**
+   * One raw refiner step (the refiner is loaded in the worker on first use) and, with `frames` (physical
+   * generator frames, frames × D), their root-frame end effectors: the inputs of tests/fixtures/refiner_reference.json.
+   */
+  refinerParity(inputs: RefinerStepInputs, frames?: ArrayLike<number>): Promise<RefinerParityResult> {
+    return this.request<RefinerParityResult>('refinerParity', { inputs, ...(frames ? { frames: Array.from(frames) } : {}) });
   }
 
   /** Follows a ground path (optimised in the worker); `onProgress` hears the share of the path done. */
@@ -99,6 +127,7 @@ export class GeneratorClient extends ModelClient<StreamParams, InitResult, Gener
       rootHeading: chunk.rootHeading,
       seedIndex: chunk.seedIndex,
       startFrame: chunk.startFrame,
+      ...(chunk.refined ? { refined: chunk.refined } : {}),
     };
   }
 }

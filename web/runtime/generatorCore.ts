@@ -5,6 +5,7 @@ import type { InferenceSession, TensorConstructor } from 'onnxruntime-web';
 import { decodeFeatures, type RootStart } from './featureDecode';
 import type { GeneratorInfo } from './generatorModel';
 import type { BenchmarkResult, GeneratedChunk, GenerateParams, InitResult, ParityResult, StepInputs, StepOutputs, StreamInfo, StreamParams } from './protocol';
+import type { RefinerCore, RefinerStream } from './refinerCore';
 import { denormalise, Rng, sampleMixture, snapContacts } from './sampler';
 import { checkFrameCount, SessionCore, timeSteps } from './session';
 
@@ -18,6 +19,13 @@ export interface GeneratorStream {
   rng: Rng;
   root: RootStart;
   frame: number;
+  /** With params.refine: the refiner's state behind this stream (made on the first advance). */
+  refiner?: RefinerStream;
+}
+
+export interface GeneratorCoreOptions {
+  /** Loads the refiner for `refine` streams (the worker fetches models/refiner.*); called once, again after a failure. */
+  loadRefiner?: (generator: GeneratorCore) => Promise<RefinerCore>;
 }
 
 export class GeneratorCore extends SessionCore<GeneratorInfo> {
@@ -25,11 +33,34 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
   private readonly H: number;
   private readonly M: number;
   private readonly D: number;
+  private readonly loadRefiner: GeneratorCoreOptions['loadRefiner'];
+  private refinerLoading: Promise<RefinerCore> | undefined;
 
   /** `Tensor` must come from the same onnxruntime module as the session. */
-  constructor(session: InferenceSession, info: GeneratorInfo, Tensor: TensorConstructor, threads = 1) {
+  constructor(session: InferenceSession, info: GeneratorInfo, Tensor: TensorConstructor, threads = 1, options: GeneratorCoreOptions = {}) {
     super(session, info, Tensor, threads);
     ({ layers: this.L, hidden: this.H, mixtures: this.M, dim: this.D } = info.onnx);
+    this.loadRefiner = options.loadRefiner;
+  }
+
+  /** The refiner, loaded the first time a stream asks for it (a failed load is tried again next time). */
+  refiner(): Promise<RefinerCore> {
+    if (!this.loadRefiner) return Promise.reject(new Error('the refiner is not available here (no refiner loader)'));
+    if (!this.refinerLoading) {
+      const loading = this.loadRefiner(this);
+      loading.catch(() => {
+        if (this.refinerLoading === loading) this.refinerLoading = undefined;
+      });
+      this.refinerLoading = loading;
+    }
+    return this.refinerLoading;
+  }
+
+  override async release(): Promise<void> {
+    const refiner = this.refinerLoading;
+    this.refinerLoading = undefined;
+    await refiner?.then((r) => r.release(), () => undefined);
+    await super.release();
   }
 
   /** Runs one step on the first seed state: a model whose sizes disagree with the JSON fails here, not mid-stream. */
@@ -72,6 +103,7 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
     if (typeof params.temperature !== 'number' || !Number.isFinite(params.temperature) || params.temperature < 0) {
       throw new Error(`temperature must be a finite number ≥ 0, got ${params.temperature}`);
     }
+    if (params.refine !== undefined && typeof params.refine !== 'boolean') throw new Error(`refine must be true or false, got ${String(params.refine)}`);
     const count = this.info.seeds.length;
     const seedIndex = params.seedIndex ?? (params.seed >>> 0) % count;
     if (!Number.isInteger(seedIndex) || seedIndex < 0 || seedIndex >= count) {
@@ -94,16 +126,28 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
     return { seedIndex: stream.seedIndex, seedName: this.info.seeds[stream.seedIndex].name };
   }
 
-  /** Advances a stream by `frames` steps and decodes them, continuing its root trajectory. */
+  /**
+   * Advances a stream by `frames` steps and decodes them, continuing its root trajectory; a `refine` stream
+   * also runs the same frames through the refiner and the foot lock (`refined`).
+   */
   async advance(stream: GeneratorStream, frames: number): Promise<GeneratedChunk> {
     checkFrameCount(frames);
     const { M, D } = this;
+    let refiner: RefinerCore | undefined;
+    if (stream.params.refine) {
+      refiner = await this.refiner();
+      // Made before the first frame: its previous frame is the seed frame (the generator's first input).
+      stream.refiner ??= refiner.createStream(denormalise(stream.x, this.mean, this.std));
+    }
     const features = new Float32Array(frames * D);
+    // What the refiner reads: the frames exactly as fed back to the generator (normalised, contacts snapped).
+    const fedBack = refiner ? new Float32Array(frames * D) : undefined;
     for (let t = 0; t < frames; t++) {
       const out = await this.step(1, stream.x, stream.h, stream.c);
       const x = sampleMixture({ weights: out.weights, mu: out.mu, sigma: out.sigma, batch: 1, mixtures: M, dim: D }, stream.params.temperature, stream.rng);
       snapContacts(x, D, this.mean, this.std);
       denormalise(x, this.mean, this.std, features.subarray(t * D, (t + 1) * D));
+      fedBack?.set(x, t * D);
       stream.x = x;
       stream.h = out.h_out;
       stream.c = out.c_out;
@@ -118,6 +162,7 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
       seedIndex: stream.seedIndex,
       startFrame: stream.frame,
     };
+    if (refiner && fedBack) chunk.refined = await refiner.refine(stream.refiner!, fedBack, features);
     stream.root = decoded.end;
     stream.frame += frames;
     return chunk;

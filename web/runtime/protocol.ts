@@ -10,6 +10,8 @@ export interface GenerateParams {
   temperature: number;
   /** Which seed state of generator.json to start from; default seed mod the number of seed states. */
   seedIndex?: number;
+  /** Also run the refiner (loaded on first use) behind the generator: chunks then carry `refined` too. */
+  refine?: boolean;
 }
 
 export type StreamParams = Omit<GenerateParams, 'frames'>;
@@ -68,6 +70,42 @@ export interface GeneratedChunk {
   seedIndex: number;
   /** Index of this chunk's first frame in its stream (0 for `generate`). */
   startFrame: number;
+  /** With `refine`: the same frames through the refiner and the foot lock. */
+  refined?: RefinedFrames;
+}
+
+/** The refiner's version of a chunk's frames (refinerCore.ts). */
+export interface RefinedFrames {
+  /** frames × D refined features, physical units (contacts as the refiner outputs them, not snapped). */
+  features: Float32Array;
+  /** frames × joints × 3, world metres: the refined frames decoded (from their own root channels), then foot-locked. */
+  positions: Float32Array;
+  /** frames × 2, 1 = planted: refined contact above refiner.json contact_threshold. */
+  contacts: Uint8Array;
+  rootHeading: Float32Array;
+}
+
+/** The refiner's ONNX step inputs, flattened: x (B×D), ends and ends_prev (B×3E), h and c (1×B×H). */
+export interface RefinerStepInputs {
+  batch: number;
+  x: ArrayLike<number>;
+  ends: ArrayLike<number>;
+  ends_prev: ArrayLike<number>;
+  h: ArrayLike<number>;
+  c: ArrayLike<number>;
+}
+
+export interface RefinerStepOutputs {
+  x_refined: Float32Array;
+  h_out: Float32Array;
+  c_out: Float32Array;
+}
+
+/** Generator worker only (`refinerParity`): one raw refiner step and, for given physical frames, their end effectors. */
+export interface RefinerParityResult {
+  outputs: RefinerStepOutputs;
+  /** frames × 3E root-frame end-effector positions of `frames`, when given. */
+  ends?: Float32Array;
 }
 
 export interface StreamInfo {
