@@ -1,21 +1,50 @@
 // Random walk mode: the generator runs endlessly in its worker (LiveMode), the viewer shows the last
-// ~20 s with the predicted foot contacts.
+// ~20 s with the predicted foot contacts. With **refine** the refiner runs behind it (same worker) and the
+// figure shows the refined, foot-locked frames; **side by side** also draws the raw frames of the same
+// samples (grey, to the left). A readout shows the foot skating of what is drawn over the last seconds.
 
+import { skatingSample } from '../motion/footSkating';
+import type { Motion } from '../motion/types';
 import type { GeneratedMotion, GeneratorClient } from '../runtime/generatorClient';
+import { CompanionAligner } from '../viewer/sideBySide';
 import type { App } from './app';
 import { $, LiveMode, type LiveStream } from './liveMode';
 
 const DEFAULT_TEMPERATURE = 0.5;
+/** Seconds of motion up to the playhead the skating readout averages over. */
+export const SKATING_SECONDS = 5;
+const LABELS = { main: 'refined + foot lock', companion: 'raw' };
 
-export class RandomWalk extends LiveMode<GeneratedMotion> {
+/** A pulled chunk as the window shows it: with refine, positions and contacts are the refined ones and `raw` the generator's. */
+type WalkChunk = GeneratedMotion & { raw?: { positions: Float32Array; contacts: Uint8Array; rootHeading: Float32Array } };
+
+/** The raw frames' window behind a refined walk: as generated (for measuring) and as drawn beside it. */
+interface RawWindow {
+  frames: number;
+  positions: Float32Array;
+  drawn: Float32Array;
+  contacts: Uint8Array;
+}
+
+export class RandomWalk extends LiveMode<WalkChunk> {
   private seedName = '';
   private seedsListed = false;
   private client: GeneratorClient | undefined;
+  /** The running stream refines (fixed per stream, like the other settings). */
+  private refining = false;
+  private raw: RawWindow | null = null;
+  private aligner: CompanionAligner | null = null;
+  private walkSkeleton: { fps: number; joints: string[]; parents: number[] } | null = null;
 
   private readonly temperature = $<HTMLInputElement>('walk-temperature');
   private readonly temperatureOut = $('walk-temperature-out');
   private readonly seedState = $<HTMLSelectElement>('walk-seed-state');
   private readonly seed = $<HTMLInputElement>('walk-seed');
+  private readonly refine = $<HTMLInputElement>('walk-refine');
+  private readonly sideBySide = $<HTMLInputElement>('walk-side-by-side');
+  private readonly skating = $('walk-skating');
+  private readonly skatingRaw = $('walk-skating-raw');
+  private readonly skatingRefined = $('walk-skating-refined');
 
   constructor(app: App) {
     // 1 s chunks at 30 fps, at least 1.5 s ahead, 20 s kept.
@@ -27,40 +56,141 @@ export class RandomWalk extends LiveMode<GeneratedMotion> {
     this.seedState.addEventListener('change', () => this.restartIfActive());
     this.seed.addEventListener('change', () => this.restartIfActive());
     $('walk-restart').addEventListener('click', () => this.restartIfActive());
+    this.refine.addEventListener('change', () => {
+      if (!this.refine.checked) {
+        this.sideBySide.checked = false;
+        this.showCompanion();
+      }
+      this.restartIfActive();
+    });
+    this.sideBySide.addEventListener('change', () => {
+      // Side by side needs the refined stream; a refined stream already carries the raw frames.
+      if (this.sideBySide.checked && !this.refine.checked) {
+        this.refine.checked = true;
+        this.restartIfActive();
+      } else {
+        this.showCompanion();
+        this.updateStatus(true);
+      }
+    });
   }
 
   private showTemperature(): void {
     this.temperatureOut.textContent = Number(this.temperature.value).toFixed(2);
   }
 
-  private params(): { seed: number; temperature: number; seedIndex?: number } {
+  private params(): { seed: number; temperature: number; seedIndex?: number; refine: boolean } {
     let seed = Math.floor(Number(this.seed.value));
     if (!Number.isFinite(seed) || seed < 0) seed = 0;
     seed = Math.min(seed, 0xffffffff);
     const temperature = Math.min(Math.max(Number(this.temperature.value) || 0, 0), 2);
     const idx = this.seedState.value === '' ? undefined : Number(this.seedState.value);
-    return { seed, temperature, ...(idx === undefined ? {} : { seedIndex: idx }) };
+    return { seed, temperature, ...(idx === undefined ? {} : { seedIndex: idx }), refine: this.refine.checked };
   }
 
-  protected async open(): Promise<LiveStream<GeneratedMotion>> {
+  protected async open(): Promise<LiveStream<WalkChunk>> {
     const { client, info } = await this.app.generator.load();
     this.client = client;
     if (!this.seedsListed) {
       for (const [i, name] of info.seeds.entries()) this.seedState.add(new Option(name, String(i)));
       this.seedsListed = true;
     }
-    const stream = await client.startStream(this.params());
+    const params = this.params();
+    const stream = await client.startStream(params);
     this.seedName = stream.seedName;
-    return { skeleton: info, pull: (frames) => client.pull(frames) };
+    this.refining = params.refine;
+    this.walkSkeleton = info;
+    this.raw = null;
+    this.aligner = params.refine ? new CompanionAligner(info.joints.length, info.fps) : null;
+    this.app.setLiveLabel('Random walk', params.refine ? 'generator + refiner · 30 fps · live' : 'generator · 30 fps · live');
+    const pull = async (frames: number): Promise<WalkChunk> => {
+      const m = await client.pull(frames);
+      if (!params.refine) return m;
+      if (!m.refined) throw new Error('the generator worker sent no refined frames');
+      return { ...m, positions: m.refined.positions, contacts: m.refined.contacts, raw: { positions: m.positions, contacts: m.contacts, rootHeading: m.rootHeading } };
+    };
+    return { skeleton: info, pull };
   }
 
   protected forget(): void {
     this.app.generator.reset(this.client);
   }
 
-  protected received(): void {}
+  /** Keeps the raw window in step with the shown (refined) one and draws it beside it when asked. */
+  protected received(chunk: WalkChunk, first: boolean): void {
+    if (!this.refining || !chunk.raw || !chunk.refined || !this.aligner || !this.walkSkeleton) return;
+    const shown = this.app.viewer.current;
+    if (!shown) return;
+    if (first) {
+      this.raw = null;
+      this.aligner.reset();
+    }
+    const stride = this.walkSkeleton.joints.length * 3;
+    const before = this.raw?.frames ?? 0;
+    // The window dropped as many frames from its start as it now lacks to hold the old frames plus the chunk.
+    const drop = Math.max(0, Math.min(before, before + chunk.frames - shown.frames));
+    const kept = before - drop;
+    const drawn = this.aligner.align(chunk.raw.positions, chunk.raw.rootHeading, chunk.refined.positions, chunk.refined.rootHeading);
+    const grow = (old: Float32Array | Uint8Array | undefined, add: Float32Array | Uint8Array, width: number) => {
+      const out = add instanceof Float32Array ? new Float32Array((kept + chunk.frames) * width) : new Uint8Array((kept + chunk.frames) * width);
+      if (old) out.set(old.subarray(drop * width, before * width));
+      out.set(add, kept * width);
+      return out;
+    };
+    this.raw = {
+      frames: kept + chunk.frames,
+      positions: grow(this.raw?.positions, chunk.raw.positions, stride) as Float32Array,
+      drawn: grow(this.raw?.drawn, drawn, stride) as Float32Array,
+      contacts: grow(this.raw?.contacts, chunk.raw.contacts, 2) as Uint8Array,
+    };
+    this.showCompanion();
+  }
+
+  /** Draws the raw window beside the refined figure while side by side is on. */
+  private showCompanion(): void {
+    const shown = this.app.viewer.current;
+    const raw = this.raw;
+    if (!this.running || !this.sideBySide.checked || !raw || !shown || !this.walkSkeleton || raw.frames !== shown.frames) {
+      this.app.viewer.setCompanion(null);
+      return;
+    }
+    this.app.viewer.setCompanion({ motion: this.motionOf(raw.drawn, raw.frames), labels: LABELS });
+  }
+
+  private motionOf(positions: Float32Array, frames: number, contacts?: Uint8Array): Motion {
+    const sk = this.walkSkeleton!;
+    return { fps: sk.fps, frames, joints: sk.joints, parents: sk.parents, positions, ...(contacts ? { contacts } : {}) };
+  }
+
+  /** Mean planted-toe speed (m/s) over the last SKATING_SECONDS up to the playhead, or NaN without planted pairs. */
+  private skatingOf(motion: Motion | null, playhead: number): number {
+    if (!motion?.contacts) return NaN;
+    const to = Math.min(playhead + 1, motion.frames);
+    const { sum, count } = skatingSample(motion as Motion & { contacts: Uint8Array }, to - Math.round(SKATING_SECONDS * motion.fps), to);
+    return count ? sum / count : NaN;
+  }
+
+  /** The skating readout: what is drawn (raw, refined, or both side by side). */
+  private showSkating(): void {
+    const playhead = this.app.viewer.playback.frame;
+    const shown = this.app.viewer.current;
+    const both = this.refining && this.sideBySide.checked && this.raw !== null && this.raw.frames === shown?.frames;
+    const main = this.skatingOf(shown, playhead);
+    const raw = !this.refining ? main : both ? this.skatingOf(this.motionOf(this.raw!.positions, this.raw!.frames, this.raw!.contacts), playhead) : NaN;
+    const refined = this.refining ? main : NaN;
+    const text = (v: number) => (Number.isFinite(v) ? v.toFixed(2) : '—');
+    this.skatingRaw.textContent = text(raw);
+    this.skatingRefined.textContent = text(refined);
+    (this.skatingRaw.closest('.skate-line') as HTMLElement).hidden = this.refining && !both;
+    (this.skatingRefined.closest('.skate-line') as HTMLElement).hidden = !this.refining;
+    this.skating.dataset.raw = Number.isFinite(raw) ? raw.toFixed(4) : '';
+    this.skating.dataset.refined = Number.isFinite(refined) ? refined.toFixed(4) : '';
+    this.skating.dataset.shown = both ? 'both' : this.refining ? 'refined' : 'raw';
+  }
 
   protected describe(frame: number, fps: number): string {
-    return `frame ${frame} · ${(frame / fps).toFixed(1)} s · ${this.seedName} · τ ${this.params().temperature.toFixed(2)}`;
+    this.showSkating();
+    const refined = this.refining ? ` · refined${this.sideBySide.checked ? ', side by side' : ''}` : '';
+    return `frame ${frame} · ${(frame / fps).toFixed(1)} s · ${this.seedName} · τ ${this.params().temperature.toFixed(2)}${refined}`;
   }
 }

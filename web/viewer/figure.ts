@@ -9,7 +9,14 @@ import { PALETTE } from './palette';
 import type { Motion } from '../motion/types';
 import { findHead, sideOf } from './naming';
 
-export const COLORS = { left: PALETTE.left, right: PALETTE.right, center: PALETTE.center, head: PALETTE.head };
+export interface FigureColors {
+  left: THREE.Color;
+  right: THREE.Color;
+  center: THREE.Color;
+  head: THREE.Color;
+}
+
+export const COLORS: FigureColors = { left: PALETTE.left, right: PALETTE.right, center: PALETTE.center, head: PALETTE.head };
 
 // Everything is done in view space: the vertex shader hands over the capsule's end points already
 // transformed, so the fragment shader has no matrix work beyond the depth.
@@ -123,7 +130,7 @@ export class Figure {
   /** The two joints whose midpoint is the head's centre, or null. */
   private readonly headSeg: [number, number] | null = null;
 
-  constructor(motion: Motion) {
+  constructor(motion: Motion, colors: FigureColors = COLORS) {
     const J = motion.joints.length;
     this.joints = J;
     this.parents = motion.parents.slice();
@@ -145,9 +152,9 @@ export class Figure {
     const radius = new Float32Array(n);
     const color = new Float32Array(n * 3);
     const colorOf = (j: number) => {
-      if (j === this.head) return COLORS.head;
+      if (j === this.head) return colors.head;
       const side = sideOf(motion.joints[j]);
-      return side === 'left' ? COLORS.left : side === 'right' ? COLORS.right : COLORS.center;
+      return side === 'left' ? colors.left : side === 'right' ? colors.right : colors.center;
     };
     this.bones.forEach((c, i) => {
       const a = this.parents[c];

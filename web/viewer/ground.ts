@@ -317,3 +317,41 @@ export class GroundMarks {
     this.geometry.setIndex(index);
   }
 }
+
+/**
+ * A soft blob shadow on its own (a second figure's; the main figure's is part of GroundMarks): the same
+ * disc as GroundMarks', placed by the mesh's transform. One small extra draw call while it is shown.
+ */
+export class BlobShadow {
+  readonly mesh: THREE.Mesh;
+
+  constructor() {
+    const verts = 1 + SHADOW_RINGS * SHADOW_SEGMENTS;
+    const pos = new Float32Array(verts * 3);
+    const col = new Float32Array(verts * 4);
+    col[3] = 0.5;
+    for (let k = 1, v = 1; k <= SHADOW_RINGS; k++) {
+      const t = k / SHADOW_RINGS;
+      for (let i = 0; i < SHADOW_SEGMENTS; i++, v++) {
+        const a = (i / SHADOW_SEGMENTS) * Math.PI * 2;
+        pos[v * 3] = Math.cos(a) * 0.5 * t;
+        pos[v * 3 + 2] = Math.sin(a) * 0.5 * t;
+        col[v * 4 + 3] = 0.5 * (1 - t) * (1 - t);
+      }
+    }
+    const geometry = new THREE.BufferGeometry();
+    geometry.setAttribute('position', new THREE.BufferAttribute(pos, 3));
+    geometry.setAttribute('color', new THREE.BufferAttribute(col, 4));
+    geometry.setIndex(discIndex(SHADOW_RINGS, SHADOW_SEGMENTS));
+    this.mesh = new THREE.Mesh(geometry, new THREE.MeshBasicMaterial({ vertexColors: true, transparent: true, depthWrite: false, side: THREE.DoubleSide }));
+    this.mesh.renderOrder = 1;
+    this.mesh.frustumCulled = false;
+    this.mesh.visible = false;
+  }
+
+  /** Centre on the ground and diameter in metres. */
+  set(x: number, z: number, size: number): void {
+    this.mesh.position.set(x, 0.004, z);
+    this.mesh.scale.set(size, 1, size);
+  }
+}

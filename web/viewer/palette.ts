@@ -16,3 +16,11 @@ export const PALETTE = {
   head: new THREE.Color('#eef1f7'),
   trail: new THREE.Color('#8f7dff'),
 };
+
+/** A second figure drawn beside the main one (the raw frames in Random walk's side-by-side view): the same sides, greyed. */
+export const COMPANION_PALETTE = {
+  left: new THREE.Color('#6f83aa'),
+  right: new THREE.Color('#b0896d'),
+  center: new THREE.Color('#8c93a3'),
+  head: new THREE.Color('#a3a9b6'),
+};

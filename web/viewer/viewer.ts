@@ -6,7 +6,8 @@ import './palette'; // first: sets up colour handling
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import type { Motion } from '../motion/types';
 import { Figure } from './figure';
-import { BACKGROUND, Floor, FloorGlow, GroundMarks } from './ground';
+import { BACKGROUND, BlobShadow, Floor, FloorGlow, GroundMarks } from './ground';
+import { COMPANION_PALETTE } from './palette';
 import { Playback, type PlaybackState } from './playback';
 import { chooseQuality, DynamicResolution, fixedResolution, probeGL, type GLInfo, type Quality } from './quality';
 
@@ -27,6 +28,17 @@ export interface RenderStats {
   software: boolean;
 }
 
+/** How far (m) a companion figure is drawn beside the main one, towards the left of the screen. */
+export const COMPANION_OFFSET = 1.2;
+
+/** A second figure playing the same frames as the main motion beside it (Random walk's side-by-side view). */
+export interface Companion {
+  /** Same frame count and joints as the shown motion. */
+  motion: Motion;
+  /** Labels drawn above the two figures' heads. */
+  labels: { main: string; companion: string };
+}
+
 export class Viewer {
   readonly renderer: THREE.WebGLRenderer;
   readonly scene = new THREE.Scene();
@@ -43,6 +55,8 @@ export class Viewer {
   private readonly marks = new GroundMarks();
   private figure: Figure | null = null;
   private motion: Motion | null = null;
+  private companion: { motion: Motion; figure: Figure; pose: Float32Array; dx: number; dz: number; labels: HTMLElement[] } | null = null;
+  private readonly companionShadow = new BlobShadow();
   private pose = new Float32Array(0);
   private root = 0;
   private targetY = 0.9;
@@ -80,7 +94,7 @@ export class Viewer {
     // No lights: the figure shades itself (figure.ts) and the ground layers are unlit.
     // The floor glow is a large filled area: only worth its pixels with a GPU.
     if (high) this.scene.add(this.glow.mesh);
-    this.scene.add(this.floor.group, this.marks.mesh);
+    this.scene.add(this.floor.group, this.marks.mesh, this.companionShadow.mesh);
 
     this.camera.position.set(3.2, 1.9, 4.6);
     this.controls = new OrbitControls(this.camera, this.renderer.domElement);
@@ -105,6 +119,7 @@ export class Viewer {
   /** Shows a motion (already validated) from its first frame, playing. */
   setMotion(motion: Motion, contacts: Uint8Array | undefined): void {
     const J = motion.joints.length;
+    this.setCompanion(null);
     const figure = new Figure(motion);
     if (this.figure) {
       this.scene.remove(this.figure.mesh);
@@ -160,8 +175,55 @@ export class Viewer {
     this.applyPose();
   }
 
+  /**
+   * Draws `companion` beside the shown motion, in step with it (null removes it). It keeps its side offset
+   * (COMPANION_OFFSET towards the screen's left, chosen from the camera when it first appears) until removed
+   * or a new motion is shown; with it the camera follows the midpoint of the two. Call again after every
+   * setLive with the companion's window of the same frames.
+   */
+  setCompanion(companion: Companion | null): void {
+    if (!companion) {
+      if (this.companion) {
+        this.scene.remove(this.companion.figure.mesh);
+        this.companion.figure.dispose();
+        this.companion.labels.forEach((l) => l.remove());
+        this.companion = null;
+        this.companionShadow.mesh.visible = false;
+        this.dirty = true;
+      }
+      return;
+    }
+    const m = this.motion;
+    if (!m || companion.motion.frames !== m.frames || companion.motion.joints.length !== m.joints.length) {
+      throw new Error(`setCompanion: the companion (${companion.motion.frames} frames) must match the shown motion (${m?.frames ?? 0} frames, same joints)`);
+    }
+    if (!this.companion) {
+      const figure = new Figure(companion.motion, COMPANION_PALETTE);
+      this.scene.add(figure.mesh);
+      // Offset towards the screen's left: minus the camera's horizontal right vector (−dz, dx of the view direction).
+      const vx = this.controls.target.x - this.camera.position.x, vz = this.controls.target.z - this.camera.position.z;
+      const l = Math.hypot(vx, vz) || 1;
+      const labels = ['main', 'companion'].map((kind) => {
+        const el = document.createElement('div');
+        el.className = `figure-label figure-label-${kind}`;
+        this.container.appendChild(el);
+        return el;
+      });
+      this.companion = { motion: companion.motion, figure, pose: new Float32Array(m.joints.length * 3), dx: (vz / l) * COMPANION_OFFSET, dz: (-vx / l) * COMPANION_OFFSET, labels };
+      this.companionShadow.mesh.visible = true;
+      this.companion.labels[0].textContent = companion.labels.main;
+      this.companion.labels[1].textContent = companion.labels.companion;
+      this.applyPose();
+      this.frameCharacter(); // both in view, a little further back
+      return;
+    }
+    this.companion.motion = companion.motion;
+    this.applyPose();
+  }
+
   /** Removes the motion: an empty stage. */
   clear(): void {
+    this.setCompanion(null);
     if (this.figure) {
       this.scene.remove(this.figure.mesh);
       this.figure.dispose();
@@ -241,8 +303,8 @@ export class Viewer {
     // its trail and footprints on either side of the figure.
     const a = (62 * Math.PI) / 180;
     const cx = dx * Math.cos(a) + dz * Math.sin(a), cz = -dx * Math.sin(a) + dz * Math.cos(a);
-    const dist = this.figureHeight * 2.8;
-    const root = this.rootNow();
+    const dist = this.figureHeight * (this.companion ? 3.3 : 2.8);
+    const root = this.followPoint();
     this.controls.target.set(root.x, this.targetY, root.z);
     this.camera.position.set(root.x + cx * dist, this.targetY + dist * 0.42, root.z + cz * dist);
     this.snap = true;
@@ -303,6 +365,30 @@ export class Viewer {
     return this.tmp.set(this.pose[r], this.pose[r + 1], this.pose[r + 2]);
   }
 
+  /** What the camera follows: the root, or with a companion the midpoint of the two roots as drawn. */
+  private followPoint(): THREE.Vector3 {
+    const root = this.rootNow();
+    const c = this.companion;
+    if (!c) return root;
+    const r = this.root * 3;
+    return root.set((root.x + c.pose[r]) / 2, root.y, (root.z + c.pose[r + 2]) / 2);
+  }
+
+  /** Puts each figure's label above its head (the highest joint), in CSS pixels of the stage. */
+  private placeLabels(): void {
+    const c = this.companion;
+    if (!c) return;
+    const w = this.container.clientWidth, h = this.container.clientHeight;
+    [this.pose, c.pose].forEach((pose, i) => {
+      let top = 1;
+      for (let j = 0; j < pose.length / 3; j++) if (pose[j * 3 + 1] > pose[top * 3 + 1]) top = j;
+      const p = this.tmp.set(pose[top * 3], pose[top * 3 + 1] + 0.22, pose[top * 3 + 2]).project(this.camera);
+      const label = c.labels[i];
+      label.hidden = p.z > 1 || p.z < -1;
+      label.style.transform = `translate(${((p.x + 1) / 2) * w}px, ${((1 - p.y) / 2) * h}px) translate(-50%, -100%)`;
+    });
+  }
+
   private applyPose(): void {
     const m = this.motion;
     if (!m || !this.figure) return;
@@ -312,6 +398,19 @@ export class Viewer {
     const P = m.positions, o0 = i0 * n, o1 = i1 * n;
     for (let k = 0; k < n; k++) this.pose[k] = P[o0 + k] + (P[o1 + k] - P[o0 + k]) * a;
     this.figure.update(this.pose);
+    const c = this.companion;
+    if (c && c.motion.frames === m.frames) {
+      // (a live window replaced by setLive has its companion window replaced right after)
+      const C = c.motion.positions;
+      for (let k = 0; k < n; k += 3) {
+        c.pose[k] = C[o0 + k] + (C[o1 + k] - C[o0 + k]) * a + c.dx;
+        c.pose[k + 1] = C[o0 + k + 1] + (C[o1 + k + 1] - C[o0 + k + 1]) * a;
+        c.pose[k + 2] = C[o0 + k + 2] + (C[o1 + k + 2] - C[o0 + k + 2]) * a + c.dz;
+      }
+      c.figure.update(c.pose);
+      const r = this.root * 3;
+      this.companionShadow.set(c.pose[r], c.pose[r + 2], this.figureHeight * 0.55);
+    }
     const root = this.rootNow();
     this.marks.setShadow(root.x, root.z, this.figureHeight * 0.55);
     this.glow.setCenter(root.x, root.z);
@@ -336,7 +435,7 @@ export class Viewer {
         this.applyPose();
       }
       if (this.follow) {
-        const root = this.rootNow();
+        const root = this.followPoint();
         const k = this.snap ? 1 : 1 - Math.exp(-dt * 5);
         const dx = (root.x - this.controls.target.x) * k;
         const dy = (this.targetY - this.controls.target.y) * k;
@@ -356,6 +455,7 @@ export class Viewer {
       this.dirty = false;
       this.floor.setCenter(this.controls.target.x, this.controls.target.z);
       this.renderer.render(this.scene, this.camera);
+      this.placeLabels();
     }
     this.onFrame?.(this.playback.state());
   }

@@ -1,0 +1,278 @@
+// End-to-end tests of the refiner in the page: playground.generate({ refine: true }), refiner parity in the
+// browser against the Python fixture, foot skating raw vs refined + foot lock, and Random walk's refine
+// toggle, side-by-side view and skating readout. Run with `node --test tests/e2e/refiner.test.mjs`.
+import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
+import path from 'node:path';
+import { after, before, describe, test } from 'node:test';
+import { launchBrowser, openPlayground, ROOT, startServer } from './harness.mjs';
+
+const GENERATOR = JSON.parse(readFileSync(path.join(ROOT, 'public', 'models', 'generator.json'), 'utf8'));
+const REFERENCE = JSON.parse(readFileSync(path.join(ROOT, 'tests', 'fixtures', 'refiner_reference.json'), 'utf8'));
+const J = GENERATOR.skeleton.joints.length;
+const TOES = ['LeftToeBase', 'RightToeBase'].map((n) => GENERATOR.skeleton.joints.indexOf(n));
+
+/** In-page: generate and return a JSON-friendly copy. */
+function generate(page, options) {
+  return page.evaluate(async (o) => {
+    const m = await window.playground.generate(o);
+    return {
+      fps: m.fps,
+      frames: m.frames,
+      joints: m.joints,
+      positionsType: Object.prototype.toString.call(m.positions),
+      contactsType: Object.prototype.toString.call(m.contacts),
+      positions: Array.from(m.positions),
+      contacts: Array.from(m.contacts),
+    };
+  }, options);
+}
+
+/** Mean horizontal toe speed (m/s) over frame pairs in which that foot is planted in both (training/metrics.py foot_skating). */
+function footSkating(m) {
+  let sum = 0, count = 0;
+  for (let f = 1; f < m.frames; f++) {
+    for (let side = 0; side < 2; side++) {
+      if (!m.contacts[f * 2 + side] || !m.contacts[(f - 1) * 2 + side]) continue;
+      const a = ((f - 1) * J + TOES[side]) * 3, b = (f * J + TOES[side]) * 3;
+      sum += Math.hypot(m.positions[b] - m.positions[a], m.positions[b + 2] - m.positions[a + 2]) * m.fps;
+      count++;
+    }
+  }
+  return sum / count;
+}
+
+const worstScaled = (a, b) => a.reduce((w, v, i) => Math.max(w, Math.abs(v - b[i]) / Math.max(1, Math.abs(b[i]))), 0);
+
+describe('refiner in the page', { timeout: 300_000 }, () => {
+  let server, url, browser, page, problems;
+
+  before(async () => {
+    ({ server, url } = await startServer());
+    browser = await launchBrowser();
+    ({ page, problems } = await openPlayground(browser, url));
+  });
+
+  after(async () => {
+    await browser?.close();
+    await server?.close();
+  });
+
+  test('generate with refine: shape, contacts, finite, deterministic, not the raw motion', async () => {
+    const m = await generate(page, { model: 'generator', frames: 300, seed: 4, refine: true });
+    assert.equal(m.fps, 30);
+    assert.equal(m.frames, 300);
+    assert.deepEqual(m.joints, GENERATOR.skeleton.joints);
+    assert.equal(m.positionsType, '[object Float32Array]');
+    assert.equal(m.positions.length, 300 * J * 3);
+    assert.ok(m.positions.every(Number.isFinite), 'no NaN or infinite positions');
+    assert.equal(m.contactsType, '[object Uint8Array]');
+    assert.equal(m.contacts.length, 600);
+    assert.ok(m.contacts.every((c) => c === 0 || c === 1));
+    for (const foot of [0, 1]) {
+      const planted = m.contacts.filter((c, i) => i % 2 === foot && c === 1).length;
+      assert.ok(planted > 20 && planted < 290, `foot ${foot} is planted some of the time (${planted} of 300 frames)`);
+    }
+    const hips = GENERATOR.skeleton.joints.indexOf('Hips');
+    const travel = Math.hypot(m.positions[(299 * J + hips) * 3] - m.positions[hips * 3], m.positions[(299 * J + hips) * 3 + 2] - m.positions[hips * 3 + 2]);
+    assert.ok(travel > 1, `the refined character walks (root travels ${travel.toFixed(2)} m)`);
+
+    const again = await generate(page, { model: 'generator', frames: 300, seed: 4, refine: true });
+    assert.deepEqual(again.positions, m.positions, 'the same seed gives the same refined motion');
+    assert.deepEqual(again.contacts, m.contacts);
+    const raw = await generate(page, { model: 'generator', frames: 300, seed: 4, refine: false });
+    assert.notDeepEqual(raw.positions, m.positions, 'refine: true is not the raw motion');
+    // The same samples: both start from the same seed state at the origin, facing the same way.
+    assert.ok(Math.hypot(raw.positions[0] - m.positions[0], raw.positions[2] - m.positions[2]) < 0.05);
+    const other = await generate(page, { model: 'generator', frames: 300, seed: 5, refine: true });
+    assert.notDeepEqual(other.positions, m.positions, 'another seed gives another refined motion');
+    assert.equal(await page.evaluate(() => window.playground.current()), null, 'generate does not show the motion');
+  });
+
+  test('refined + foot lock skates far less than the raw motion (same seeds)', async () => {
+    const rows = [];
+    for (const seed of [0, 1, 2]) {
+      const raw = footSkating(await generate(page, { model: 'generator', frames: 900, seed }));
+      const refined = footSkating(await generate(page, { model: 'generator', frames: 900, seed, refine: true }));
+      rows.push({ seed, raw, refined });
+    }
+    const mean = (k) => rows.reduce((a, r) => a + r[k], 0) / rows.length;
+    console.log(`# foot skating (m/s), 900 frames, τ 0.5: ${rows.map((r) => `seed ${r.seed} raw ${r.raw.toFixed(3)} refined ${r.refined.toFixed(3)}`).join('; ')}`);
+    assert.ok(mean('raw') > 0.5, `the raw generator skates (${mean('raw').toFixed(3)} m/s)`);
+    for (const r of rows) assert.ok(r.refined < 0.5 * r.raw, `seed ${r.seed}: refined ${r.refined.toFixed(3)} vs raw ${r.raw.toFixed(3)} m/s`);
+    assert.ok(mean('refined') < 0.25 * mean('raw'), `refined + foot lock ${mean('refined').toFixed(3)} vs raw ${mean('raw').toFixed(3)} m/s`);
+  });
+
+  test('refiner parity in the browser: the fixture steps within 1e-4, and the end effectors', async () => {
+    const results = await page.evaluate(async (ref) => {
+      const { GeneratorClient } = await import('/runtime/generatorClient.ts');
+      const client = new GeneratorClient({ threads: 1 });
+      try {
+        await client.init();
+        const out = [];
+        for (const [k, step] of ref.steps.entries()) {
+          const r = await client.refinerParity({ batch: ref.batch, ...step.inputs }, k === 0 ? ref.frames_physical : undefined);
+          out.push({ outputs: Object.fromEntries(Object.entries(r.outputs).map(([n, v]) => [n, Array.from(v)])), ends: r.ends && Array.from(r.ends) });
+        }
+        return out;
+      } finally {
+        client.dispose();
+      }
+    }, REFERENCE);
+    let worst = 0;
+    results.forEach((r, k) => {
+      for (const name of ['x_refined', 'h_out', 'c_out']) {
+        const expected = REFERENCE.steps[k].outputs[name];
+        assert.equal(r.outputs[name].length, expected.length, `step ${k} ${name} length`);
+        worst = Math.max(worst, worstScaled(r.outputs[name], expected));
+      }
+    });
+    console.log(`# refiner parity in the browser: worst |a−b|/max(1,|b|) = ${worst.toExponential(2)}`);
+    assert.ok(worst <= 1e-4, `refiner steps: worst ${worst}`);
+    assert.equal(results[0].ends.length, REFERENCE.ends.length);
+    assert.ok(worstScaled(results[0].ends, REFERENCE.ends) <= 1e-5, 'root-frame end effectors match the Python side');
+  });
+
+  test('bad refine values reject with clear messages and leave the scene as it was', async () => {
+    const r = await page.evaluate(async () => {
+      const pg = window.playground;
+      const messages = [];
+      for (const refine of ['yes', 1, null]) {
+        try {
+          await pg.generate({ model: 'generator', frames: 10, seed: 1, refine });
+          messages.push('resolved');
+        } catch (e) {
+          messages.push(e.message);
+        }
+      }
+      const one = await pg.generate({ model: 'generator', frames: 1, seed: 1, refine: true });
+      return { messages, current: pg.current(), one: { frames: one.frames, contacts: one.contacts.length, finite: Array.from(one.positions).every(Number.isFinite) } };
+    });
+    assert.match(r.messages[0], /^generate: refine must be true or false, got yes/);
+    assert.match(r.messages[1], /refine must be true or false, got 1/);
+    assert.match(r.messages[2], /refine must be true or false, got null/);
+    assert.equal(r.current, null);
+    assert.deepEqual(r.one, { frames: 1, contacts: 2, finite: true });
+  });
+
+  test('a refiner that cannot load gives a message, and works once it can', async () => {
+    const fresh = await openPlayground(browser, url);
+    try {
+      await fresh.context.route('**/models/refiner.onnx', (route) => route.fulfill({ status: 404, body: 'not here' }));
+      const failed = await fresh.page.evaluate(async () => {
+        try {
+          await window.playground.generate({ model: 'generator', frames: 30, seed: 1, refine: true });
+          return 'resolved';
+        } catch (e) {
+          return { message: e.message, lastError: window.playground.lastError() };
+        }
+      });
+      assert.match(failed.message, /^generate: .*refiner model .*refiner\.onnx: HTTP 404/);
+      assert.equal(failed.lastError, failed.message);
+      // The generator itself still works, and the refiner loads once it is there.
+      await fresh.context.unroute('**/models/refiner.onnx');
+      const ok = await fresh.page.evaluate(async () => {
+        const raw = await window.playground.generate({ model: 'generator', frames: 30, seed: 1 });
+        const refined = await window.playground.generate({ model: 'generator', frames: 30, seed: 1, refine: true });
+        return [raw.frames, refined.frames];
+      });
+      assert.deepEqual(ok, [30, 30]);
+    } finally {
+      await fresh.context.close();
+    }
+  });
+
+  test('Random walk: refine toggle, side-by-side view and the skating readout', async () => {
+    const status = () =>
+      page.evaluate(() => {
+        const s = document.getElementById('walk-status');
+        const card = document.getElementById('walk-skating');
+        const labels = [...document.querySelectorAll('.figure-label')].filter((l) => !l.hidden).map((l) => ({ text: l.textContent, box: l.getBoundingClientRect().toJSON() }));
+        return {
+          frame: Number(s.dataset.frame),
+          text: s.textContent,
+          skating: { ...card.dataset },
+          card: getComputedStyle(card).display,
+          rawLine: !document.getElementById('walk-skating-raw').closest('.skate-line').hidden,
+          refinedLine: !document.getElementById('walk-skating-refined').closest('.skate-line').hidden,
+          rawText: document.getElementById('walk-skating-raw').textContent,
+          refinedText: document.getElementById('walk-skating-refined').textContent,
+          labels,
+          meta: document.getElementById('clip-meta').textContent,
+          sideBySide: document.getElementById('walk-side-by-side').checked,
+          refine: document.getElementById('walk-refine').checked,
+        };
+      });
+    const waitFrame = (n, text = '') =>
+      page.waitForFunction(([n, text]) => Number(document.getElementById('walk-status').dataset.frame) > n && document.getElementById('walk-status').textContent.includes(text), [n, text], { timeout: 90_000 });
+
+    await page.click('#mode-walk');
+    await waitFrame(60);
+    let s = await status();
+    assert.equal(s.card, 'block', 'the skating readout shows in Random walk mode');
+    assert.equal(s.skating.shown, 'raw');
+    assert.ok(s.rawLine && !s.refinedLine);
+    assert.ok(Number(s.skating.raw) > 0.2, `raw skating shown (${s.skating.raw} m/s)`);
+    assert.equal(s.rawText, Number(s.skating.raw).toFixed(2));
+    assert.doesNotMatch(s.text, /refined/);
+
+    // Refine: the stream restarts refined; one figure, the refined readout.
+    await page.check('#walk-refine');
+    await page.waitForFunction(() => /refined/.test(document.getElementById('walk-status').textContent), null, { timeout: 60_000 });
+    await waitFrame(90, 'refined');
+    s = await status();
+    assert.equal(s.skating.shown, 'refined');
+    assert.ok(!s.rawLine && s.refinedLine);
+    assert.ok(Number.isFinite(Number(s.skating.refined)) && s.skating.refined !== '', `refined skating shown (${s.skating.refined})`);
+    assert.equal(s.skating.raw, '');
+    assert.equal(s.labels.length, 0, 'no side-by-side labels yet');
+    assert.match(s.meta, /generator \+ refiner/);
+    const shown = await page.evaluate(() => {
+      const m = window.playground.current();
+      return { joints: m.joints.length, contacts: m.contacts.length === m.frames * 2, finite: Array.from(m.positions).every(Number.isFinite) };
+    });
+    assert.deepEqual(shown, { joints: J, contacts: true, finite: true });
+
+    // Side by side: no restart (the refined stream carries the raw frames), both figures labelled, both numbers.
+    const before = s.frame;
+    await page.check('#walk-side-by-side');
+    await page.waitForFunction(() => /side by side/.test(document.getElementById('walk-status').textContent) && document.querySelectorAll('.figure-label:not([hidden])').length === 2, null, { timeout: 20_000 });
+    await page.waitForTimeout(3000);
+    s = await status();
+    assert.ok(s.frame > before, `the walk went on (frame ${before} → ${s.frame})`);
+    assert.equal(s.skating.shown, 'both');
+    assert.ok(s.rawLine && s.refinedLine);
+    const raw = Number(s.skating.raw), refined = Number(s.skating.refined);
+    assert.ok(raw > 0.3 && refined >= 0 && refined < raw, `readout: raw ${raw} vs refined ${refined} m/s`);
+    assert.deepEqual(s.labels.map((l) => l.text).sort(), ['raw', 'refined + foot lock']);
+    const [a, b] = s.labels.map((l) => l.box.x + l.box.width / 2);
+    assert.ok(Math.abs(a - b) > 80, `the two figures are drawn apart (labels at ${a.toFixed(0)} and ${b.toFixed(0)} px)`);
+    const rawLabel = s.labels.find((l) => l.text === 'raw'), refinedLabel = s.labels.find((l) => l.text !== 'raw');
+    assert.ok(rawLabel.box.x < refinedLabel.box.x, 'the raw figure is on the left');
+
+    // Side by side off: one figure again, same stream.
+    await page.uncheck('#walk-side-by-side');
+    await page.waitForFunction(() => document.querySelectorAll('.figure-label').length === 0, null, { timeout: 10_000 });
+    s = await status();
+    assert.equal(s.refine, true);
+    assert.equal(s.skating.shown, 'refined');
+
+    // Refine off (turns side by side off too): back to the raw generator.
+    await page.check('#walk-side-by-side');
+    await page.waitForFunction(() => document.querySelectorAll('.figure-label').length === 2, null, { timeout: 10_000 });
+    await page.uncheck('#walk-refine');
+    assert.equal(await page.evaluate(() => document.querySelectorAll('.figure-label').length), 0, 'the raw figure goes at once');
+    await page.waitForFunction(() => {
+      const s = document.getElementById('walk-status');
+      return /τ/.test(s.textContent) && !/refined/.test(s.textContent) && Number(s.dataset.frame) > 30;
+    }, null, { timeout: 60_000 });
+    s = await status();
+    assert.equal(s.sideBySide, false);
+    assert.equal(s.labels.length, 0);
+    assert.equal(s.skating.shown, 'raw');
+
+    await page.click('#mode-clip');
+    assert.equal(await page.evaluate(() => getComputedStyle(document.getElementById('walk-skating')).display), 'none');
+    assert.deepEqual(problems, [], 'no console errors');
+  });
+});
