@@ -193,6 +193,66 @@ const GENERATOR_BENCHMARKS = [1, 2].flatMap((threads) => [
   },
 ]);
 
+/**
+ * The refiner's extra cost per frame: generate (batch 1, one thread) of the same frames without and with
+ * refine, interleaved, best of `runs` each. With refine the worker also runs R's step per frame, the
+ * end effectors, the decoding of the refined frames and the foot lock; the foot lock alone is timed on the
+ * page's thread over the same refined frames, so the refiner's share without it can be reported too.
+ */
+async function refinerCostBenchmark(ctx, { frames = 3000, runs = 3 } = {}) {
+  const { context, page, problems } = await openPlayground(ctx.browser, `${ctx.url}?threads=1`, VIEWPORT);
+  try {
+    const r = await page.evaluate(
+      async ({ frames, runs }) => {
+        const { GeneratorClient } = await import('/runtime/generatorClient.ts');
+        const { footLock } = await import('/motion/footLock.ts');
+        const info = await (await fetch('models/generator.json')).json();
+        const client = new GeneratorClient({ threads: 1 });
+        try {
+          const loaded = await client.init();
+          const params = { seed: 0, temperature: 0.5 };
+          await client.generate({ ...params, frames: 60 }); // warm-up: wasm, and loading the refiner
+          await client.generate({ ...params, frames: 60, refine: true });
+          const raw = [], refined = [], lock = [];
+          let last;
+          for (let i = 0; i < runs; i++) {
+            let t = performance.now();
+            await client.generate({ ...params, frames });
+            raw.push(performance.now() - t);
+            t = performance.now();
+            last = await client.generate({ ...params, frames, refine: true });
+            refined.push(performance.now() - t);
+            // The foot lock alone, on the refined frames before the lock would be ideal; on the locked ones it
+            // takes the same path (same contacts, planted feet), which is what the timing needs.
+            t = performance.now();
+            footLock(last.refined.positions, last.refined.contacts, info.skeleton.joints, info.skeleton.offsets);
+            lock.push(performance.now() - t);
+          }
+          return { raw: Math.min(...raw), refined: Math.min(...refined), lock: Math.min(...lock), threads: loaded.threads, isolated: globalThis.crossOriginIsolated };
+        } finally {
+          client.dispose();
+        }
+      },
+      { frames, runs },
+    );
+    const perFrame = (ms) => +((ms / frames) * 1000).toFixed(1); // µs per frame
+    return {
+      frames,
+      threads: r.threads,
+      isolated: r.isolated,
+      generator_us_per_frame: perFrame(r.raw),
+      refine_us_per_frame: perFrame(r.refined),
+      foot_lock_us_per_frame: perFrame(r.lock),
+      refiner_extra: +(r.refined / r.raw - 1).toFixed(3),
+      refiner_extra_without_lock: +((r.refined - r.lock) / r.raw - 1).toFixed(3),
+      target_refiner_extra: 0.3,
+      page_errors: problems.length,
+    };
+  } finally {
+    await context.close();
+  }
+}
+
 const BENCHMARK_PATHS = JSON.parse(readFileSync(path.join(ROOT, 'tests/fixtures/benchmark_paths.json'), 'utf8')).paths;
 
 /** followPath on each benchmark path (walk, seed 0): optimisation time against the motion's duration. */
@@ -261,6 +321,12 @@ export const BENCHMARKS = [
   },
   ...GENERATOR_BENCHMARKS,
   {
+    name: 'refiner-cost',
+    description: 'generate 3000 frames (batch 1, 1 thread) without and with refine (refiner step + end effectors + decode + foot lock) — target: refine adds ≤ 30% per frame',
+    kind: 'refiner',
+    run: (ctx) => refinerCostBenchmark(ctx),
+  },
+  {
     name: 'random-walk',
     description: 'Random walk mode streaming from the generator (default threads), default quality — target 60 fps',
     kind: 'live',
@@ -326,6 +392,13 @@ async function main() {
     if (b.kind === 'generator') {
       const target = r.batch === 1 ? `${r.steps_per_s} steps/s (target ≥ 1,000)` : `${r.particle_steps_per_s} particle-steps/s (target ≥ 20,000)`;
       console.log(`  ${b.name}: ${target}, ${r.ms_per_call} ms/call, ${r.threads} thread(s)${r.isolated ? '' : ' (not isolated)'}\n    ${b.description}`);
+      continue;
+    }
+    if (b.kind === 'refiner') {
+      console.log(
+        `  ${b.name}: refine adds ${(r.refiner_extra * 100).toFixed(1)}% per frame (target ≤ 30%), ${(r.refiner_extra_without_lock * 100).toFixed(1)}% without the foot lock;` +
+          ` ${r.generator_us_per_frame} → ${r.refine_us_per_frame} µs per frame, foot lock ${r.foot_lock_us_per_frame} µs, ${r.threads} thread(s)\n    ${b.description}`,
+      );
       continue;
     }
     if (b.kind === 'path') {
