@@ -9,6 +9,7 @@
 // returned motions, against unconstrained generation (generate, temperature 0.5) from the same seed
 // states.
 import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
+import os from 'node:os';
 import path from 'node:path';
 import { launchBrowser, openPlayground, ROOT, startServer } from '../tests/e2e/harness.mjs';
 
@@ -113,7 +114,7 @@ function headingResponse(sim, change) {
 async function main() {
   const { server, url } = await startServer();
   const browser = await launchBrowser();
-  const report = { date: new Date().toISOString().slice(0, 10), seeds: SEEDS, targets: TARGETS, paths: [], control: [] };
+  const report = { date: new Date().toISOString().slice(0, 10), seeds: SEEDS, targets: TARGETS, paths: [], control: [], loadBefore: os.loadavg()[0] };
   try {
     const { page, problems } = await openPlayground(browser, url);
     const threads = await page.evaluate(async () => (await window.playground.generate({ model: 'generator', frames: 2, seed: 0 }), globalThis.crossOriginIsolated));
@@ -162,6 +163,7 @@ async function main() {
     for (let seed = 0; seed < SEEDS; seed++) freeControl.push(skating(await freeOne(page, seed, SIM_SECONDS * 30)));
     report.freeControlSkating = mean(freeControl);
     report.problems = problems;
+    report.loadAfter = os.loadavg()[0];
   } finally {
     await browser.close();
     await server.close();
@@ -180,7 +182,7 @@ function markdown(r) {
   const pass = (ok) => (ok ? 'yes' : '**no**');
   lines.push('# Path following and live control', '');
   lines.push(
-    `Made by \`npm run evaluate:control\` (${r.date}) in headless Chromium through \`playground.followPath\` and \`playground.simulateControl\`, ${r.seeds} seeds per case, one onnxruntime-web thread (cross-origin isolated: ${r.crossOriginIsolated}). ` +
+    `Made by \`npm run evaluate:control\` (${r.date}) in headless Chromium through \`playground.followPath\` and \`playground.simulateControl\`, ${r.seeds} seeds per case, one onnxruntime-web thread (cross-origin isolated: ${r.crossOriginIsolated}), 1-minute load average ${fmt(r.loadBefore, 1)} before and ${fmt(r.loadAfter, 1)} after on this 2-core machine (timings are only meaningful near 1, this run alone). ` +
       'The optimiser is `web/optimizer/` over the shipped generator (see [generator.md](generator.md)); paths are `tests/fixtures/benchmark_paths.json`.',
     '',
   );
