@@ -1,6 +1,8 @@
 """Export the trained refiner R as a causal streaming step (ONNX) plus its JSON, parity-checked.
 
-    python -m training.export_refiner [--checkpoint runs/refiner/best.pt]
+    python -m training.export_refiner [--checkpoint runs/refiner/shipped.pt]
+    python -m training.export_refiner --checkpoint runs/refiner/checkpoint.pt --recover runs/refiner/shipped.pt
+        (rebuild the torch checkpoint of the shipped export; see refiner_from_onnx)
 
 public/models/refiner.onnx: one step, inputs
     x          (B, D)    the generator's newest frame, normalised (generator.json normalisation), contacts
@@ -250,11 +252,73 @@ def write_fixture(model: Refiner, path: Path, frames: np.ndarray, info: dict) ->
     print(f"wrote {FIXTURE}")
 
 
+def refiner_from_onnx(path: Path, meta: dict) -> Refiner:
+    """The torch Refiner computing what an export of step_graph computes: FC1 unfolded from the folded weights
+    (the end-effector normalisation comes from `meta`, any run's; the function does not depend on it), the
+    LSTM gates back in PyTorch's order, the summed LSTM bias as bias_ih."""
+    inits = {t.name: numpy_helper.to_array(t).astype(np.float64) for t in onnx.load(str(path)).graph.initializer}
+    model = Refiner(np.array(meta["mean"]), np.array(meta["std"]), np.array(meta["references"]),
+                    inits["lstm_hh.weight_t"].shape[0], np.array(meta["end_mean"]), np.array(meta["end_std"]), fps=meta["fps"])
+    g, D, E3, H = model.geometry, model.dim, 3 * model.ends, model.hidden
+    std, mean = np.array(meta["std"]), np.array(meta["mean"])
+    em, es = np.array(meta["end_mean"]), np.array(meta["end_std"])
+    w = inits["fc1.weight_t"].T
+    wx, wq_f, wqp = w[:, :D].copy(), w[:, D:D + E3], w[:, D + E3:D + 2 * E3]
+    wv = -wqp / g.fps
+    P = np.zeros((E3, 2))
+    P[0::3, 0], P[2::3, 1] = 1.0, 1.0
+    My = np.zeros((E3, E3))
+    My[1::3, 1::3] = np.eye(model.ends)
+    wq = wq_f - g.fps * wv @ My
+    wx[:, 0:2] -= g.fps * wv @ P * std[0:2]
+    bias = inits["fc1.bias"] + wq @ em[:E3] + wv @ em[E3:] - g.fps * wv @ P @ mean[0:2]
+    ungate = lambda a: a.reshape(4, H, *a.shape[1:])[GATE_ORDER].reshape(4 * H, *a.shape[1:])  # its own inverse
+    sd = {"fc1.weight": np.concatenate([wx, wq * es[:E3], wv * es[E3:]], axis=1), "fc1.bias": bias,
+          "lstm.weight_ih_l0": ungate(inits["lstm_ih.weight_t"].T), "lstm.weight_hh_l0": ungate(inits["lstm_hh.weight_t"].T),
+          "lstm.bias_ih_l0": ungate(inits["lstm.bias"]), "lstm.bias_hh_l0": np.zeros(4 * H),
+          "fc2.weight": inits["fc2.weight_t"].T, "fc2.bias": inits["fc2.bias"]}
+    state = model.state_dict()
+    for k, v in sd.items():
+        state[k] = torch.tensor(v, dtype=torch.float32)
+    model.load_state_dict(state)
+    return model.eval()
+
+
+def recover_checkpoint(onnx_path: Path, meta_checkpoint: Path, info_json: Path, out: Path) -> float:
+    """Rebuild a torch checkpoint for a shipped export (meta from a checkpoint of the same run, counters from
+    the export's JSON); returns the largest output difference between the export and a re-export."""
+    meta = torch.load(meta_checkpoint, weights_only=False)["meta"]
+    info = json.loads(info_json.read_text())
+    model = refiner_from_onnx(onnx_path, meta)
+    t = info["training"]
+    state = {"r_updates": t["r_updates"], "d_updates": t["d_updates"], "elapsed": t["minutes"] * 60}
+    torch.save({"refiner": model.state_dict(), "meta": dict(meta, args=t["args"]), "state": state, "valid": t["valid"],
+                "recovered_from": str(onnx_path)}, out)
+    tmp = out.with_suffix(".onnx")
+    export_onnx(model, tmp)
+    rng = np.random.default_rng(0)
+    a, b = (ort.InferenceSession(str(p), providers=["CPUExecutionProvider"]) for p in (onnx_path, tmp))
+    feed = {"x": rng.normal(size=(5, model.dim)).astype(np.float32), "ends": rng.normal(size=(5, 3 * model.ends)).astype(np.float32),
+            "ends_prev": rng.normal(size=(5, 3 * model.ends)).astype(np.float32),
+            "h": rng.normal(size=(1, 5, model.hidden)).astype(np.float32), "c": rng.normal(size=(1, 5, model.hidden)).astype(np.float32)}
+    diff = max(float(np.abs(u - v).max()) for u, v in zip(a.run(OUTPUTS, feed), b.run(OUTPUTS, feed)))
+    tmp.unlink()
+    return diff
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--checkpoint", type=Path, default=RUNS_DIR / "refiner" / "best.pt")
+    parser.add_argument("--checkpoint", type=Path, default=RUNS_DIR / "refiner" / "shipped.pt",
+                        help="the shipped model's checkpoint (a run's best.pt or last.pt to try another)")
     parser.add_argument("--out", type=Path, default=MODELS_DIR)
+    parser.add_argument("--recover", type=Path, default=None, metavar="OUT.pt",
+                        help="instead of exporting: rebuild a torch checkpoint for the shipped refiner.onnx into OUT.pt "
+                             "(meta from --checkpoint, a checkpoint of the same run)")
     args = parser.parse_args(argv)
+    if args.recover is not None:
+        diff = recover_checkpoint(MODELS_DIR / "refiner.onnx", args.checkpoint, MODELS_DIR / "refiner.json", args.recover)
+        print(f"wrote {args.recover}; its re-export differs from the shipped export by {diff:.2e}")
+        return
     if not args.checkpoint.exists():
         raise SystemExit(f"error: no checkpoint at {args.checkpoint}; train first with python -m training.train_refiner")
     model, meta, state = load_refiner(args.checkpoint)

@@ -8,7 +8,8 @@ import torch
 
 from training.dataset import clip_contacts, load_clip, read_index
 from training.export_generator import MODELS_DIR
-from training.export_refiner import FIXTURE, OUTPUTS, export_onnx, parity_error, step_parity, stream_inputs
+from training.export_refiner import (FIXTURE, OUTPUTS, export_onnx, parity_error, refiner_from_onnx, step_parity,
+                                     stream_inputs)
 from training.features import FeatureCodec
 from training.footlock import BLEND_IN, TOE_GROUND_HEIGHT, FootLock, foot_lock, two_bone_ik
 from training.models.refiner import (FeatureGeometry, Refiner, RefinerStep, rotvec_to_matrix, straight_through_bits)
@@ -133,6 +134,21 @@ def test_onnx_step_parity(walk, tmp_path):
     out = session.run(OUTPUTS, {"x": frames[:3, 1], "ends": q[:3, 1], "ends_prev": q[:3, 0],
                                 "h": np.zeros((1, 3, 32), np.float32), "c": np.zeros((1, 3, 32), np.float32)})
     assert out[0].shape == (3, model.dim) and out[1].shape == (1, 3, 32)
+
+
+def test_refiner_rebuilt_from_its_export_computes_the_same(walk, tmp_path):
+    codec, x = walk
+    model = random_refiner(codec, x, hidden=16, seed=5)
+    path = tmp_path / "r.onnx"
+    export_onnx(model, path)
+    meta = {"mean": model.mean.tolist(), "std": model.std.tolist(), "references": codec.references.tolist(), "fps": 30.0,
+            "end_mean": np.zeros(42).tolist(), "end_std": np.ones(42).tolist()}  # other end statistics than the model's
+    rebuilt = refiner_from_onnx(path, meta)
+    xn = torch.from_numpy(normalised(model, x[None, :40]))
+    with torch.no_grad():
+        a, _ = model(xn[:, 1:], xn[:, 0])
+        b, _ = rebuilt(xn[:, 1:], xn[:, 0])
+    assert (a - b).abs().max() < 1e-4
 
 
 def test_shipped_refiner_matches_its_fixture():
