@@ -444,6 +444,10 @@ def write_markdown(r: dict) -> None:
         "(D(refined) 0.01-0.25 on validation) without its loss falling below 0.01, so the multiplier never changed.",
         "",
     ]
+    # The browser measurements are made by the e2e test and the bench, not here: kept in their own file.
+    browser = REPORTS / "refiner-browser.md"
+    if browser.exists():
+        lines += [browser.read_text().strip(), ""]
     (REPORTS / "refiner.md").write_text("\n".join(lines))
 
 
