@@ -20,6 +20,19 @@ def foot_skating(positions: np.ndarray, contacts: np.ndarray, fps: float, skel: 
     return float(allv.mean()) if len(allv) else float("nan")
 
 
+def foot_skating_clips(clips: list[tuple[np.ndarray, np.ndarray]], fps: float, skel: Skeleton) -> float:
+    """foot_skating pooled over separate clips (positions, contacts), each measured on its own: frame pairs
+    never span two clips (joining clips end to end would count the jump between them as skating)."""
+    speeds = []
+    for positions, contacts in clips:
+        for side, name in enumerate(TOES):
+            toe = positions[:, skel.index(name)][:, [0, 2]]
+            v = np.linalg.norm(np.diff(toe, axis=0), axis=-1) * fps
+            speeds.append(v[(contacts[1:, side] > 0) & (contacts[:-1, side] > 0)])
+    allv = np.concatenate(speeds) if speeds else np.zeros(0)
+    return float(allv.mean()) if len(allv) else float("nan")
+
+
 def root_speed(features: np.ndarray, fps: float) -> np.ndarray:
     """Horizontal root speed per frame (m/s) from generator features."""
     return np.hypot(features[:, 0], features[:, 1]) * fps
