@@ -62,6 +62,15 @@ describe('path following and live control in the page', { timeout: 300_000 }, ()
     assert.deepEqual(b.positions, a.positions);
     const c = await followPath(page, { points: BEND, gait: 'walk', seed: 5 });
     assert.notDeepEqual(c.positions, a.positions);
+    // Feet are locked by default; the root (joint 0) is the same either way.
+    const raw = await followPath(page, { points: BEND, gait: 'walk', seed: 4, footLock: false });
+    assert.ok(a.stats.skating < a.stats.skatingBeforeLock, `skating ${a.stats.skating} vs ${a.stats.skatingBeforeLock} before the lock`);
+    assert.ok(Math.abs(raw.stats.skating - a.stats.skatingBeforeLock) < 1e-6);
+    assert.notDeepEqual(raw.positions, a.positions);
+    for (let f = 0; f < a.frames; f += 10) {
+      const i = f * a.joints.length * 3;
+      assert.deepEqual(raw.positions.slice(i, i + 3), a.positions.slice(i, i + 3));
+    }
   });
 
   test('followPath refuses bad input with a message and leaves the scene as it was', async () => {
@@ -79,6 +88,8 @@ describe('path following and live control in the page', { timeout: 300_000 }, ()
     assert.match(gait.message, /gait must be "walk" or "run"/);
     const option = await failure(page, 'followPath', { points: BEND, speed: 2 });
     assert.match(option.message, /unknown option "speed"/);
+    const lock = await failure(page, 'followPath', { points: BEND, footLock: 'yes' });
+    assert.match(lock.message, /footLock must be true or false/);
   });
 
   test('simulateControl turns to a new heading and holds the speed; compute is reported per frame', async () => {

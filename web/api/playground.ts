@@ -11,7 +11,7 @@ import type { RenderStats } from '../viewer/viewer';
 import { errorMessage, type App } from '../ui/app';
 import { checkSchedule } from '../optimizer/liveControl';
 import { checkPathPoints, GroundPath } from '../optimizer/path';
-import { checkFitSigma, checkGait, checkSeconds, checkSeed } from '../runtime/optimizerRequests';
+import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed } from '../runtime/optimizerRequests';
 
 declare const __APP_VERSION__: string;
 
@@ -64,6 +64,8 @@ export interface FollowPathOptions {
   seed?: number;
   /** σ_fit of the path-fit term in metres, 0.02–2 (default 0.1): smaller follows tighter. */
   fitTolerance?: number;
+  /** Lock planted feet (the refiner issue's contact clean-up; default true). The root path is not changed. */
+  footLock?: boolean;
 }
 
 export interface FollowPathStats {
@@ -74,6 +76,9 @@ export interface FollowPathStats {
   arcProgress: number;
   /** Wall-clock milliseconds the optimisation took. */
   optimizeMs: number;
+  /** Foot skating (m/s, mean planted-toe speed) of the motion, and of the optimised motion before the foot lock. */
+  skating: number;
+  skatingBeforeLock: number;
 }
 
 export type FollowedPathMotion = Motion & { contacts: Uint8Array; stats: FollowPathStats };
@@ -87,6 +92,8 @@ export interface SimulateControlOptions {
   seed?: number;
   /** Seed states to start from: "walk", or "run"; default "run" when the first target speed is 2 m/s or more. */
   gait?: 'walk' | 'run';
+  /** Lock planted feet (default true). */
+  footLock?: boolean;
 }
 
 export type ControlledMotion = Motion & {
@@ -376,31 +383,33 @@ export function createPlayground(app: App): Playground {
 
     followPath(options) {
       return guardedAsync('followPath', async () => {
-        const o = checkKeys(options, ['points', 'gait', 'seed', 'fitTolerance'], '{ points: [[x, z], …], gait?, seed?, fitTolerance? }');
+        const o = checkKeys(options, ['points', 'gait', 'seed', 'fitTolerance', 'footLock'], '{ points: [[x, z], …], gait?, seed?, fitTolerance?, footLock? }');
         // Checked here too (the worker checks again), so bad input fails fast and without a worker prefix.
         const points = checkPathPoints(o.points);
         GroundPath.fromPoints(points);
         const gait = checkGait(o.gait ?? 'walk');
         const seed = checkSeed(o.seed ?? 0);
         const fitSigma = checkFitSigma(o.fitTolerance ?? 0.1, 'fitTolerance');
+        const lockFeet = checkFootLock(o.footLock);
         await ready;
         const { client } = await app.generator.load();
-        const m = await client.followPath({ points, gait, seed, fitSigma });
-        const { meanError, maxError, arcProgress, optimizeMs } = m.stats;
-        return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, stats: { meanError, maxError, arcProgress, optimizeMs } };
+        const m = await client.followPath({ points, gait, seed, fitSigma, footLock: lockFeet });
+        const { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock } = m.stats;
+        return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, stats: { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock } };
       });
     },
 
     simulateControl(options) {
       return guardedAsync('simulateControl', async () => {
-        const o = checkKeys(options, ['seconds', 'schedule', 'seed', 'gait'], '{ seconds, schedule: [{ t, speed, heading }, …], seed?, gait? }');
+        const o = checkKeys(options, ['seconds', 'schedule', 'seed', 'gait', 'footLock'], '{ seconds, schedule: [{ t, speed, heading }, …], seed?, gait?, footLock? }');
+        const lockFeet = checkFootLock(o.footLock);
         const seconds = checkSeconds(o.seconds);
         const schedule = checkSchedule(o.schedule);
         const seed = checkSeed(o.seed ?? 0);
         const gait = o.gait === undefined ? undefined : checkGait(o.gait);
         await ready;
         const { client } = await app.generator.load();
-        const m = await client.simulateControl({ seconds, schedule, seed, ...(gait ? { gait } : {}) });
+        const m = await client.simulateControl({ seconds, schedule, seed, footLock: lockFeet, ...(gait ? { gait } : {}) });
         return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, speed: m.speed, heading: m.heading, computeMs: m.computeMs };
       });
     },

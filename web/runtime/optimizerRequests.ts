@@ -4,6 +4,8 @@
 import { followPath, gaitSeeds, type Gait } from '../optimizer/pathFollower';
 import { checkSchedule, LiveController, simulateControl, checkTarget, CONTROL_HORIZON } from '../optimizer/liveControl';
 import { checkPathPoints, GroundPath } from '../optimizer/path';
+import { FootLock, footLock } from '../motion/footLock';
+import { footSkating } from '../motion/footSkating';
 import type { GeneratorCore } from './generatorCore';
 import type { ControlChunkReply, ControlStartParams, ControlTargetParams, FollowPathChunk, FollowPathParams, SimulateControlParams, SimulatedControlChunk, StreamInfo } from './protocol';
 
@@ -19,6 +21,11 @@ export function checkSeed(seed: unknown): number {
   return seed;
 }
 
+export function checkFootLock(value: unknown): boolean {
+  if (value !== undefined && typeof value !== 'boolean') throw new TypeError(`footLock must be true or false, got ${String(value)}`);
+  return value ?? true;
+}
+
 export function checkFitSigma(value: unknown, name = 'fitSigma'): number {
   if (typeof value !== 'number' || !(value >= 0.02 && value <= 2)) throw new RangeError(`${name} must be a number from 0.02 to 2 m, got ${String(value)}`);
   return value;
@@ -30,7 +37,7 @@ export function checkSeconds(seconds: unknown): number {
 }
 
 export class OptimizerRequests {
-  private live: { controller: LiveController; seedIndex: number } | undefined;
+  private live: { controller: LiveController; seedIndex: number; lock: FootLock } | undefined;
 
   constructor(private readonly core: GeneratorCore) {}
 
@@ -72,12 +79,23 @@ export class OptimizerRequests {
       flat[2 * i] = path.xs[i];
       flat[2 * i + 1] = path.zs[i];
     }
-    return { frames: r.frames, features: r.features, positions: r.positions, contacts: r.contacts, rootHeading: r.rootHeading, seedIndex: r.seedIndex, startFrame: 0, stats: r.stats, path: flat };
+    const lock = checkFootLock(p.footLock);
+    const positions = lock ? this.lock(r.positions, r.contacts) : r.positions;
+    const skating = (pos: Float32Array) => footSkating({ fps: info.fps, frames: r.frames, joints: info.skeleton.joints, parents: info.skeleton.parents, positions: pos, contacts: r.contacts });
+    const stats = { ...r.stats, skating: skating(positions), skatingBeforeLock: skating(r.positions) };
+    return { frames: r.frames, features: r.features, positions, contacts: r.contacts, rootHeading: r.rootHeading, seedIndex: r.seedIndex, startFrame: 0, stats, path: flat };
+  }
+
+  /** The foot lock over a whole motion of the generator's skeleton (hips and above unchanged). */
+  private lock(positions: Float32Array, contacts: Uint8Array): Float32Array {
+    const { joints, offsets } = this.core.info.skeleton;
+    return footLock(positions, contacts, joints, offsets);
   }
 
   controlStart(p: ControlStartParams): StreamInfo {
     this.live = undefined;
-    this.live = this.controller(checkSeed(p.seed), checkGait(p.gait));
+    const { joints, offsets } = this.core.info.skeleton;
+    this.live = { ...this.controller(checkSeed(p.seed), checkGait(p.gait)), lock: new FootLock(joints, offsets) };
     return { seedIndex: this.live.seedIndex, seedName: this.core.info.seeds[this.live.seedIndex].name };
   }
 
@@ -88,6 +106,12 @@ export class OptimizerRequests {
     if (!Number.isInteger(p.frames) || p.frames < 1 || p.frames > CONTROL_HORIZON) throw new RangeError(`frames must be an integer from 1 to ${CONTROL_HORIZON}, got ${p.frames}`);
     const startFrame = live.controller.frame;
     const chunk = await live.controller.advance({ speed: p.speed, heading: p.heading }, p.frames, p.particles);
+    // Planted feet locked frame by frame, continuing across batches (as simulateControl's whole-run lock).
+    const n = this.core.info.skeleton.joints.length * 3;
+    for (let f = 0; f < chunk.frames; f++) {
+      const pose = chunk.positions.subarray(f * n, (f + 1) * n);
+      live.lock.step(pose, chunk.contacts.subarray(f * 2, f * 2 + 2), pose);
+    }
     return { ...chunk, seedIndex: live.seedIndex, startFrame };
   }
 
@@ -119,6 +143,7 @@ export class OptimizerRequests {
       batchFrames: Uint8Array.from(sim.chunks, (c) => c.frames),
     };
     let at = 0;
+    const lock = checkFootLock(p.footLock);
     for (const c of sim.chunks) {
       out.features.set(c.features, at * D);
       out.positions.set(c.positions, at * J * 3);
@@ -129,6 +154,7 @@ export class OptimizerRequests {
       out.computeMs.fill(c.computeMs / c.frames, at, at + c.frames);
       at += c.frames;
     }
+    if (lock) out.positions = this.lock(out.positions, out.contacts);
     return out;
   }
 }

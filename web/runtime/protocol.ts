@@ -152,6 +152,8 @@ export interface FollowPathParams {
   fitSigma?: number;
   /** The points are a hand-drawn stroke: drop jitter and smooth before following. */
   stroke?: boolean;
+  /** Clean planted feet with the foot lock (web/motion/footLock.ts; default true). The root is not moved. */
+  footLock?: boolean;
 }
 
 export interface FollowPathStatsReply {
@@ -161,6 +163,9 @@ export interface FollowPathStatsReply {
   optimizeMs: number;
   windows: number;
   particleSteps: number;
+  /** Foot skating (m/s, planted toe speed) of the returned motion and of the optimised motion before the foot lock. */
+  skating: number;
+  skatingBeforeLock: number;
 }
 
 export interface FollowPathChunk extends GeneratedChunk {
@@ -191,6 +196,8 @@ export interface ControlChunkReply extends GeneratedChunk {
 }
 
 export interface SimulateControlParams {
+  /** As FollowPathParams.footLock (default true). */
+  footLock?: boolean;
   seconds: number;
   schedule: { t: number; speed: number; heading: number }[];
   seed: number;
