@@ -16,11 +16,12 @@ import numpy as np
 import onnx
 import onnxruntime as ort
 import torch
-from onnx import TensorProto, helper, numpy_helper
+from onnx import numpy_helper
 
 from .features import FIXED_JOINTS, FeatureCodec, feature_names
 from .models.generator import LOG_SIGMA_MIN, GeneratorStep, MixtureLSTM, mixture_nll
 from .manifest import register_model
+from .onnx_graph import OPSET, GraphBuilder
 from .paths import REPO_ROOT
 from .rotations import matrix_to_quat
 from .runs import RUNS_DIR
@@ -30,7 +31,6 @@ from .train_generator import load_clips
 MODELS_DIR = REPO_ROOT / "public" / "models"
 INPUTS, OUTPUTS = ["x", "h", "c"], ["weights", "mu", "sigma", "h_out", "c_out"]
 PARITY_TOLERANCE = 1e-4
-OPSET = 17
 
 
 def load_generator(checkpoint: Path) -> tuple[MixtureLSTM, dict, dict]:
@@ -56,15 +56,8 @@ def step_graph(model: MixtureLSTM) -> onnx.ModelProto:
     """
     sd = {k: v.detach().cpu().numpy().astype(np.float32) for k, v in model.state_dict().items()}
     H, D, M = model.hidden, model.dim, model.mixtures
-    inits, nodes = [], []
-
-    def const(name, value):
-        inits.append(numpy_helper.from_array(np.ascontiguousarray(value), name))
-        return name
-
-    def node(op, inputs, outputs, **attrs):
-        nodes.append(helper.make_node(op, inputs, outputs, **attrs))
-        return outputs[0] if len(outputs) == 1 else outputs
+    builder = GraphBuilder()
+    const, node = builder.const, builder.node
 
     def gemm(inp, name, weight, bias, out, c=None):  # inp @ weight.T + bias (torch layout), or + c
         w = const(f"{name}.weight_t", weight.T)
@@ -108,18 +101,11 @@ def step_graph(model: MixtureLSTM) -> onnx.ModelProto:
     log_sigma = node("Reshape", [out["log_sigma"], mixture_shape], ["log_sigma"])
     node("Exp", [node("Max", [log_sigma, const("log_sigma_min", np.array(LOG_SIGMA_MIN, np.float32))], ["log_sigma_clamped"])], ["sigma"])
 
-    def value(name, shape):
-        return helper.make_tensor_value_info(name, TensorProto.FLOAT, shape)
-
-    graph = helper.make_graph(
-        nodes, "generator_step",
-        [value("x", ["batch", D]), value("h", [2, "batch", H]), value("c", [2, "batch", H])],
-        [value("weights", ["batch", M]), value("mu", ["batch", M, D]), value("sigma", ["batch", M, D]),
-         value("h_out", [2, "batch", H]), value("c_out", [2, "batch", H])], inits)
-    onnx_model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", OPSET)], producer_name="training.export_generator")
-    onnx_model.ir_version = 8
-    onnx.checker.check_model(onnx_model, full_check=True)
-    return onnx_model
+    return builder.model("generator_step",
+        [("x", ["batch", D]), ("h", [2, "batch", H]), ("c", [2, "batch", H])],
+        [("weights", ["batch", M]), ("mu", ["batch", M, D]), ("sigma", ["batch", M, D]),
+         ("h_out", [2, "batch", H]), ("c_out", [2, "batch", H])],
+        "training.export_generator")
 
 
 def export_onnx(model: MixtureLSTM, path: Path) -> None:

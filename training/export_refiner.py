@@ -32,18 +32,18 @@ import numpy as np
 import onnx
 import onnxruntime as ort
 import torch
-from onnx import TensorProto, helper, numpy_helper
+from onnx import numpy_helper
 
 from .export_generator import MODELS_DIR
 from .footlock import BLEND_IN, BLEND_OUT, REACH, TOE_GROUND_HEIGHT
 from .manifest import register_model
+from .onnx_graph import OPSET, GraphBuilder
 from .models.refiner import Refiner, RefinerStep
 from .paths import REPO_ROOT
 from .runs import RUNS_DIR
 
 INPUTS, OUTPUTS = ["x", "ends", "ends_prev", "h", "c"], ["x_refined", "h_out", "c_out"]
 PARITY_TOLERANCE = 1e-4
-OPSET = 17
 GATE_ORDER = [0, 1, 3, 2]  # graph gate blocks (i, f, o, g) from PyTorch's (i, f, g, o)
 FIXTURE = REPO_ROOT / "tests" / "fixtures" / "refiner_reference.json"
 
@@ -88,15 +88,8 @@ def folded_fc1(model: Refiner) -> tuple[np.ndarray, np.ndarray]:
 def step_graph(model: Refiner) -> onnx.ModelProto:
     H, D, E3 = model.hidden, model.dim, 3 * model.ends
     sd = {k: v.detach().cpu().numpy().astype(np.float32) for k, v in model.state_dict().items()}
-    inits, nodes = [], []
-
-    def const(name, value):
-        inits.append(numpy_helper.from_array(np.ascontiguousarray(value), name))
-        return name
-
-    def node(op, inputs, outputs, **attrs):
-        nodes.append(helper.make_node(op, inputs, outputs, **attrs))
-        return outputs[0] if len(outputs) == 1 else outputs
+    builder = GraphBuilder()
+    const, node = builder.const, builder.node
 
     def gates(w):
         return w.reshape(4, H, *w.shape[1:])[GATE_ORDER].reshape(4 * H, *w.shape[1:])
@@ -128,18 +121,11 @@ def step_graph(model: Refiner) -> onnx.ModelProto:
     delta = node("Gemm", [h2, const("fc2.weight_t", sd["fc2.weight"].T), "x"], ["fc2_plus_x"])
     node("Add", [delta, const("fc2.bias", sd["fc2.bias"])], ["x_refined"])
 
-    def value(name, shape):
-        return helper.make_tensor_value_info(name, TensorProto.FLOAT, shape)
-
-    graph = helper.make_graph(
-        nodes, "refiner_step",
-        [value("x", ["batch", D]), value("ends", ["batch", E3]), value("ends_prev", ["batch", E3]),
-         value("h", [1, "batch", H]), value("c", [1, "batch", H])],
-        [value("x_refined", ["batch", D]), value("h_out", [1, "batch", H]), value("c_out", [1, "batch", H])], inits)
-    m = helper.make_model(graph, opset_imports=[helper.make_opsetid("", OPSET)], producer_name="training.export_refiner")
-    m.ir_version = 8
-    onnx.checker.check_model(m, full_check=True)
-    return m
+    return builder.model("refiner_step",
+        [("x", ["batch", D]), ("ends", ["batch", E3]), ("ends_prev", ["batch", E3]),
+         ("h", [1, "batch", H]), ("c", [1, "batch", H])],
+        [("x_refined", ["batch", D]), ("h_out", [1, "batch", H]), ("c_out", [1, "batch", H])],
+        "training.export_refiner")
 
 
 def export_onnx(model: Refiner, path: Path) -> None:

@@ -1,8 +1,8 @@
 // End-to-end tests of the optimiser through the public API in the page: playground.followPath and
 // playground.simulateControl (the code the Path and Steer modes run), with their error handling.
 import assert from 'node:assert/strict';
-import { after, before, describe, test } from 'node:test';
-import { launchBrowser, openPlayground, startServer } from './harness.mjs';
+import { describe, test } from 'node:test';
+import { usePlayground } from './harness.mjs';
 
 const BEND = [[0, 0], [0, 2], [1.5, 3.5]];
 
@@ -30,21 +30,10 @@ function failure(page, method, options) {
 }
 
 describe('path following and live control in the page', { timeout: 300_000 }, () => {
-  let server, url, browser, page, problems;
-
-  before(async () => {
-    ({ server, url } = await startServer());
-    browser = await launchBrowser();
-    ({ page, problems } = await openPlayground(browser, url));
-  });
-
-  after(async () => {
-    await browser?.close();
-    await server?.close();
-  });
+  const suite = usePlayground();
 
   test('followPath walks a bent path to its end, close to it, the same way for the same seed', async () => {
-    const a = await followPath(page, { points: BEND, gait: 'walk', seed: 4 });
+    const a = await followPath(suite.page, { points: BEND, gait: 'walk', seed: 4 });
     assert.equal(a.fps, 30);
     assert.ok(a.frames > 60, `a 3.6 m walk takes more than 2 s (got ${a.frames} frames)`);
     assert.equal(a.positions.length, a.frames * a.joints.length * 3);
@@ -58,12 +47,12 @@ describe('path following and live control in the page', { timeout: 300_000 }, ()
     const last = (a.frames - 1) * a.joints.length * 3;
     assert.ok(Math.hypot(a.positions[0], a.positions[2]) < 0.1);
     assert.ok(Math.hypot(a.positions[last] - 1.5, a.positions[last + 2] - 3.5) < 0.35, `ends at ${a.positions[last]}, ${a.positions[last + 2]}`);
-    const b = await followPath(page, { points: BEND, gait: 'walk', seed: 4 });
+    const b = await followPath(suite.page, { points: BEND, gait: 'walk', seed: 4 });
     assert.deepEqual(b.positions, a.positions);
-    const c = await followPath(page, { points: BEND, gait: 'walk', seed: 5 });
+    const c = await followPath(suite.page, { points: BEND, gait: 'walk', seed: 5 });
     assert.notDeepEqual(c.positions, a.positions);
     // Feet are locked by default; the root (joint 0) is the same either way.
-    const raw = await followPath(page, { points: BEND, gait: 'walk', seed: 4, footLock: false });
+    const raw = await followPath(suite.page, { points: BEND, gait: 'walk', seed: 4, footLock: false });
     assert.ok(a.stats.skating < a.stats.skatingBeforeLock, `skating ${a.stats.skating} vs ${a.stats.skatingBeforeLock} before the lock`);
     assert.ok(Math.abs(raw.stats.skating - a.stats.skatingBeforeLock) < 1e-6);
     assert.notDeepEqual(raw.positions, a.positions);
@@ -74,26 +63,26 @@ describe('path following and live control in the page', { timeout: 300_000 }, ()
   });
 
   test('followPath refuses bad input with a message and leaves the scene as it was', async () => {
-    await page.evaluate(async () => {
+    await suite.page.evaluate(async () => {
       const m = await window.playground.generate({ model: 'generator', frames: 40, seed: 1 });
       window.playground.show(m, 'before');
     });
-    const short = await failure(page, 'followPath', { points: [[0, 0], [0, 0.2]] });
+    const short = await failure(suite.page, 'followPath', { points: [[0, 0], [0, 0.2]] });
     assert.match(short.message, /^followPath: the path is 0\.20 m long; it must be at least 0\.5 m/);
     assert.equal(short.lastError, short.message);
     assert.equal(short.shown, 40);
-    const bad = await failure(page, 'followPath', { points: [[0, 0], [1, null]] });
+    const bad = await failure(suite.page, 'followPath', { points: [[0, 0], [1, null]] });
     assert.match(bad.message, /points\[1\] must be a pair of finite numbers/);
-    const gait = await failure(page, 'followPath', { points: BEND, gait: 'crawl' });
+    const gait = await failure(suite.page, 'followPath', { points: BEND, gait: 'crawl' });
     assert.match(gait.message, /gait must be "walk" or "run"/);
-    const option = await failure(page, 'followPath', { points: BEND, speed: 2 });
+    const option = await failure(suite.page, 'followPath', { points: BEND, speed: 2 });
     assert.match(option.message, /unknown option "speed"/);
-    const lock = await failure(page, 'followPath', { points: BEND, footLock: 'yes' });
+    const lock = await failure(suite.page, 'followPath', { points: BEND, footLock: 'yes' });
     assert.match(lock.message, /footLock must be true or false/);
   });
 
   test('simulateControl turns to a new heading and holds the speed; compute is reported per frame', async () => {
-    const m = await page.evaluate(async () => {
+    const m = await suite.page.evaluate(async () => {
       const r = await window.playground.simulateControl({ seconds: 4, seed: 2, schedule: [{ t: 0, speed: 1.2, heading: 0 }, { t: 1, speed: 1.2, heading: Math.PI / 2 }] });
       return { frames: r.frames, speed: Array.from(r.speed), heading: Array.from(r.heading), computeMs: Array.from(r.computeMs), positions: Array.from(r.positions), joints: r.joints.length, contacts: r.contacts.length };
     });
@@ -114,12 +103,12 @@ describe('path following and live control in the page', { timeout: 300_000 }, ()
   });
 
   test('simulateControl refuses bad schedules', async () => {
-    const late = await failure(page, 'simulateControl', { seconds: 2, schedule: [{ t: 0.5, speed: 1, heading: 0 }] });
+    const late = await failure(suite.page, 'simulateControl', { seconds: 2, schedule: [{ t: 0.5, speed: 1, heading: 0 }] });
     assert.match(late.message, /^simulateControl: schedule\[0\]\.t must be 0/);
-    const fast = await failure(page, 'simulateControl', { seconds: 2, schedule: [{ t: 0, speed: 12, heading: 0 }] });
+    const fast = await failure(suite.page, 'simulateControl', { seconds: 2, schedule: [{ t: 0, speed: 12, heading: 0 }] });
     assert.match(fast.message, /speed must be a number from 0 to 4/);
-    const long = await failure(page, 'simulateControl', { seconds: 6000, schedule: [{ t: 0, speed: 1, heading: 0 }] });
+    const long = await failure(suite.page, 'simulateControl', { seconds: 6000, schedule: [{ t: 0, speed: 1, heading: 0 }] });
     assert.match(long.message, /seconds must be a number above 0 and at most 600/);
-    assert.deepEqual(problems, []);
+    assert.deepEqual(suite.problems, []);
   });
 });

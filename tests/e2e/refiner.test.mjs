@@ -4,8 +4,8 @@
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
-import { after, before, describe, test } from 'node:test';
-import { launchBrowser, openPlayground, ROOT, startServer } from './harness.mjs';
+import { describe, test } from 'node:test';
+import { openPlayground, ROOT, usePlayground } from './harness.mjs';
 
 const GENERATOR = JSON.parse(readFileSync(path.join(ROOT, 'public', 'models', 'generator.json'), 'utf8'));
 const REFERENCE = JSON.parse(readFileSync(path.join(ROOT, 'tests', 'fixtures', 'refiner_reference.json'), 'utf8'));
@@ -45,21 +45,10 @@ function footSkating(m) {
 const worstScaled = (a, b) => a.reduce((w, v, i) => Math.max(w, Math.abs(v - b[i]) / Math.max(1, Math.abs(b[i]))), 0);
 
 describe('refiner in the page', { timeout: 300_000 }, () => {
-  let server, url, browser, page, problems;
-
-  before(async () => {
-    ({ server, url } = await startServer());
-    browser = await launchBrowser();
-    ({ page, problems } = await openPlayground(browser, url));
-  });
-
-  after(async () => {
-    await browser?.close();
-    await server?.close();
-  });
+  const suite = usePlayground();
 
   test('generate with refine: shape, contacts, finite, deterministic, not the raw motion', async () => {
-    const m = await generate(page, { model: 'generator', frames: 300, seed: 4, refine: true });
+    const m = await generate(suite.page, { model: 'generator', frames: 300, seed: 4, refine: true });
     assert.equal(m.fps, 30);
     assert.equal(m.frames, 300);
     assert.deepEqual(m.joints, GENERATOR.skeleton.joints);
@@ -77,23 +66,23 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
     const travel = Math.hypot(m.positions[(299 * J + hips) * 3] - m.positions[hips * 3], m.positions[(299 * J + hips) * 3 + 2] - m.positions[hips * 3 + 2]);
     assert.ok(travel > 1, `the refined character walks (root travels ${travel.toFixed(2)} m)`);
 
-    const again = await generate(page, { model: 'generator', frames: 300, seed: 4, refine: true });
+    const again = await generate(suite.page, { model: 'generator', frames: 300, seed: 4, refine: true });
     assert.deepEqual(again.positions, m.positions, 'the same seed gives the same refined motion');
     assert.deepEqual(again.contacts, m.contacts);
-    const raw = await generate(page, { model: 'generator', frames: 300, seed: 4, refine: false });
+    const raw = await generate(suite.page, { model: 'generator', frames: 300, seed: 4, refine: false });
     assert.notDeepEqual(raw.positions, m.positions, 'refine: true is not the raw motion');
     // The same samples: both start from the same seed state at the origin, facing the same way.
     assert.ok(Math.hypot(raw.positions[0] - m.positions[0], raw.positions[2] - m.positions[2]) < 0.05);
-    const other = await generate(page, { model: 'generator', frames: 300, seed: 5, refine: true });
+    const other = await generate(suite.page, { model: 'generator', frames: 300, seed: 5, refine: true });
     assert.notDeepEqual(other.positions, m.positions, 'another seed gives another refined motion');
-    assert.equal(await page.evaluate(() => window.playground.current()), null, 'generate does not show the motion');
+    assert.equal(await suite.page.evaluate(() => window.playground.current()), null, 'generate does not show the motion');
   });
 
   test('refined + foot lock skates far less than the raw motion (same seeds)', async () => {
     const rows = [];
     for (const seed of [0, 1, 2]) {
-      const raw = footSkating(await generate(page, { model: 'generator', frames: 900, seed }));
-      const refined = footSkating(await generate(page, { model: 'generator', frames: 900, seed, refine: true }));
+      const raw = footSkating(await generate(suite.page, { model: 'generator', frames: 900, seed }));
+      const refined = footSkating(await generate(suite.page, { model: 'generator', frames: 900, seed, refine: true }));
       rows.push({ seed, raw, refined });
     }
     const mean = (k) => rows.reduce((a, r) => a + r[k], 0) / rows.length;
@@ -104,7 +93,7 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
   });
 
   test('refiner parity in the browser: the fixture steps within 1e-4, and the end effectors', async () => {
-    const results = await page.evaluate(async (ref) => {
+    const results = await suite.page.evaluate(async (ref) => {
       const { GeneratorClient } = await import('/runtime/generatorClient.ts');
       const client = new GeneratorClient({ threads: 1 });
       try {
@@ -134,7 +123,7 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
   });
 
   test('bad refine values reject with clear messages and leave the scene as it was', async () => {
-    const r = await page.evaluate(async () => {
+    const r = await suite.page.evaluate(async () => {
       const pg = window.playground;
       const messages = [];
       for (const refine of ['yes', 1, null]) {
@@ -156,7 +145,7 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
   });
 
   test('a refiner that cannot load gives a message, and works once it can', async () => {
-    const fresh = await openPlayground(browser, url);
+    const fresh = await openPlayground(suite.browser, suite.url);
     try {
       await fresh.context.route('**/models/refiner.onnx', (route) => route.fulfill({ status: 404, body: 'not here' }));
       const failed = await fresh.page.evaluate(async () => {
@@ -184,7 +173,7 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
 
   test('Random walk: refine toggle, side-by-side view and the skating readout', async () => {
     const status = () =>
-      page.evaluate(() => {
+      suite.page.evaluate(() => {
         const s = document.getElementById('walk-status');
         const card = document.getElementById('walk-skating');
         const labels = [...document.querySelectorAll('.figure-label')].filter((l) => !l.hidden).map((l) => ({ text: l.textContent, box: l.getBoundingClientRect().toJSON() }));
@@ -204,9 +193,9 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
         };
       });
     const waitFrame = (n, text = '') =>
-      page.waitForFunction(([n, text]) => Number(document.getElementById('walk-status').dataset.frame) > n && document.getElementById('walk-status').textContent.includes(text), [n, text], { timeout: 90_000 });
+      suite.page.waitForFunction(([n, text]) => Number(document.getElementById('walk-status').dataset.frame) > n && document.getElementById('walk-status').textContent.includes(text), [n, text], { timeout: 90_000 });
 
-    await page.click('#mode-walk');
+    await suite.page.click('#mode-walk');
     await waitFrame(60);
     let s = await status();
     assert.equal(s.card, 'block', 'the skating readout shows in Random walk mode');
@@ -217,8 +206,8 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
     assert.doesNotMatch(s.text, /refined/);
 
     // Refine: the stream restarts refined; one figure, the refined readout.
-    await page.check('#walk-refine');
-    await page.waitForFunction(() => /refined/.test(document.getElementById('walk-status').textContent), null, { timeout: 60_000 });
+    await suite.page.check('#walk-refine');
+    await suite.page.waitForFunction(() => /refined/.test(document.getElementById('walk-status').textContent), null, { timeout: 60_000 });
     await waitFrame(90, 'refined');
     s = await status();
     assert.equal(s.skating.shown, 'refined');
@@ -227,7 +216,7 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
     assert.equal(s.skating.raw, '');
     assert.equal(s.labels.length, 0, 'no side-by-side labels yet');
     assert.match(s.meta, /generator \+ refiner/);
-    const shown = await page.evaluate(() => {
+    const shown = await suite.page.evaluate(() => {
       const m = window.playground.current();
       return { joints: m.joints.length, contacts: m.contacts.length === m.frames * 2, finite: Array.from(m.positions).every(Number.isFinite) };
     });
@@ -235,9 +224,9 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
 
     // Side by side: no restart (the refined stream carries the raw frames), both figures labelled, both numbers.
     const before = s.frame;
-    await page.check('#walk-side-by-side');
-    await page.waitForFunction(() => /side by side/.test(document.getElementById('walk-status').textContent) && document.querySelectorAll('.figure-label:not([hidden])').length === 2, null, { timeout: 20_000 });
-    await page.waitForTimeout(3000);
+    await suite.page.check('#walk-side-by-side');
+    await suite.page.waitForFunction(() => /side by side/.test(document.getElementById('walk-status').textContent) && document.querySelectorAll('.figure-label:not([hidden])').length === 2, null, { timeout: 20_000 });
+    await suite.page.waitForTimeout(3000);
     s = await status();
     assert.ok(s.frame > before, `the walk went on (frame ${before} → ${s.frame})`);
     assert.equal(s.skating.shown, 'both');
@@ -251,18 +240,18 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
     assert.ok(rawLabel.box.x < refinedLabel.box.x, 'the raw figure is on the left');
 
     // Side by side off: one figure again, same stream.
-    await page.uncheck('#walk-side-by-side');
-    await page.waitForFunction(() => document.querySelectorAll('.figure-label').length === 0, null, { timeout: 10_000 });
+    await suite.page.uncheck('#walk-side-by-side');
+    await suite.page.waitForFunction(() => document.querySelectorAll('.figure-label').length === 0, null, { timeout: 10_000 });
     s = await status();
     assert.equal(s.refine, true);
     assert.equal(s.skating.shown, 'refined');
 
     // Refine off (turns side by side off too): back to the raw generator.
-    await page.check('#walk-side-by-side');
-    await page.waitForFunction(() => document.querySelectorAll('.figure-label').length === 2, null, { timeout: 10_000 });
-    await page.uncheck('#walk-refine');
-    assert.equal(await page.evaluate(() => document.querySelectorAll('.figure-label').length), 0, 'the raw figure goes at once');
-    await page.waitForFunction(() => {
+    await suite.page.check('#walk-side-by-side');
+    await suite.page.waitForFunction(() => document.querySelectorAll('.figure-label').length === 2, null, { timeout: 10_000 });
+    await suite.page.uncheck('#walk-refine');
+    assert.equal(await suite.page.evaluate(() => document.querySelectorAll('.figure-label').length), 0, 'the raw figure goes at once');
+    await suite.page.waitForFunction(() => {
       const s = document.getElementById('walk-status');
       return /τ/.test(s.textContent) && !/refined/.test(s.textContent) && Number(s.dataset.frame) > 30;
     }, null, { timeout: 60_000 });
@@ -271,8 +260,8 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
     assert.equal(s.labels.length, 0);
     assert.equal(s.skating.shown, 'raw');
 
-    await page.click('#mode-clip');
-    assert.equal(await page.evaluate(() => getComputedStyle(document.getElementById('walk-skating')).display), 'none');
-    assert.deepEqual(problems, [], 'no console errors');
+    await suite.page.click('#mode-clip');
+    assert.equal(await suite.page.evaluate(() => getComputedStyle(document.getElementById('walk-skating')).display), 'none');
+    assert.deepEqual(suite.problems, [], 'no console errors');
   });
 });

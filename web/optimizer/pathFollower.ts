@@ -242,10 +242,10 @@ export async function followPath(o: FollowPathOptions): Promise<FollowPathResult
     // Keep the first 17 frames, or fewer if the best particle reaches the end before.
     const { result, b } = best;
     let keep = COMMIT_FRAMES, s = arc, finished = false;
+    const [ex, ez] = path.pointAt(path.length);
     for (let t = 0; t < WINDOW_FRAMES; t++) {
       const i = (b * WINDOW_FRAMES + t) * 3;
       s = trackArc(path, result.roots[i], result.roots[i + 1], s);
-      const [ex, ez] = path.pointAt(path.length);
       if (s >= path.length - 0.05 || (path.length - s < 0.3 && Math.hypot(result.roots[i] - ex, result.roots[i + 1] - ez) < 0.1)) {
         if (t < COMMIT_FRAMES) {
           keep = t + 1;

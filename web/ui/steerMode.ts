@@ -5,6 +5,7 @@
 // A mint arrow on the ground at the character shows the target heading; the readout at the top left
 // compares target and achieved speed.
 
+import { angleDifference } from '../optimizer/path';
 import type { ControlledMotion, GeneratorClient } from '../runtime/generatorClient';
 import { GroundArrow, TARGET_COLOR } from '../viewer/groundPath';
 import type { App } from './app';
@@ -50,12 +51,7 @@ const KEYS: Record<string, 'left' | 'right' | 'up' | 'down'> = {
   ArrowDown: 'down', s: 'down', S: 'down',
 };
 
-/** Angle wrapped to (−π, π]. */
-function wrap(a: number): number {
-  return a - 2 * Math.PI * Math.ceil((a - Math.PI) / (2 * Math.PI));
-}
-
-const degrees = (a: number) => Math.round((wrap(a) * 180) / Math.PI);
+const degrees = (a: number) => Math.round((angleDifference(a, 0) * 180) / Math.PI);
 
 export class SteerMode extends LiveMode<ControlledMotion> {
   private readonly gait = $<HTMLSelectElement>('steer-gait');
@@ -227,7 +223,7 @@ export class SteerMode extends LiveMode<ControlledMotion> {
     const ox = camera.position.x - controls.target.x, oz = camera.position.z - controls.target.z;
     const current = Math.atan2(ox, oz);
     const wanted = facing + Math.PI + CHASE_SIDE;
-    const turn = wrap(wanted - current) * (1 - Math.exp(-dt * CHASE_RATE));
+    const turn = angleDifference(wanted, current) * (1 - Math.exp(-dt * CHASE_RATE));
     if (Math.abs(turn) < 1e-5) return;
     const c = Math.cos(turn), s = Math.sin(turn);
     // A turn about +y by `turn`: (x, z) → (x cos + z sin, −x sin + z cos).
@@ -326,7 +322,7 @@ export class SteerMode extends LiveMode<ControlledMotion> {
     this.lastTick = now;
     const turn = (this.held.has('left') ? 1 : 0) - (this.held.has('right') ? 1 : 0);
     // Left turns the character to its own left: from +z toward +x, a growing heading.
-    if (turn) this.heading = wrap(this.heading + turn * TURN_RATE * dt);
+    if (turn) this.heading = angleDifference(this.heading + turn * TURN_RATE * dt, 0);
     const faster = (this.held.has('up') ? 1 : 0) - (this.held.has('down') ? 1 : 0);
     if (faster) this.setSpeed(this.cruise + faster * SPEED_RATE * dt);
     this.pollGamepad();
