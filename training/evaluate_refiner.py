@@ -407,16 +407,18 @@ def write_markdown(r: dict) -> None:
         f"Trained {t['r_updates']} refiner / {t['d_updates']} discriminator updates in {t['minutes']:.0f} minutes on one CPU core "
         "(`python -m training.train_refiner`; recipe and deviations in its docstring and below).",
         "",
-        f"ONNX: {ref['bytes'] / 1e6:.2f} MB (the generator: {r['generator_bytes'] / 1e6:.2f} MB), a gate-level graph written with "
-        "onnx.helper; parity with torch's sequence forward "
-        f"{ref['parity']['max_abs_diff']:.1e} and with the torch step {ref['parity']['step_max_abs_diff']:.1e} "
-        f"(|a − b| / max(1, |a|), batches 1 and 7, {ref['parity']['steps']} steps). Cost in onnxruntime Python (1 thread): "
-        f"{cost['batch1']['refiner_ms']:.3f} ms per step at batch 1 against the generator's {cost['batch1']['generator_ms']:.3f} ms "
+        f"ONNX: {ref['bytes'] / 1e6:.2f} MB (the generator: {r['generator_bytes'] / 1e6:.2f} MB), a graph written with "
+        "onnx.helper that refines a chunk of T frames per call (one ONNX LSTM node; T = 1 is the streaming step); "
+        f"parity with torch's sequence forward {ref['parity']['max_abs_diff']:.1e} (whole sequence, one frame and 7 frames "
+        f"per call) and with the torch step {ref['parity']['step_max_abs_diff']:.1e} "
+        f"(|a − b| / max(1, |a|), batches 1 and 7, {ref['parity']['steps']} steps). Cost in onnxruntime Python (1 thread, "
+        "the refiner in calls of 15 frames, the generator one call per frame): "
+        f"{cost['batch1']['refiner_ms']:.3f} ms per frame at batch 1 against the generator's {cost['batch1']['generator_ms']:.3f} ms "
         f"({100 * cost['batch1']['ratio']:.0f}%); batch 64: {cost['batch64']['refiner_ms']:.3f} vs {cost['batch64']['generator_ms']:.3f} ms "
         f"({100 * cost['batch64']['ratio']:.0f}%). The end-effector positions are computed by the caller (the browser's "
         "decoder does the forward kinematics anyway); the graph does the velocities and everything else. An export "
         "with the forward kinematics inside the graph (torch's exporter, 507 nodes) cost 0.82 ms against the "
-        "generator's 0.36 ms, more than twice the generator; the shipped graph has 25 nodes.",
+        "generator's 0.36 ms, more than twice the generator; the shipped graph has 20 nodes.",
         "",
         "## Training runs and deviations from the paper", "",
         "Recorded by hand from `runs/<name>/train.log` (validation on 256 held-out generated windows of 90 frames; "

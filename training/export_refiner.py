@@ -1,25 +1,26 @@
-"""Export the trained refiner R as a causal streaming step (ONNX) plus its JSON, parity-checked.
+"""Export the trained refiner R as a causal streaming model (ONNX) plus its JSON, parity-checked.
 
     python -m training.export_refiner [--checkpoint runs/refiner/shipped.pt]
     python -m training.export_refiner --checkpoint runs/refiner/checkpoint.pt --recover runs/refiner/shipped.pt
         (rebuild the torch checkpoint of the shipped export; see refiner_from_onnx)
 
-public/models/refiner.onnx: one step, inputs
-    x          (B, D)    the generator's newest frame, normalised (generator.json normalisation), contacts
-                         as the generator feeds them back (clean 0/1 bits, normalised);
-    ends       (B, 3E)   root-frame positions (metres) of the E end effectors of that raw frame;
-    ends_prev  (B, 3E)   the same for the raw frame before it (for the first generated frame: the seed frame);
-    h, c       (1, B, H) R's LSTM state (zeros at the start of a stream);
-outputs x_refined (B, D) normalised (same layout, contacts included), h_out, c_out. The batch is dynamic.
+public/models/refiner.onnx: T frames per call (T dynamic; T = 1 is a single streaming step), inputs
+    x          (B, T, D)  the generator's newest frames, normalised (generator.json normalisation), contacts
+                          as the generator feeds them back (clean 0/1 bits, normalised);
+    ends       (B, T, 3E) root-frame positions (metres) of the E end effectors of those raw frames;
+    ends_prev  (B, 3E)    the same for the raw frame before the first (after a seed: the seed frame);
+    h, c       (1, B, H)  R's LSTM state (zeros at the start of a stream);
+outputs x_refined (B, T, D) normalised (same layout, contacts included), h_out, c_out after the last frame.
+R is causal, so refining a chunk in one call gives what T single steps give. The batch is dynamic.
 "Root frame": q = R_y(-yaw) (p - (root_x, 0, root_z)) for world positions p of the decoded frame, with
 yaw the frame's heading (after its own dry), i.e. positions relative to the root's ground point with the
 heading removed and y the height above the floor (models/refiner.py FeatureGeometry.end_positions).
 
-The graph is written directly with onnx.helper (step_graph): the velocities v = fps (step + R_y(dry) q - q_prev)
-and the input normalisation are folded into FC1's weights (FC1 acts on [x, q, q_prev, cos(dry) q, sin(dry) q]),
-the LSTM is written at gate level, and the residual is FC2's Gemm plus x. Also writes public/models/refiner.json,
-the manifest entry and tests/fixtures/refiner_reference.json (a few streamed steps at batch 2, for the
-browser's parity test and its end-effector computation).
+The graph is written directly with onnx.helper (sequence_graph): the velocities v = fps (step + R_y(dry) q -
+q_prev) and the input normalisation are folded into FC1's weights (FC1 acts on [x, q, q_prev, cos(dry) q,
+sin(dry) q]), the LSTM is one ONNX LSTM node, and the residual is FC2 plus x. Also writes
+public/models/refiner.json, the manifest entry and tests/fixtures/refiner_reference.json (two calls at
+batch 2, for the browser's parity test and its end-effector computation).
 """
 from __future__ import annotations
 
@@ -44,7 +45,7 @@ from .runs import RUNS_DIR
 
 INPUTS, OUTPUTS = ["x", "ends", "ends_prev", "h", "c"], ["x_refined", "h_out", "c_out"]
 PARITY_TOLERANCE = 1e-4
-GATE_ORDER = [0, 1, 3, 2]  # graph gate blocks (i, f, o, g) from PyTorch's (i, f, g, o)
+GATE_ORDER = [0, 3, 1, 2]  # the ONNX LSTM node's gate blocks (i, o, f, c) from PyTorch's (i, f, g, o)
 FIXTURE = REPO_ROOT / "tests" / "fixtures" / "refiner_reference.json"
 
 
@@ -85,7 +86,10 @@ def folded_fc1(model: Refiner) -> tuple[np.ndarray, np.ndarray]:
     return weights.astype(np.float32), bias.astype(np.float32)
 
 
-def step_graph(model: Refiner) -> onnx.ModelProto:
+def sequence_graph(model: Refiner) -> onnx.ModelProto:
+    """R over T frames in one call (T dynamic; T = 1 is the streaming step): FC1 and FC2 as MatMuls over
+    (B, T, .), the LSTM as one ONNX LSTM node. One call per generated chunk instead of one per frame: in
+    onnxruntime-web a call's fixed cost is about that of R's arithmetic for a whole chunk."""
     H, D, E3 = model.hidden, model.dim, 3 * model.ends
     sd = {k: v.detach().cpu().numpy().astype(np.float32) for k, v in model.state_dict().items()}
     builder = GraphBuilder()
@@ -94,42 +98,41 @@ def step_graph(model: Refiner) -> onnx.ModelProto:
     def gates(w):
         return w.reshape(4, H, *w.shape[1:])[GATE_ORDER].reshape(4 * H, *w.shape[1:])
 
-    # dry (physical) as a one-column Gemm of x, then its cosine and sine
+    # q_prev per frame: ends_prev (the frame before the first), then ends without its last frame
+    first = node("Unsqueeze", ["ends_prev", const("axis1", np.array([1], np.int64))], ["ends_first"])
+    earlier = node("Slice", ["ends", const("slice_start", np.array([0], np.int64)), const("slice_end", np.array([-1], np.int64)),
+                             "axis1"], ["ends_earlier"])
+    q_prev = node("Concat", [first, earlier], ["q_prev"], axis=1)
+    # dry (physical) per frame as a one-column MatMul of x, then its cosine and sine
     pick = np.zeros((D, 1), np.float32)
     pick[2, 0] = model.std[2].item()
-    dry = node("Gemm", ["x", const("dry_pick", pick), const("dry_mean", np.array([model.mean[2].item()], np.float32))], ["dry"])
+    dry = node("Add", [node("MatMul", ["x", const("dry_pick", pick)], ["dry_scaled"]),
+                       const("dry_mean", np.array([model.mean[2].item()], np.float32))], ["dry"])
     cq = node("Mul", ["ends", node("Cos", [dry], ["cos_dry"])], ["cos_q"])
     sq = node("Mul", ["ends", node("Sin", [dry], ["sin_dry"])], ["sin_q"])
-    z = node("Concat", ["x", "ends", "ends_prev", cq, sq], ["fc1_in"], axis=1)
+    z = node("Concat", ["x", "ends", q_prev, cq, sq], ["fc1_in"], axis=2)
     w1, b1 = folded_fc1(model)
-    y = node("Relu", [node("Gemm", [z, const("fc1.weight_t", w1.T), const("fc1.bias", b1)], ["fc1"])], ["fc1_relu"])
-    rows = const("rows", np.array([-1, H], np.int64))
-    h0 = node("Reshape", ["h", rows], ["h_rows"])
-    c0 = node("Reshape", ["c", rows], ["c_rows"])
-    b = sd["lstm.bias_ih_l0"] + sd["lstm.bias_hh_l0"]
-    rec = node("Gemm", [h0, const("lstm_hh.weight_t", gates(sd["lstm.weight_hh_l0"]).T), const("lstm.bias", gates(b))], ["rec"])
-    pre = node("Gemm", [y, const("lstm_ih.weight_t", gates(sd["lstm.weight_ih_l0"]).T), rec], ["gates"])
-    sig_in, tanh_in = node("Split", [pre, const("gate_split", np.array([3 * H, H], np.int64))], ["sig_in", "tanh_in"], axis=1)
-    i, f, o = node("Split", [node("Sigmoid", [sig_in], ["sig"]), const("ifo_split", np.array([H, H, H], np.int64))],
-                   ["i", "f", "o"], axis=1)
-    g = node("Tanh", [tanh_in], ["g"])
-    c2 = node("Add", [node("Mul", [f, c0], ["f_c"]), node("Mul", [i, g], ["i_g"])], ["c_new"])
-    h2 = node("Mul", [o, node("Tanh", [c2], ["tanh_c"])], ["h_new"])
-    state = const("state_shape", np.array([1, -1, H], np.int64))
-    node("Reshape", [h2, state], ["h_out"])
-    node("Reshape", [c2, state], ["c_out"])
-    delta = node("Gemm", [h2, const("fc2.weight_t", sd["fc2.weight"].T), "x"], ["fc2_plus_x"])
-    node("Add", [delta, const("fc2.bias", sd["fc2.bias"])], ["x_refined"])
+    y = node("Relu", [node("Add", [node("MatMul", [z, const("fc1.weight_t", w1.T)], ["fc1_mm"]), const("fc1.bias", b1)],
+                           ["fc1"])], ["fc1_relu"])
+    y_tb = node("Transpose", [y], ["fc1_tb"], perm=[1, 0, 2])  # (T, B, F): the LSTM node's layout
+    w_ih, w_hh = gates(sd["lstm.weight_ih_l0"])[None], gates(sd["lstm.weight_hh_l0"])[None]
+    bias = np.concatenate([gates(sd["lstm.bias_ih_l0"]), gates(sd["lstm.bias_hh_l0"])])[None]
+    seq = node("LSTM", [y_tb, const("lstm.W", w_ih), const("lstm.R", w_hh), const("lstm.B", bias), "", "h", "c"],
+               ["lstm_y", "h_out", "c_out"], hidden_size=H)
+    hs = node("Transpose", [node("Squeeze", [seq[0], "axis1"], ["lstm_y_tbh"])], ["lstm_h_bt"], perm=[1, 0, 2])
+    delta = node("Add", [node("MatMul", [hs, const("fc2.weight_t", sd["fc2.weight"].T)], ["fc2_mm"]), const("fc2.bias", sd["fc2.bias"])],
+                 ["fc2"])
+    node("Add", [delta, "x"], ["x_refined"])
 
-    return builder.model("refiner_step",
-        [("x", ["batch", D]), ("ends", ["batch", E3]), ("ends_prev", ["batch", E3]),
+    return builder.model("refiner_sequence",
+        [("x", ["batch", "frames", D]), ("ends", ["batch", "frames", E3]), ("ends_prev", ["batch", E3]),
          ("h", [1, "batch", H]), ("c", [1, "batch", H])],
-        [("x_refined", ["batch", D]), ("h_out", [1, "batch", H]), ("c_out", [1, "batch", H])],
+        [("x_refined", ["batch", "frames", D]), ("h_out", [1, "batch", H]), ("c_out", [1, "batch", H])],
         "training.export_refiner")
 
 
 def export_onnx(model: Refiner, path: Path) -> None:
-    onnx.save(step_graph(model.eval()), str(path))
+    onnx.save(sequence_graph(model.eval()), str(path))
 
 
 def stream_inputs(model: Refiner, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -139,28 +142,35 @@ def stream_inputs(model: Refiner, x: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return q.flatten(-2).numpy()
 
 
-def parity_error(model: Refiner, path: Path, frames: np.ndarray, batches=(1, 7)) -> float:
+def parity_error(model: Refiner, path: Path, frames: np.ndarray, batches=(1, 7), chunks=(None, 1, 7)) -> float:
     """Largest |torch - onnxruntime| / max(1, |torch|) over all outputs, streaming `frames` (N, T + 1, D)
-    (normalised, frame 0 = the frame before) step by step from a zero state: torch's full-sequence forward
-    (nn.LSTM, FK in torch) against the ONNX step fed the same ends."""
+    (normalised, frame 0 = the frame before) from a zero state in calls of `chunk` frames (None: all at once,
+    the rest of the sequence after the last whole chunk in a shorter call): torch's full-sequence forward
+    (nn.LSTM, FK in torch) against the ONNX graph fed the same ends."""
     session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
     worst = 0.0
     for batch in batches:
         x = frames[:batch]
         q = stream_inputs(model, x)
         with torch.no_grad():
-            ref, _ = model(torch.from_numpy(x[:, 1:]), torch.from_numpy(x[:, 0]))
+            ref, (ref_h, ref_c) = model(torch.from_numpy(x[:, 1:]), torch.from_numpy(x[:, 0]))
         ref = ref.numpy()
-        h = np.zeros((1, batch, model.hidden), np.float32)
-        c = h.copy()
-        for t in range(1, x.shape[1]):
-            out, h, c = session.run(OUTPUTS, {"x": x[:, t], "ends": q[:, t], "ends_prev": q[:, t - 1], "h": h, "c": c})
-            worst = max(worst, float((np.abs(out - ref[:, t - 1]) / np.maximum(1.0, np.abs(ref[:, t - 1]))).max()))
+        scaled = lambda a, b: float((np.abs(a - b) / np.maximum(1.0, np.abs(b))).max())
+        for chunk in chunks:
+            h = np.zeros((1, batch, model.hidden), np.float32)
+            c = h.copy()
+            t, total = 1, x.shape[1]
+            while t < total:
+                n = total - t if chunk is None else min(chunk, total - t)
+                out, h, c = session.run(OUTPUTS, {"x": x[:, t:t + n], "ends": q[:, t:t + n], "ends_prev": q[:, t - 1], "h": h, "c": c})
+                worst = max(worst, scaled(out, ref[:, t - 1:t - 1 + n]))
+                t += n
+            worst = max(worst, scaled(h, ref_h.numpy()), scaled(c, ref_c.numpy()))
     return worst
 
 
 def step_parity(model: Refiner, path: Path, frames: np.ndarray) -> float:
-    """The same against torch's RefinerStep (the step form) with states fed forward from torch."""
+    """The graph at one frame per call against torch's RefinerStep (the step form) with states fed forward from torch."""
     session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
     step = RefinerStep(model).eval()
     x = frames[:5]
@@ -172,7 +182,8 @@ def step_parity(model: Refiner, path: Path, frames: np.ndarray) -> float:
         feed = {"x": x[:, t], "ends": q[:, t], "ends_prev": q[:, t - 1], "h": h, "c": c}
         with torch.no_grad():
             ref = [a.numpy() for a in step(*(torch.from_numpy(feed[k]) for k in INPUTS))]
-        got = session.run(OUTPUTS, feed)
+        got = session.run(OUTPUTS, dict(feed, x=x[:, t:t + 1], ends=q[:, t:t + 1]))
+        got[0] = got[0][:, 0]
         worst = max(worst, max(float(np.abs(a - b).max()) for a, b in zip(ref, got)))
         h, c = ref[1], ref[2]
     return worst
@@ -195,56 +206,61 @@ def time_steps(path: Path, batch: int, inputs_fn, repeats: int = 3000) -> float:
     return float(np.median(runs))
 
 
-def measure_cost(refiner_path: Path, generator_path: Path, model: Refiner, gen_hidden: int) -> dict:
+def measure_cost(refiner_path: Path, generator_path: Path, model: Refiner, gen_hidden: int, chunk: int = 15) -> dict:
+    """Refiner against generator cost per frame: the generator one call per frame, the refiner one call per
+    `chunk` frames (as the browser calls it, a generated chunk at a time)."""
     rng = np.random.default_rng(0)
     D, E3, H = model.dim, 3 * model.ends, model.hidden
-    r_in = lambda b: {"x": rng.normal(size=(b, D)).astype(np.float32), "ends": rng.normal(size=(b, E3)).astype(np.float32),
+    r_in = lambda b: {"x": rng.normal(size=(b, chunk, D)).astype(np.float32), "ends": rng.normal(size=(b, chunk, E3)).astype(np.float32),
                       "ends_prev": rng.normal(size=(b, E3)).astype(np.float32),
                       "h": np.zeros((1, b, H), np.float32), "c": np.zeros((1, b, H), np.float32)}
     g_in = lambda b: {"x": rng.normal(size=(b, D)).astype(np.float32), "h": np.zeros((2, b, gen_hidden), np.float32),
                       "c": np.zeros((2, b, gen_hidden), np.float32)}
-    out = {"measure": "onnxruntime Python, 1 thread, mean ms per session.run (median of 5 runs, interleaved)"}
+    out = {"measure": f"onnxruntime Python, 1 thread, mean ms per frame (median of 5 runs, interleaved); the refiner "
+                      f"in calls of {chunk} frames, the generator one call per frame"}
     for b in (1, 64):
         r, g = [], []
         for _ in range(2):  # interleaved, so both see the same machine load
-            r.append(time_steps(refiner_path, b, r_in))
+            r.append(time_steps(refiner_path, b, r_in, repeats=600) / chunk)
             g.append(time_steps(generator_path, b, g_in))
         out[f"batch{b}"] = {"refiner_ms": min(r), "generator_ms": min(g), "ratio": min(r) / min(g)}
     return out
 
 
 def write_fixture(model: Refiner, path: Path, frames: np.ndarray, info: dict) -> None:
-    """Two streams of 4 steps: inputs (x, ends, ends_prev, h, c) and outputs per step, plus the physical frames
-    the ends come from (for testing the browser's end-effector computation)."""
+    """Two streams of 4 frames in two calls (frames 1-3, then frame 4 from the first call's state): inputs
+    (x, ends, ends_prev, h, c) and outputs per call, plus the physical frames the ends come from (for testing
+    the browser's end-effector computation)."""
     session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
     x = frames[:2, :5]
     q = stream_inputs(model, x)
     mean, std = model.mean.numpy(), model.std.numpy()
     h = np.zeros((1, 2, model.hidden), np.float32)
     c = h.copy()
-    steps = []
-    for t in range(1, x.shape[1]):
-        feed = {"x": x[:, t], "ends": q[:, t], "ends_prev": q[:, t - 1], "h": h, "c": c}
+    calls = []
+    for t, n in ((1, 3), (4, 1)):
+        feed = {"x": x[:, t:t + n], "ends": q[:, t:t + n], "ends_prev": q[:, t - 1], "h": h, "c": c}
         out, h2, c2 = session.run(OUTPUTS, feed)
-        steps.append({"inputs": {k: np.asarray(v).ravel().tolist() for k, v in feed.items()},
+        calls.append({"frames": n, "inputs": {k: np.asarray(v).ravel().tolist() for k, v in feed.items()},
                       "outputs": {"x_refined": out.ravel().tolist(), "h_out": h2.ravel().tolist(), "c_out": c2.ravel().tolist()}})
         h, c = h2, c2
     FIXTURE.write_text(json.dumps({
         "model": info["file"], "batch": 2, "hidden": model.hidden, "dim": model.dim, "end_effectors": info["end_effectors"]["names"],
         "frames_normalised": x.ravel().tolist(), "frames_physical": (x * std + mean).ravel().tolist(), "frames": x.shape[1],
-        "ends": q.ravel().tolist(), "steps": steps,
+        "ends": q.ravel().tolist(), "calls": calls,
         "note": "frames_* are (batch 2, 5 frames, dim); ends (2, 5, 3E) are their root-frame end-effector positions; "
-                "step k feeds frame k + 1 with ends_prev from frame k, states from step k - 1 (zeros first)."}) + "\n")
+                "call 1 feeds frames 1-3 (x (2, 3, dim)) with ends_prev from frame 0 and zero states, call 2 feeds "
+                "frame 4 with ends_prev from frame 3 and call 1's states."}) + "\n")
     print(f"wrote {FIXTURE}")
 
 
 def refiner_from_onnx(path: Path, meta: dict) -> Refiner:
-    """The torch Refiner computing what an export of step_graph computes: FC1 unfolded from the folded weights
+    """The torch Refiner computing what an export of sequence_graph computes: FC1 unfolded from the folded weights
     (the end-effector normalisation comes from `meta`, any run's; the function does not depend on it), the
     LSTM gates back in PyTorch's order, the summed LSTM bias as bias_ih."""
     inits = {t.name: numpy_helper.to_array(t).astype(np.float64) for t in onnx.load(str(path)).graph.initializer}
     model = Refiner(np.array(meta["mean"]), np.array(meta["std"]), np.array(meta["references"]),
-                    inits["lstm_hh.weight_t"].shape[0], np.array(meta["end_mean"]), np.array(meta["end_std"]), fps=meta["fps"])
+                    inits["lstm.R"].shape[-1], np.array(meta["end_mean"]), np.array(meta["end_std"]), fps=meta["fps"])
     g, D, E3, H = model.geometry, model.dim, 3 * model.ends, model.hidden
     std, mean = np.array(meta["std"]), np.array(meta["mean"])
     em, es = np.array(meta["end_mean"]), np.array(meta["end_std"])
@@ -258,10 +274,12 @@ def refiner_from_onnx(path: Path, meta: dict) -> Refiner:
     wq = wq_f - g.fps * wv @ My
     wx[:, 0:2] -= g.fps * wv @ P * std[0:2]
     bias = inits["fc1.bias"] + wq @ em[:E3] + wv @ em[E3:] - g.fps * wv @ P @ mean[0:2]
-    ungate = lambda a: a.reshape(4, H, *a.shape[1:])[GATE_ORDER].reshape(4 * H, *a.shape[1:])  # its own inverse
+    inverse = np.argsort(GATE_ORDER)
+    ungate = lambda a: a.reshape(4, H, *a.shape[1:])[inverse].reshape(4 * H, *a.shape[1:])
+    lstm_b = inits["lstm.B"][0]
     sd = {"fc1.weight": np.concatenate([wx, wq * es[:E3], wv * es[E3:]], axis=1), "fc1.bias": bias,
-          "lstm.weight_ih_l0": ungate(inits["lstm_ih.weight_t"].T), "lstm.weight_hh_l0": ungate(inits["lstm_hh.weight_t"].T),
-          "lstm.bias_ih_l0": ungate(inits["lstm.bias"]), "lstm.bias_hh_l0": np.zeros(4 * H),
+          "lstm.weight_ih_l0": ungate(inits["lstm.W"][0]), "lstm.weight_hh_l0": ungate(inits["lstm.R"][0]),
+          "lstm.bias_ih_l0": ungate(lstm_b[:4 * H]), "lstm.bias_hh_l0": ungate(lstm_b[4 * H:]),
           "fc2.weight": inits["fc2.weight_t"].T, "fc2.bias": inits["fc2.bias"]}
     state = model.state_dict()
     for k, v in sd.items():
@@ -284,7 +302,7 @@ def recover_checkpoint(onnx_path: Path, meta_checkpoint: Path, info_json: Path, 
     export_onnx(model, tmp)
     rng = np.random.default_rng(0)
     a, b = (ort.InferenceSession(str(p), providers=["CPUExecutionProvider"]) for p in (onnx_path, tmp))
-    feed = {"x": rng.normal(size=(5, model.dim)).astype(np.float32), "ends": rng.normal(size=(5, 3 * model.ends)).astype(np.float32),
+    feed = {"x": rng.normal(size=(5, 4, model.dim)).astype(np.float32), "ends": rng.normal(size=(5, 4, 3 * model.ends)).astype(np.float32),
             "ends_prev": rng.normal(size=(5, 3 * model.ends)).astype(np.float32),
             "h": rng.normal(size=(1, 5, model.hidden)).astype(np.float32), "c": rng.normal(size=(1, 5, model.hidden)).astype(np.float32)}
     diff = max(float(np.abs(u - v).max()) for u, v in zip(a.run(OUTPUTS, feed), b.run(OUTPUTS, feed)))
@@ -333,24 +351,27 @@ def main(argv: list[str] | None = None) -> None:
         "id": "refiner", "kind": "refiner", "fps": meta["fps"], "file": "refiner.onnx", "bytes": onnx_path.stat().st_size,
         "pairs_with": "generator",
         "description": "Adversarial refiner (Wang, Chai, Xia §4.2): FC + LSTM + FC with a residual connection over the "
-                       "generator's frames and their end-effector positions and velocities; causal, one step per frame.",
+                       "generator's frames and their end-effector positions and velocities; causal, a chunk of frames per call (state in, state out).",
         "onnx": {"inputs": INPUTS, "outputs": OUTPUTS, "opset": OPSET, "hidden": model.hidden, "dim": model.dim,
                  "ends": 3 * model.ends, "state_shape": [1, "batch", model.hidden],
+                 "shapes": {"x": ["batch", "frames", model.dim], "ends": ["batch", "frames", 3 * model.ends],
+                            "ends_prev": ["batch", 3 * model.ends], "x_refined": ["batch", "frames", model.dim]},
                  "graph": "FC1 over [x, ends, ends_prev, cos(dry) ends, sin(dry) ends] (velocities and normalisation folded "
-                          "in), gate-level LSTM, FC2 + x"},
+                          "in), one ONNX LSTM node over the frames, FC2 + x"},
         "end_effectors": {
             "names": g.end_names, "joints": g.end_index,
             "frame": "root frame: q = R_y(-yaw) (p - (root_x, 0, root_z)) per end effector, p the world position of the "
                      "decoded raw generator frame, yaw its heading (after its dry); q[1] = height above the floor. "
                      "Equivalently: FK with the root at (0, ty, 0) and the root rotation = reference[0] * exp(tilt) "
                      "(no heading).",
-            "ends": "ends = concat of q over `names` (x, y, z each), metres, of the raw frame x_t; "
-                    "ends_prev = the same of the raw frame x_(t-1) (for the first frame after a seed: the seed frame).",
+            "ends": "ends[t] = concat of q over `names` (x, y, z each), metres, of the raw frame x_t; "
+                    "ends_prev = the same of the raw frame before the call's first (after a seed: the seed frame).",
             "velocity_in_graph": "v = fps * ((dtx, 0, dtz) + R_y(dry) q_t - q_(t-1)), R_y(a) q = (cos a qx + sin a qz, qy, "
                                  "-sin a qx + cos a qz), with dtx, dtz, dry of x_t",
         },
-        "usage": "per frame, after the generator sampled x_t (normalised, contacts snapped to 0/1 as fed back): "
-                 "ends = rootFrameEnds(decode(x_t)); x_ref = refiner(x_t, ends, ends_prev, h, c); ends_prev = ends; "
+        "usage": "per chunk, after the generator sampled frames x_t..x_(t+T-1) (normalised, contacts snapped to 0/1 as "
+                 "fed back): ends = rootFrameEnds(decode(frames)); x_ref = refiner(frames, ends, ends_prev, h, c); "
+                 "ends_prev = ends of the last frame; "
                  "feed x_t (not x_ref) back to the generator; decode x_ref for display (contact on when its physical "
                  "value > 0.5), then the foot lock (training/footlock.py) on the decoded positions.",
         "normalisation": {"mean": [round(float(v), 7) for v in meta["mean"]], "std": [round(float(v), 7) for v in meta["std"]],
@@ -363,6 +384,7 @@ def main(argv: list[str] | None = None) -> None:
                      "checkpoint": str(args.checkpoint.relative_to(REPO_ROOT)) if args.checkpoint.is_relative_to(REPO_ROOT) else str(args.checkpoint)},
         "parity": {"max_abs_diff": worst, "step_max_abs_diff": worst_step, "measure": "|a - b| / max(1, |a|)",
                    "tolerance": PARITY_TOLERANCE, "batches": [1, 7], "steps": frames.shape[1] - 1,
+                   "calls": "all frames in one call, one frame per call, and calls of 7 frames",
                    "reference": "torch full-sequence forward (nn.LSTM, torch FK) and torch RefinerStep"},
         "cost": cost,
     }

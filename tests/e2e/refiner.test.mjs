@@ -92,15 +92,15 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
     assert.ok(mean('refined') < 0.25 * mean('raw'), `refined + foot lock ${mean('refined').toFixed(3)} vs raw ${mean('raw').toFixed(3)} m/s`);
   });
 
-  test('refiner parity in the browser: the fixture steps within 1e-4, and the end effectors', async () => {
+  test('refiner parity in the browser: the fixture calls (3 frames, then 1) within 1e-4, and the end effectors', async () => {
     const results = await suite.page.evaluate(async (ref) => {
       const { GeneratorClient } = await import('/runtime/generatorClient.ts');
       const client = new GeneratorClient({ threads: 1 });
       try {
         await client.init();
         const out = [];
-        for (const [k, step] of ref.steps.entries()) {
-          const r = await client.refinerParity({ batch: ref.batch, ...step.inputs }, k === 0 ? ref.frames_physical : undefined);
+        for (const [k, call] of ref.calls.entries()) {
+          const r = await client.refinerParity({ batch: ref.batch, frames: call.frames, ...call.inputs }, k === 0 ? ref.frames_physical : undefined);
           out.push({ outputs: Object.fromEntries(Object.entries(r.outputs).map(([n, v]) => [n, Array.from(v)])), ends: r.ends && Array.from(r.ends) });
         }
         return out;
@@ -111,13 +111,13 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
     let worst = 0;
     results.forEach((r, k) => {
       for (const name of ['x_refined', 'h_out', 'c_out']) {
-        const expected = REFERENCE.steps[k].outputs[name];
-        assert.equal(r.outputs[name].length, expected.length, `step ${k} ${name} length`);
+        const expected = REFERENCE.calls[k].outputs[name];
+        assert.equal(r.outputs[name].length, expected.length, `call ${k} ${name} length`);
         worst = Math.max(worst, worstScaled(r.outputs[name], expected));
       }
     });
     console.log(`# refiner parity in the browser: worst |a−b|/max(1,|b|) = ${worst.toExponential(2)}`);
-    assert.ok(worst <= 1e-4, `refiner steps: worst ${worst}`);
+    assert.ok(worst <= 1e-4, `refiner calls: worst ${worst}`);
     assert.equal(results[0].ends.length, REFERENCE.ends.length);
     assert.ok(worstScaled(results[0].ends, REFERENCE.ends) <= 1e-5, 'root-frame end effectors match the Python side');
   });

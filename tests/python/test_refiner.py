@@ -131,9 +131,9 @@ def test_onnx_step_parity(walk, tmp_path):
     # dynamic batch
     session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
     q = stream_inputs(model, frames)
-    out = session.run(OUTPUTS, {"x": frames[:3, 1], "ends": q[:3, 1], "ends_prev": q[:3, 0],
+    out = session.run(OUTPUTS, {"x": frames[:3, 1:6], "ends": q[:3, 1:6], "ends_prev": q[:3, 0],
                                 "h": np.zeros((1, 3, 32), np.float32), "c": np.zeros((1, 3, 32), np.float32)})
-    assert out[0].shape == (3, model.dim) and out[1].shape == (1, 3, 32)
+    assert out[0].shape == (3, 5, model.dim) and out[1].shape == (1, 3, 32)
 
 
 def test_refiner_rebuilt_from_its_export_computes_the_same(walk, tmp_path):
@@ -160,12 +160,13 @@ def test_shipped_refiner_matches_its_fixture():
     assert path.stat().st_size <= 8e6 and info["bytes"] == path.stat().st_size
     session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
     b, d, h, e3 = fx["batch"], fx["dim"], fx["hidden"], info["onnx"]["ends"]
-    shapes = {"x": (b, d), "ends": (b, e3), "ends_prev": (b, e3), "h": (1, b, h), "c": (1, b, h)}
-    for step in fx["steps"]:
-        feed = {k: np.array(v, np.float32).reshape(shapes[k]) for k, v in step["inputs"].items()}
+    for call in fx["calls"]:
+        n = call["frames"]
+        shapes = {"x": (b, n, d), "ends": (b, n, e3), "ends_prev": (b, e3), "h": (1, b, h), "c": (1, b, h)}
+        feed = {k: np.array(v, np.float32).reshape(shapes[k]) for k, v in call["inputs"].items()}
         out = session.run(OUTPUTS, feed)
         for name, got in zip(OUTPUTS, out):
-            assert np.abs(got.ravel() - np.array(step["outputs"][name])).max() < 1e-4, name
+            assert np.abs(got.ravel() - np.array(call["outputs"][name])).max() < 1e-4, name
     # The fixture's ends are the torch geometry of its frames (the convention the browser must reproduce).
     geo = FeatureGeometry(np.array(fx_references(info)), fps=info["fps"]).double()
     frames = torch.tensor(fx["frames_physical"], dtype=torch.float64).reshape(b, fx["frames"], d)

@@ -21,7 +21,7 @@ interface RefinerFixture {
   frames_normalised: number[];
   frames_physical: number[];
   ends: number[];
-  steps: { inputs: Record<'x' | 'ends' | 'ends_prev' | 'h' | 'c', number[]>; outputs: Record<'x_refined' | 'h_out' | 'c_out', number[]> }[];
+  calls: { frames: number; inputs: Record<'x' | 'ends' | 'ends_prev' | 'h' | 'c', number[]>; outputs: Record<'x_refined' | 'h_out' | 'c_out', number[]> }[];
 }
 
 const PARITY_TOLERANCE = 1e-4;
@@ -83,11 +83,12 @@ describe('refiner.json', () => {
 });
 
 describe('RefinerCore', () => {
-  it('matches Python onnxruntime step by step within 1e-4', async () => {
-    for (const [k, step] of fixture.steps.entries()) {
-      const out = await refiner.parity({ batch: fixture.batch, ...step.inputs });
+  it('matches Python onnxruntime call by call (3 frames, then 1) within 1e-4', async () => {
+    expect(fixture.calls.map((c) => c.frames)).toEqual([3, 1]);
+    for (const [k, call] of fixture.calls.entries()) {
+      const out = await refiner.parity({ batch: fixture.batch, frames: call.frames, ...call.inputs });
       for (const name of ['x_refined', 'h_out', 'c_out'] as const) {
-        expect(worstScaled(out[name], step.outputs[name]), `step ${k} ${name}`).toBeLessThan(PARITY_TOLERANCE);
+        expect(worstScaled(out[name], call.outputs[name]), `call ${k} ${name}`).toBeLessThan(PARITY_TOLERANCE);
       }
     }
   });
@@ -105,7 +106,13 @@ describe('RefinerCore', () => {
     expect(Array.from(refiner.endEffectors(moved))).toEqual(Array.from(ends));
   });
 
-  it('streams the fixture frames through refine() with the fixture steps\' outputs', async () => {
+  it('streams the fixture frames through refine() in one call with the fixture calls\' outputs', async () => {
+    // Frame t's expected output: call 1 holds frames 1-3 (batch × 3 × D), call 2 frame 4 (batch × 1 × D).
+    const expectedFrame = (b: number, t: number) => {
+      const call = t < 3 ? fixture.calls[0] : fixture.calls[1];
+      const k = b * call.frames + (t < 3 ? t : 0);
+      return call.outputs.x_refined.slice(k * D, (k + 1) * D);
+    };
     const frames = fixture.frames;
     for (let b = 0; b < fixture.batch; b++) {
       const row = (data: number[], f: number) => data.slice((b * frames + f) * D, (b * frames + f + 1) * D);
@@ -114,16 +121,16 @@ describe('RefinerCore', () => {
       const physical = Float32Array.from(Array.from({ length: frames - 1 }, (_, f) => row(fixture.frames_physical, f + 1)).flat());
       const refined = await refiner.refine(stream, normalised, physical);
       for (let t = 0; t < frames - 1; t++) {
-        const expected = fixture.steps[t].outputs.x_refined.slice(b * D, (b + 1) * D);
+        const expected = expectedFrame(b, t);
         const got = Array.from(refined.features.subarray(t * D, (t + 1) * D), (v, d) => (v - refinerInfo.normalisation.mean[d]) / refinerInfo.normalisation.std[d]);
         expect(worstScaled(got, expected), `stream ${b} step ${t}`).toBeLessThan(PARITY_TOLERANCE);
       }
-      expect(worstScaled(stream.h, fixture.steps[frames - 2].outputs.h_out.slice(b * fixture.hidden, (b + 1) * fixture.hidden))).toBeLessThan(PARITY_TOLERANCE);
+      expect(worstScaled(stream.h, fixture.calls[1].outputs.h_out.slice(b * fixture.hidden, (b + 1) * fixture.hidden))).toBeLessThan(PARITY_TOLERANCE);
     }
   });
 
   it('rejects parity inputs of the wrong size with a clear message', async () => {
-    await expect(refiner.parity({ batch: 1, x: [1, 2], ends: [], ends_prev: [], h: [], c: [] })).rejects.toThrow(/refiner parity inputs do not fit batch 1: x 2 \(expected 69\)/);
+    await expect(refiner.parity({ batch: 1, frames: 1, x: [1, 2], ends: [], ends_prev: [], h: [], c: [] })).rejects.toThrow(/refiner parity inputs do not fit batch 1 × 1 frames: x 2 \(expected 69\)/);
   });
 });
 

@@ -85,9 +85,10 @@ export interface RefinedFrames {
   rootHeading: Float32Array;
 }
 
-/** The refiner's ONNX step inputs, flattened: x (B×D), ends and ends_prev (B×3E), h and c (1×B×H). */
+/** The refiner's ONNX inputs for `frames` frames per stream, flattened: x (B×T×D), ends (B×T×3E), ends_prev (B×3E), h and c (1×B×H). */
 export interface RefinerStepInputs {
   batch: number;
+  frames: number;
   x: ArrayLike<number>;
   ends: ArrayLike<number>;
   ends_prev: ArrayLike<number>;

@@ -1,6 +1,7 @@
 // The refiner R (Wang, Chai, Xia §4.2) streamed right behind the generator, as refiner.json "usage" says:
-// per frame, R gets the generator's raw frame x_t (normalised, contacts snapped as fed back), the root-frame
-// end-effector positions of that frame and of the frame before, and its own LSTM state; the refined frame is
+// per generated chunk, R gets the generator's raw frames (normalised, contacts snapped as fed back), their
+// root-frame end-effector positions and those of the frame before, and its own LSTM state, all in one call
+// (R is causal, so this is what per-frame steps give, without a session call per frame); the refined frames are
 // decoded (contact on when its physical value is above the threshold) and the foot lock (footLock.ts) cleans
 // the decoded positions. The generator itself is always fed its own raw frames. Independent of where it runs,
 // like GeneratorCore: the generator worker wraps it, unit tests drive it with onnxruntime-web's Node build.
@@ -42,20 +43,20 @@ export class RefinerCore extends SessionCore<RefinerInfo> {
   /** One step from a zero state: a model whose sizes disagree with its JSON fails at load time. */
   async check(): Promise<void> {
     const { H, D, E3 } = this;
-    await this.step(1, new Float32Array(D), new Float32Array(E3), new Float32Array(E3), new Float32Array(H), new Float32Array(H));
+    await this.step(1, 1, new Float32Array(D), new Float32Array(E3), new Float32Array(E3), new Float32Array(H), new Float32Array(H));
   }
 
-  /** One raw session call: x (B×D normalised), ends and ends_prev (B×3E metres), h and c (1×B×H). */
-  async step(batch: number, x: Float32Array, ends: Float32Array, endsPrev: Float32Array, h: Float32Array, c: Float32Array): Promise<RefinerStepOutputs> {
+  /** One raw session call over T frames per stream: x (B×T×D normalised), ends (B×T×3E metres), ends_prev (B×3E), h and c (1×B×H). */
+  async step(batch: number, frames: number, x: Float32Array, ends: Float32Array, endsPrev: Float32Array, h: Float32Array, c: Float32Array): Promise<RefinerStepOutputs> {
     const { H, D, E3 } = this;
     const read = await this.run({
-      x: [x, [batch, D]],
-      ends: [ends, [batch, E3]],
+      x: [x, [batch, frames, D]],
+      ends: [ends, [batch, frames, E3]],
       ends_prev: [endsPrev, [batch, E3]],
       h: [h, [1, batch, H]],
       c: [c, [1, batch, H]],
     });
-    return { x_refined: read('x_refined', batch * D), h_out: read('h_out', batch * H), c_out: read('c_out', batch * H) };
+    return { x_refined: read('x_refined', batch * frames * D), h_out: read('h_out', batch * H), c_out: read('c_out', batch * H) };
   }
 
   /**
@@ -102,16 +103,13 @@ export class RefinerCore extends SessionCore<RefinerInfo> {
     if (!Number.isInteger(frames) || physical.length !== normalised.length) {
       throw new Error(`refine: ${normalised.length} normalised and ${physical.length} physical values are not the same whole number of ${D}-value frames`);
     }
+    if (frames === 0) return { features: new Float32Array(0), positions: new Float32Array(0), contacts: new Uint8Array(0), rootHeading: new Float32Array(0) };
     const ends = this.endEffectors(physical);
-    const refined = new Float32Array(frames * D);
-    for (let t = 0; t < frames; t++) {
-      const endsNow = ends.slice(t * E3, (t + 1) * E3);
-      const out = await this.step(1, normalised.slice(t * D, (t + 1) * D), endsNow, stream.endsPrev, stream.h, stream.c);
-      refined.set(out.x_refined, t * D);
-      stream.h = out.h_out;
-      stream.c = out.c_out;
-      stream.endsPrev = endsNow;
-    }
+    const out = await this.step(1, frames, normalised, ends, stream.endsPrev, stream.h, stream.c);
+    const refined = out.x_refined;
+    stream.h = out.h_out;
+    stream.c = out.c_out;
+    stream.endsPrev = ends.slice((frames - 1) * E3);
     const features = denormalise(refined, this.mean, this.std);
     const decoded = decodeFeatures(this.generator, features, stream.root);
     stream.root = decoded.end;
@@ -129,17 +127,18 @@ export class RefinerCore extends SessionCore<RefinerInfo> {
     return { features, positions, contacts, rootHeading: decoded.rootHeading };
   }
 
-  /** One raw step on given inputs (the parity check against tests/fixtures/refiner_reference.json). */
+  /** One raw call on given inputs (the parity check against tests/fixtures/refiner_reference.json). */
   async parity(inputs: RefinerStepInputs): Promise<RefinerStepOutputs> {
     const { H, D, E3 } = this;
-    const { batch } = inputs;
+    const { batch, frames } = inputs;
     const x = Float32Array.from(inputs.x), ends = Float32Array.from(inputs.ends), endsPrev = Float32Array.from(inputs.ends_prev);
     const h = Float32Array.from(inputs.h), c = Float32Array.from(inputs.c);
-    if (!Number.isInteger(batch) || batch < 1 || x.length !== batch * D || ends.length !== batch * E3 || endsPrev.length !== batch * E3 || h.length !== batch * H || c.length !== batch * H) {
+    const n = batch * frames;
+    if (!Number.isInteger(batch) || batch < 1 || !Number.isInteger(frames) || frames < 1 || x.length !== n * D || ends.length !== n * E3 || endsPrev.length !== batch * E3 || h.length !== batch * H || c.length !== batch * H) {
       throw new Error(
-        `refiner parity inputs do not fit batch ${batch}: x ${x.length} (expected ${batch * D}), ends ${ends.length} and ends_prev ${endsPrev.length} (expected ${batch * E3}), h ${h.length} and c ${c.length} (expected ${batch * H})`,
+        `refiner parity inputs do not fit batch ${batch} × ${frames} frames: x ${x.length} (expected ${n * D}), ends ${ends.length} (expected ${n * E3}), ends_prev ${endsPrev.length} (expected ${batch * E3}), h ${h.length} and c ${c.length} (expected ${batch * H})`,
       );
     }
-    return this.step(batch, x, ends, endsPrev, h, c);
+    return this.step(batch, frames, x, ends, endsPrev, h, c);
   }
 }
