@@ -260,8 +260,8 @@ def main(argv: list[str] | None = None) -> None:
         "parity": parity,
     }
     (args.out / "generator.json").write_text(json.dumps(info) + "\n")
-    write_reference_fixture(onnx_path, info, codec)
-    if args.out == MODELS_DIR:
+    if args.out == MODELS_DIR:  # a candidate exported elsewhere must not replace the shipped model's fixture
+        write_reference_fixture(onnx_path, info, codec)
         register_model({"id": "generator", "kind": info["kind"], "skeleton": "cmu-canonical", "fps": info["fps"],
                         "bytes": info["bytes"], "file": info["file"]})
     print(f"wrote {onnx_path} ({onnx_path.stat().st_size / 1e6:.2f} MB) and generator.json")
