@@ -6,7 +6,7 @@ Every file in ../shared/mocap/aclstm/{salsa,indian,martial} is on one standard 5
 (43 joints + 14 end sites). The BVH headers all say 120 fps, but the set's readme gives salsa at 60 fps
 (28 files, 15 minutes, which only adds up at 60), so the readme's rate is used.
 
-Features of frame t (model rate 60 fps, metres, y up):
+Features of frame t (model rate 30 fps, metres, y up):
     [r_x(t) - r_x(t-1), r_y(t), r_z(t) - r_z(t-1), p_j(t) - r(t) for the 56 other points]
 The paper uses the root displacement in all three axes; here the root height is absolute, because an
 integrated height drifts without bound over a 20,000-frame run. Joint offsets are in world axes (not the
@@ -26,7 +26,10 @@ from .paths import DEFAULT_CACHE, add_mocap_argument, resolve_mocap_dir
 
 STYLES = ("salsa", "indian", "martial")
 SOURCE_FPS = {"salsa": 60.0, "indian": 120.0, "martial": 120.0}  # from aclstm/readme.txt
-MODEL_FPS = 60.0
+# 30 fps, not the paper's 60: at 60 fps the 5 self-fed frames of a u = v = 5 cycle span only 83 ms and a
+# 100-frame window 1.7 s; at 30 fps they span 167 ms and 3.3 s for the same cost per iteration. The 60 fps
+# model (2026-12-01, 7,181 iterations) froze in all 15 long runs.
+MODEL_FPS = 30.0
 CM = 0.01  # the set's BVH units are centimetres
 CACHE = DEFAULT_CACHE / "aclstm_positions.npz"
 # Held out per style for validation, the evaluation report and the browser's seed motions.
@@ -106,9 +109,10 @@ def load_clips(mocap_flag: str | None = None) -> tuple[DanceSkeleton, list[dict]
     return skel, clips
 
 
-def resample_positions(pos: np.ndarray, src_fps: float, start: float, count: int, speed: float = 1.0) -> np.ndarray:
-    """`count` frames at MODEL_FPS from source time `start` (s), played `speed` times as fast (linear interpolation)."""
-    t = (start + np.arange(count) * speed / MODEL_FPS) * src_fps
+def resample_positions(pos: np.ndarray, src_fps: float, start: float, count: int, speed: float = 1.0,
+                       fps: float = MODEL_FPS) -> np.ndarray:
+    """`count` frames at `fps` from source time `start` (s), played `speed` times as fast (linear interpolation)."""
+    t = (start + np.arange(count) * speed / fps) * src_fps
     i = np.clip(np.floor(t).astype(int), 0, len(pos) - 2)
     w = np.clip(t - i, 0.0, 1.0)[:, None, None]
     return pos[i] * (1 - w) + pos[i + 1] * w
@@ -119,6 +123,26 @@ def rotate_y(pos: np.ndarray, angle: float) -> np.ndarray:
     out = pos.copy()
     out[..., 0] = c * pos[..., 0] + s * pos[..., 2]
     out[..., 2] = -s * pos[..., 0] + c * pos[..., 2]
+    return out
+
+
+def mirror_pairs(names: list[str]) -> np.ndarray:
+    """Index of each point's left/right counterpart (itself on the midline): rShin <-> lShin, rightEye <-> leftEye."""
+    def other(n: str) -> str:
+        if n.startswith("left"):
+            return "right" + n[4:]
+        if n.startswith("right"):
+            return "left" + n[5:]
+        if len(n) > 1 and n[0] in "lr" and n[1].isupper():
+            return ("l" if n[0] == "r" else "r") + n[1:]
+        return n
+    return np.array([names.index(other(n)) for n in names])
+
+
+def mirror(pos: np.ndarray, pairs: np.ndarray) -> np.ndarray:
+    """The mirror image across the y-z plane: x negated and left and right points swapped."""
+    out = pos[..., pairs, :].copy()
+    out[..., 0] *= -1
     return out
 
 
@@ -142,10 +166,13 @@ def decode(feats: np.ndarray, start_xz=(0.0, 0.0)) -> np.ndarray:
     return np.concatenate([root[:, None], root[:, None] + rel], axis=1)
 
 
-def bone_length_error(pos: np.ndarray, skel: DanceSkeleton) -> np.ndarray:
-    """Per frame: mean |predicted bone length / true length - 1| over bones longer than 2 cm."""
+LIMB_MIN_LENGTH = 0.15  # bones at least this long: spine, neck, collars, upper and lower arms and legs (11 bones)
+
+
+def bone_length_error(pos: np.ndarray, skel: DanceSkeleton, min_length: float = 0.02) -> np.ndarray:
+    """Per frame: mean |predicted bone length / true length - 1| over bones longer than `min_length`."""
     lengths = skel.bone_lengths()
-    bones = [j for j in range(1, len(skel.parents)) if lengths[j] > 0.02]
+    bones = [j for j in range(1, len(skel.parents)) if lengths[j] > min_length]
     parents = [skel.parents[j] for j in bones]
     got = np.linalg.norm(pos[:, bones] - pos[:, parents], axis=-1)
     return np.abs(got / lengths[bones] - 1).mean(axis=1)

@@ -160,7 +160,7 @@ def main(argv: list[str] | None = None) -> None:
         "skeleton": meta["skeleton"],
         "features": {"dim": meta["dim"], "seed_frames": SEED_FRAMES,
                      "layout": "x = [root dx (m/frame), root height y (m), root dz (m/frame), then for each skeleton point "
-                               "after the root: its position minus the root's (m, world axes)]; y up, 60 fps"},
+                               "after the root: its position minus the root's (m, world axes)]; y up, " f"{meta['fps']:g} fps"},
         "onnx": {"inputs": INPUTS, "outputs": OUTPUTS, "opset": 17, "layers": meta["layers"], "hidden": meta["hidden"],
                  "dim": meta["dim"], "styles": len(meta["styles"]),
                  "style_input": "one-hot over `styles`; x and y are normalised features"},

@@ -335,7 +335,7 @@ export const BENCHMARKS = [
   ...ACLSTM_BENCHMARKS,
   {
     name: 'dance-mode',
-    description: 'Dance mode streaming acLSTM at 60 fps (default threads), skeleton fit and pose-change plot, default quality — target 60 fps',
+    description: 'Dance mode streaming acLSTM (30 fps model) (default threads), skeleton fit and pose-change plot, default quality — target 60 fps',
     kind: 'live',
     run: (ctx) => liveModeBenchmark(ctx, '#mode-dance', 'dance-status'),
   },

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 import torch
 
-from training.aclstm_data import (STYLES, bone_length_error, decode, encode, load_clips, resample_positions,
-                                  rotate_y)
+from training.aclstm_data import (STYLES, bone_length_error, decode, encode, load_clips, mirror, mirror_pairs,
+                                  resample_positions, rotate_y)
 from training.dance import ShippedDance
 from training.export_aclstm import MODELS_DIR, check_parity, export_onnx
 from training.models.aclstm import DanceLSTM, DanceStep
@@ -46,6 +46,23 @@ def test_features_round_trip_and_rotation(dance):
     assert np.allclose(np.linalg.norm(turned[:, 3:].reshape(29, -1, 3), axis=-1),
                        np.linalg.norm(feats[:, 3:].reshape(29, -1, 3), axis=-1))
     assert np.abs(turned[:, 3:] - feats[:, 3:]).max() > 0.05
+
+
+def test_mirroring_swaps_sides_and_keeps_the_body(dance):
+    skel, clips = dance
+    pairs = mirror_pairs(skel.names)
+    name = skel.names.index
+    assert pairs[name("lHand")] == name("rHand") and pairs[name("rightEye")] == name("leftEye")
+    assert pairs[name("hip")] == name("hip") and pairs[name("head")] == name("head")
+    pos = clips[0]["positions"][::40]
+    out = mirror(pos, pairs)
+    assert np.abs(mirror(out, pairs) - pos).max() < 1e-12
+    # The left hand goes where the right hand was, mirrored in x; heights stay.
+    assert np.allclose(out[:, name("lHand"), 0], -pos[:, name("rHand"), 0])
+    assert np.allclose(out[..., 1], pos[:, pairs, 1])
+    # The standard skeleton is symmetric to within 2 mm, so the mirrored body keeps its bone lengths.
+    assert bone_length_error(out, skel).max() < 0.05
+    assert np.abs(out - pos).max() > 0.1
 
 
 def test_resampling_plays_faster_and_slower(dance):

@@ -1,5 +1,5 @@
 // Dance mode: a dance model (acLSTM, or the vanilla LSTM baseline for comparison) dances endlessly in
-// its worker (LiveMode) at 60 fps; the viewer shows the last ~20 s of the fitted skeleton, and a small
+// its worker (LiveMode) at the model's 30 fps, shown at the display's rate; the viewer shows the last ~20 s of the fitted skeleton, and a small
 // plot shows the pose change per second against real dance (the baseline's curve falls to the freeze
 // line within seconds: it stops moving).
 
@@ -22,8 +22,8 @@ export class DanceMode extends LiveMode<DanceMotion> {
   private seedName = '';
 
   constructor(app: App) {
-    // 1 s chunks at 60 fps, at least 1.5 s ahead, 20 s kept.
-    super(app, $('dance-status'), { chunk: 60, ahead: 90, keep: 1200, label: 'Dance', name: 'dance' });
+    // 1 s chunks at the models' 30 fps, at least 1.5 s ahead, 20 s kept.
+    super(app, $('dance-status'), { chunk: 30, ahead: 45, keep: 600, label: 'Dance', name: 'dance' });
     this.model.addEventListener('change', () => this.restartIfActive());
     this.style.addEventListener('change', () => {
       if (this.info) this.listSeeds(this.info, 0);
