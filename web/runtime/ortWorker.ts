@@ -54,6 +54,20 @@ async function fetchBytes(url: string, what: string): Promise<Uint8Array> {
   return new Uint8Array(await response.arrayBuffer());
 }
 
+/** A wasm session on fetched ONNX bytes; `modelUrl` names the file in messages. */
+async function createSession(bytes: Uint8Array, modelUrl: string): Promise<ort.InferenceSession> {
+  try {
+    return await ort.InferenceSession.create(bytes, { executionProviders: ['wasm'], graphOptimizationLevel: 'all' });
+  } catch (err) {
+    throw new Error(`could not create an onnxruntime-web session for ${modelUrl}: ${describe(err)}`);
+  }
+}
+
+/** Fetches an ONNX file and creates its session on the runtime already set up (a second model in a worker). */
+export async function loadExtraSession(modelUrl: string, what: string): Promise<ort.InferenceSession> {
+  return createSession(await fetchBytes(modelUrl, what), modelUrl);
+}
+
 /**
  * Fetches a model's description (`loadInfo`) and ONNX bytes in parallel, sets the runtime up and
  * creates a session. `what` names the model in messages ("generator model").
@@ -67,12 +81,7 @@ async function loadSession<Info>(
 ): Promise<{ session: ort.InferenceSession; info: Info; threads: number }> {
   configureRuntime(requestedThreads);
   const [info, bytes] = await Promise.all([loadInfo(infoUrl), fetchBytes(modelUrl, what)]);
-  let session: ort.InferenceSession;
-  try {
-    session = await ort.InferenceSession.create(bytes, { executionProviders: ['wasm'], graphOptimizationLevel: 'all' });
-  } catch (err) {
-    throw new Error(`could not create an onnxruntime-web session for ${modelUrl}: ${describe(err)}`);
-  }
+  const session = await createSession(bytes, modelUrl);
   runtimeThreads ??= ort.env.wasm.numThreads ?? 1; // onnxruntime lowers it to 1 where threads are unavailable
   return { session, info, threads: runtimeThreads };
 }
