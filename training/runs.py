@@ -45,15 +45,15 @@ class Run:
             return None
         return torch.load(self.checkpoint_path, weights_only=False)
 
-    def resume(self, model, optimiser, scheduler, rng) -> dict:
-        """Restore weights, optimiser, schedule and both random generators from the latest checkpoint;
-        returns the checkpoint for the caller's own counters. Exits with a message when there is none."""
+    def resume(self, rng, **parts) -> dict:
+        """Restore each of `parts` (models, optimisers, schedules: anything with load_state_dict, saved under
+        the same key) and both random generators from the latest checkpoint; returns the checkpoint for the
+        caller's own counters. Exits with a message when there is none."""
         state = self.load()
         if state is None:
             raise SystemExit(f"error: --resume but no checkpoint at {self.checkpoint_path}")
-        model.load_state_dict(state["model"])
-        optimiser.load_state_dict(state["optimiser"])
-        scheduler.load_state_dict(state["scheduler"])
+        for key, part in parts.items():
+            part.load_state_dict(state[key])
         rng.bit_generator.state = state["rng"]
         torch.set_rng_state(state["torch_rng"])
         return state

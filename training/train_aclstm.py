@@ -141,7 +141,7 @@ def main(argv: list[str] | None = None) -> None:
     scheduler = torch.optim.lr_scheduler.ExponentialLR(optimiser, gamma=args.decay)
     iteration, best, elapsed_before, history = 0, float("inf"), 0.0, []
     if args.resume:
-        state = run.resume(model, optimiser, scheduler, rng)
+        state = run.resume(rng, model=model, optimiser=optimiser, scheduler=scheduler)
         iteration, best, elapsed_before, history = state["iteration"], state["best"], state["elapsed"], state["history"]
         run.log.info("resumed at iteration %d", iteration)
     meta = {"dim": dim, "styles": list(STYLES), "hidden": args.hidden, "layers": args.layers, "fps": MODEL_FPS,

@@ -152,7 +152,7 @@ def main(argv: list[str] | None = None) -> None:
     iters_per_epoch = args.iters_per_epoch
     start_epoch, start_iter, best, elapsed_before = 0, 0, float("inf"), 0.0
     if args.resume:
-        state = run.resume(model, optimiser, scheduler, rng)
+        state = run.resume(rng, model=model, optimiser=optimiser, scheduler=scheduler)
         start_epoch, start_iter, best = state["epoch"], state["iteration"], state["best"]
         elapsed_before = state["elapsed"]
         run.log.info("resumed at epoch %d iteration %d", start_epoch, start_iter)

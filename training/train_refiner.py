@@ -279,16 +279,8 @@ def main(argv: list[str] | None = None) -> None:
 
     state = {"r_updates": 0, "d_updates": 0, "k": args.ratio, "best": float("inf"), "elapsed": 0.0, "history": []}
     if args.resume:
-        ck = run.load()
-        if ck is None:
-            raise SystemExit(f"error: --resume but no checkpoint at {run.checkpoint_path}")
-        refiner.load_state_dict(ck["refiner"])
-        disc.load_state_dict(ck["discriminator"])
-        opt_r.load_state_dict(ck["opt_r"])
-        opt_d.load_state_dict(ck["opt_d"])
+        ck = run.resume(rng, refiner=refiner, discriminator=disc, opt_r=opt_r, opt_d=opt_d)
         buffer = ck["buffer"]
-        rng.bit_generator.state = ck["rng"]
-        torch.set_rng_state(ck["torch_rng"])
         state = ck["state"]
         run.log.info("resumed at %d refiner / %d discriminator updates", state["r_updates"], state["d_updates"])
     else:
