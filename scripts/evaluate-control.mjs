@@ -5,9 +5,9 @@
 //   SEEDS=5 npm run evaluate:control
 //
 // Path fit, arc progress and optimisation time come from followPath's stats; foot skating (planted toe
-// speed, as training/metrics.py foot_skating) and the control responses are computed here from the
-// returned motions, against unconstrained generation (generate, temperature 0.5) from the same seed
-// states.
+// speed: the app's web/motion/footSkating.ts, as training/metrics.py foot_skating) is measured in the
+// page, the control responses here from the returned motions, against unconstrained generation
+// (generate, temperature 0.5) from the same seed states.
 import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
@@ -42,22 +42,6 @@ const percentile = (v, p) => {
 };
 const fmt = (v, d = 2) => (Number.isFinite(v) ? v.toFixed(d) : String(v));
 
-/** Planted toe speed (m/s), as training/metrics.py foot_skating; also the planted-frame count. */
-function skating(m) {
-  const J = m.joints.length;
-  const toes = ['LeftToeBase', 'RightToeBase'].map((n) => m.joints.indexOf(n));
-  let sum = 0, count = 0;
-  for (let f = 1; f < m.frames; f++) {
-    for (let s = 0; s < 2; s++) {
-      if (!m.contacts[f * 2 + s] || !m.contacts[(f - 1) * 2 + s]) continue;
-      const a = ((f - 1) * J + toes[s]) * 3, b = (f * J + toes[s]) * 3;
-      sum += Math.hypot(m.positions[b] - m.positions[a], m.positions[b + 2] - m.positions[a + 2]) * m.fps;
-      count++;
-    }
-  }
-  return count ? sum / count : NaN;
-}
-
 /** Mean root speed (m/s) over the whole motion. */
 function rootSpeed(m) {
   const J = m.joints.length;
@@ -66,39 +50,34 @@ function rootSpeed(m) {
   return (d * m.fps) / Math.max(1, m.frames - 1);
 }
 
-/** Runs `fn` in the page on plain data and brings back motions as plain arrays. */
-async function inPage(page, fn, arg) {
-  return page.evaluate(fn, arg);
-}
-
 async function followOne(page, name, gait, seed) {
-  return inPage(
-    page,
+  return page.evaluate(
     async ({ points, gait, seed }) => {
       const m = await window.playground.followPath({ points, gait, seed });
-      return { fps: m.fps, frames: m.frames, joints: m.joints, positions: Array.from(m.positions), contacts: Array.from(m.contacts), stats: m.stats };
+      const { footSkating } = await import('/motion/footSkating.ts');
+      return { skating: footSkating(m), fps: m.fps, frames: m.frames, joints: m.joints, positions: Array.from(m.positions), stats: m.stats };
     },
     { points: PATHS[name].points, gait, seed },
   );
 }
 
 async function freeOne(page, seed, frames) {
-  return inPage(
-    page,
+  return page.evaluate(
     async ({ seed, frames }) => {
       const m = await window.playground.generate({ model: 'generator', frames, seed, temperature: 0.5 });
-      return { fps: m.fps, frames: m.frames, joints: m.joints, positions: Array.from(m.positions), contacts: Array.from(m.contacts) };
+      const { footSkating } = await import('/motion/footSkating.ts');
+      return { skating: footSkating(m) };
     },
     { seed, frames },
   );
 }
 
 async function simulateOne(page, scenario, seed) {
-  return inPage(
-    page,
+  return page.evaluate(
     async ({ schedule, seed, seconds, gait }) => {
       const m = await window.playground.simulateControl({ seconds, schedule, seed, ...(gait ? { gait } : {}) });
-      return { fps: m.fps, frames: m.frames, joints: m.joints, positions: Array.from(m.positions), contacts: Array.from(m.contacts), speed: Array.from(m.speed), heading: Array.from(m.heading), computeMs: Array.from(m.computeMs) };
+      const { footSkating } = await import('/motion/footSkating.ts');
+      return { skating: footSkating(m), fps: m.fps, frames: m.frames, speed: Array.from(m.speed), heading: Array.from(m.heading), computeMs: Array.from(m.computeMs) };
     },
     { schedule: scenario.schedule, seed, seconds: SIM_SECONDS, gait: scenario.gait },
   );
@@ -131,9 +110,9 @@ async function main() {
             ...m.stats,
             realtime: (seconds * 1000) / m.stats.optimizeMs,
             speed: rootSpeed(m),
-            skating: skating(m),
+            skating: m.skating,
             skatingBeforeLock: m.stats.skatingBeforeLock,
-            freeSkating: free ? skating(free) : null,
+            freeSkating: free ? free.skating : null,
           };
           report.paths.push(row);
           console.log(JSON.stringify(row));
@@ -152,7 +131,7 @@ async function main() {
           speedError: Math.abs(sim.speed[f1] - change.speed),
           p95ms: percentile(sim.computeMs, 95),
           maxMs: Math.max(...sim.computeMs),
-          skating: skating(sim),
+          skating: sim.skating,
         };
         if (scenario.kind === 'heading') row.limit = scenario.change === 90 ? TARGETS.heading90 : TARGETS.heading180;
         report.control.push(row);
@@ -161,7 +140,7 @@ async function main() {
     }
     // Unconstrained skating for the control runs: free generation from the same seed states, same length.
     const freeControl = [];
-    for (let seed = 0; seed < SEEDS; seed++) freeControl.push(skating(await freeOne(page, seed, SIM_SECONDS * 30)));
+    for (let seed = 0; seed < SEEDS; seed++) freeControl.push((await freeOne(page, seed, SIM_SECONDS * 30)).skating);
     report.freeControlSkating = mean(freeControl);
     report.problems = problems;
     report.loadAfter = os.loadavg()[0];

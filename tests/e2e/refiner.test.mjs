@@ -8,15 +8,16 @@ import { describe, test } from 'node:test';
 import { openPlayground, ROOT, usePlayground } from './harness.mjs';
 
 const GENERATOR = JSON.parse(readFileSync(path.join(ROOT, 'public', 'models', 'generator.json'), 'utf8'));
-const REFERENCE = JSON.parse(readFileSync(path.join(ROOT, 'tests', 'fixtures', 'refiner_reference.json'), 'utf8'));
 const J = GENERATOR.skeleton.joints.length;
-const TOES = ['LeftToeBase', 'RightToeBase'].map((n) => GENERATOR.skeleton.joints.indexOf(n));
+const REFERENCE = JSON.parse(readFileSync(path.join(ROOT, 'tests', 'fixtures', 'refiner_reference.json'), 'utf8'));
 
-/** In-page: generate and return a JSON-friendly copy. */
+/** In-page: generate and return a JSON-friendly copy, with its foot skating (the app's web/motion/footSkating.ts). */
 function generate(page, options) {
   return page.evaluate(async (o) => {
     const m = await window.playground.generate(o);
+    const { footSkating } = await import('/motion/footSkating.ts');
     return {
+      skating: footSkating(m),
       fps: m.fps,
       frames: m.frames,
       joints: m.joints,
@@ -26,20 +27,6 @@ function generate(page, options) {
       contacts: Array.from(m.contacts),
     };
   }, options);
-}
-
-/** Mean horizontal toe speed (m/s) over frame pairs in which that foot is planted in both (training/metrics.py foot_skating). */
-function footSkating(m) {
-  let sum = 0, count = 0;
-  for (let f = 1; f < m.frames; f++) {
-    for (let side = 0; side < 2; side++) {
-      if (!m.contacts[f * 2 + side] || !m.contacts[(f - 1) * 2 + side]) continue;
-      const a = ((f - 1) * J + TOES[side]) * 3, b = (f * J + TOES[side]) * 3;
-      sum += Math.hypot(m.positions[b] - m.positions[a], m.positions[b + 2] - m.positions[a + 2]) * m.fps;
-      count++;
-    }
-  }
-  return sum / count;
 }
 
 const worstScaled = (a, b) => a.reduce((w, v, i) => Math.max(w, Math.abs(v - b[i]) / Math.max(1, Math.abs(b[i]))), 0);
@@ -81,8 +68,8 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
   test('refined + foot lock skates far less than the raw motion (same seeds)', async () => {
     const rows = [];
     for (const seed of [0, 1, 2]) {
-      const raw = footSkating(await generate(suite.page, { model: 'generator', frames: 900, seed }));
-      const refined = footSkating(await generate(suite.page, { model: 'generator', frames: 900, seed, refine: true }));
+      const raw = (await generate(suite.page, { model: 'generator', frames: 900, seed })).skating;
+      const refined = (await generate(suite.page, { model: 'generator', frames: 900, seed, refine: true })).skating;
       rows.push({ seed, raw, refined });
     }
     const mean = (k) => rows.reduce((a, r) => a + r[k], 0) / rows.length;
