@@ -1,8 +1,8 @@
 // The TypeScript feature decoder against the Python one (training/features.py), via the fixture the
 // Python export writes (tests/fixtures/generator_reference.json), plus the generator JSON checks.
 import { describe, expect, it } from 'vitest';
-import { decodeFeatures } from '../../web/runtime/featureDecode';
-import { GeneratorInfoError, parseGeneratorInfo, type GeneratorInfo } from '../../web/runtime/generatorModel';
+import { decodeFeatures } from '../../web/model/featureDecode';
+import { GeneratorInfoError, parseGeneratorInfo, type GeneratorInfo } from '../../web/model/generatorInfo';
 import { readRepoFile } from './corpus';
 
 const TOLERANCE = 0.001; // metres

@@ -3,7 +3,7 @@
 // onnxruntime fixture, seeded determinism, and streams that continue exactly where they stopped.
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { GeneratorCore } from '../../web/runtime/generatorCore';
-import { parseGeneratorInfo } from '../../web/runtime/generatorModel';
+import { parseGeneratorInfo } from '../../web/model/generatorInfo';
 import { readRepoFile } from './corpus';
 import { bytes, maxAbsDiff, ort, shippedSession } from './shippedModel';
 

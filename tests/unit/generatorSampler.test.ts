@@ -1,7 +1,7 @@
 // The mixture sampler: seeded determinism, τ = 0, draw statistics against the analytic moments of a
 // known mixture, temperature sharpening, and contact snapping.
 import { describe, expect, it } from 'vitest';
-import { denormalise, Rng, sampleMixture, snapContacts, type MixtureBatch } from '../../web/runtime/sampler';
+import { denormalise, Rng, sampleMixture, snapContacts, type MixtureBatch } from '../../web/model/sampler';
 
 // Batch of 2 rows, 3 components, 2 dimensions.
 const WEIGHTS = [0.2, 0.5, 0.3];

@@ -3,7 +3,7 @@
 // and the path follower and live controller do what they are for on short runs.
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { GeneratorCore } from '../../web/runtime/generatorCore';
-import { parseGeneratorInfo } from '../../web/runtime/generatorModel';
+import { parseGeneratorInfo } from '../../web/model/generatorInfo';
 import { footSkating } from '../../web/motion/footSkating';
 import { checkSchedule, LiveController, simulateControl } from '../../web/optimizer/liveControl';
 import { angleDifference, GroundPath } from '../../web/optimizer/path';

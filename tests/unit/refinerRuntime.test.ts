@@ -5,7 +5,7 @@
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { footSkating } from '../../web/motion/footSkating';
 import { GeneratorCore } from '../../web/runtime/generatorCore';
-import { parseGeneratorInfo } from '../../web/runtime/generatorModel';
+import { parseGeneratorInfo } from '../../web/model/generatorInfo';
 import { RefinerCore } from '../../web/runtime/refinerCore';
 import { checkRefinerPairing, parseRefinerInfo, type RefinerInfo } from '../../web/runtime/refinerModel';
 import type { GeneratedChunk } from '../../web/runtime/protocol';

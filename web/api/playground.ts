@@ -11,7 +11,7 @@ import type { RenderStats } from '../viewer/viewer';
 import { errorMessage, type App } from '../ui/app';
 import { checkSchedule } from '../optimizer/liveControl';
 import { checkPathPoints, GroundPath } from '../optimizer/path';
-import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed } from '../runtime/optimizerRequests';
+import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed } from '../optimizer/options';
 
 declare const __APP_VERSION__: string;
 

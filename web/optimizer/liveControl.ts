@@ -3,9 +3,9 @@
 // (eq. 23: the last frame's facing near the asked heading), with the prior, noise and contact terms of
 // the path follower. Particles look a little past the batch so the choice is not greedy; only the batch
 // is kept. `LiveController` is what both the live page loop and `simulateControl` run.
-import { decodeFeatures } from '../runtime/featureDecode';
-import type { GeneratorInfo } from '../runtime/generatorModel';
-import { Rng } from '../runtime/sampler';
+import { decodeFeatures } from '../model/featureDecode';
+import type { GeneratorInfo } from '../model/generatorInfo';
+import { Rng } from '../model/sampler';
 import { contactCost, lastToes, lowest, particleFeatures, type ToeState } from './objective';
 import { angleDifference } from './path';
 import { perturbInto, randomVariables, rollout, type RolloutResult, type SteerRequest, type StepFn, type Steering, type StreamState, type Variables } from './rollout';

@@ -1,7 +1,7 @@
 // Objective terms shared by the path follower and live control (Wang, Chai, Xia eqs. 16–19, 22–23):
 // the contact term needs the feet, so it runs forward kinematics on each particle's frames.
-import { decodeFeatures, type RootStart } from '../runtime/featureDecode';
-import type { GeneratorInfo } from '../runtime/generatorModel';
+import { decodeFeatures, type RootStart } from '../model/featureDecode';
+import type { GeneratorInfo } from '../model/generatorInfo';
 import type { RolloutResult } from './rollout';
 
 /** Eq. (18)'s σ_con for the path follower: a planted toe moving 1 cm in a frame (0.3 m/s) costs 1. */

@@ -4,9 +4,9 @@
 // P_contact) (eq. 19) with a progress term; the best few seed the next rounds, which perturb them ever
 // more locally (a cross-entropy search). The best particle's first 17 frames are kept and the next
 // window starts from its state.
-import { decodeFeatures, type RootStart } from '../runtime/featureDecode';
-import type { GeneratorInfo } from '../runtime/generatorModel';
-import { Rng } from '../runtime/sampler';
+import { decodeFeatures, type RootStart } from '../model/featureDecode';
+import type { GeneratorInfo } from '../model/generatorInfo';
+import { Rng } from '../model/sampler';
 import { contactCost, lastToes, lowest, particleFeatures, type ToeState } from './objective';
 import { angleDifference, GroundPath } from './path';
 import { perturbInto, randomVariables, rollout, type RolloutResult, type SteerRequest, type StepFn, type Steering, type StreamState, type Variables } from './rollout';

@@ -8,9 +8,8 @@
 // reach: the move is clipped to that many model σ, because the model is sure of its next root step (σ
 // of a few cm/s) and a change of pace has to be spread over many frames to stay likely. The window objective (prior NLL, noise prior, control and contact terms)
 // then ranks whole particles.
-import type { StepOutputs } from '../runtime/protocol';
-import type { GeneratorInfo } from '../runtime/generatorModel';
-import type { Rng } from '../runtime/sampler';
+import type { GeneratorInfo, StepOutputs } from '../model/generatorInfo';
+import type { Rng } from '../model/sampler';
 
 /** The paper's input-noise prior: d ~ N(0, 0.05²) on the normalised network input (eq. 16). */
 export const INPUT_NOISE_SIGMA = 0.05;

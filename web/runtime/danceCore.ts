@@ -9,7 +9,7 @@ import { decodeDance, type DanceRoot } from './danceDecode';
 import { seedsOfStyle, type DanceInfo } from './danceModel';
 import type { DanceChunk, DanceGenerateParams, DanceInitResult, DanceParityResult, DanceStepInputs, DanceStepOutputs, DanceStreamInfo, DanceStreamParams } from './danceProtocol';
 import type { BenchmarkResult } from './protocol';
-import { denormalise } from './sampler';
+import { denormalise } from '../model/sampler';
 import { checkFrameCount, SessionCore, timeSteps } from './session';
 
 /** One dance: the next network input, the LSTM state, and where the root stands. */

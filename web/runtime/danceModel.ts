@@ -2,7 +2,7 @@
 // training/export_aclstm.py): skeleton, ONNX step signature, feature layout, normalisation, the seed
 // motions per style and the real pose change per style. `parseDanceInfo` checks everything the runtime
 // relies on and names the first bad field.
-import { modelInfoFormat } from './modelInfo';
+import { modelInfoFormat } from '../model/modelInfo';
 
 export interface DanceInfo {
   id: string;

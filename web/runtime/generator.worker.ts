@@ -3,7 +3,7 @@
 // (setup and the requests are shared with the other model workers: ortWorker.ts). The refiner runs in the
 // same worker, in a second session loaded the first time a stream asks for `refine`.
 import { GeneratorCore } from './generatorCore';
-import { loadGeneratorInfo } from './generatorModel';
+import { loadGeneratorInfo } from '../model/generatorInfo';
 import { ort, serveModel } from './ortWorker';
 import { OptimizerRequests } from './optimizerRequests';
 import type { RefinerParityResult, RefinerStepInputs, StreamParams } from './protocol';

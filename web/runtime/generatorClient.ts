@@ -1,5 +1,6 @@
 // Main-thread handle on the generator worker: promise methods (ModelClient; requests matched to
 // replies by id: WorkerClient).
+import type { StepInputs } from '../model/generatorInfo';
 import type { Motion } from '../motion/types';
 import type {
   BenchmarkResult,
@@ -17,7 +18,6 @@ import type {
   RefinerStepInputs,
   SimulateControlParams,
   SimulatedControlChunk,
-  StepInputs,
   StreamInfo,
   StreamParams,
 } from './protocol';

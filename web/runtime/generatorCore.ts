@@ -2,11 +2,11 @@
 // and the feature decoder. generator.worker.ts wraps it in messages; unit tests drive it directly with
 // onnxruntime-web's Node build.
 import type { InferenceSession, TensorConstructor } from 'onnxruntime-web';
-import { decodeFeatures, type RootStart } from './featureDecode';
-import type { GeneratorInfo } from './generatorModel';
-import type { BenchmarkResult, GeneratedChunk, GenerateParams, InitResult, ParityResult, StepInputs, StepOutputs, StreamInfo, StreamParams } from './protocol';
+import { decodeFeatures, type RootStart } from '../model/featureDecode';
+import type { GeneratorInfo, StepInputs, StepOutputs } from '../model/generatorInfo';
+import type { BenchmarkResult, GeneratedChunk, GenerateParams, InitResult, ParityResult, StreamInfo, StreamParams } from './protocol';
 import type { RefinerCore, RefinerStream } from './refinerCore';
-import { denormalise, Rng, sampleMixture, snapContacts } from './sampler';
+import { denormalise, Rng, sampleMixture, snapContacts } from '../model/sampler';
 import { checkFrameCount, SessionCore, timeSteps } from './session';
 
 /** One generation stream: the LSTM input and state, the PRNG and where the root stands. */

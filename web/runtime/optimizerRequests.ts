@@ -2,39 +2,13 @@
 // (one live stream at a time, and its scripted twin simulateControl). The algorithms live in
 // web/optimizer/; this file checks the requests and packs results for the page.
 import { followPath, gaitSeeds, type Gait } from '../optimizer/pathFollower';
+import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed } from '../optimizer/options';
 import { checkSchedule, LiveController, simulateControl, checkTarget, CONTROL_HORIZON } from '../optimizer/liveControl';
 import { checkPathPoints, GroundPath } from '../optimizer/path';
 import { FootLock, footLock } from '../motion/footLock';
 import { footSkating } from '../motion/footSkating';
 import type { GeneratorCore } from './generatorCore';
 import type { ControlChunkReply, ControlStartParams, ControlTargetParams, FollowPathChunk, FollowPathParams, SimulateControlParams, SimulatedControlChunk, StreamInfo } from './protocol';
-
-export const MAX_SIMULATED_SECONDS = 600;
-
-export function checkGait(gait: unknown): Gait {
-  if (gait !== 'walk' && gait !== 'run') throw new TypeError(`gait must be "walk" or "run", got ${JSON.stringify(gait)}`);
-  return gait;
-}
-
-export function checkSeed(seed: unknown): number {
-  if (typeof seed !== 'number' || !Number.isInteger(seed) || seed < 0 || seed > 0xffffffff) throw new RangeError(`seed must be an integer from 0 to 4294967295, got ${String(seed)}`);
-  return seed;
-}
-
-export function checkFootLock(value: unknown): boolean {
-  if (value !== undefined && typeof value !== 'boolean') throw new TypeError(`footLock must be true or false, got ${String(value)}`);
-  return value ?? true;
-}
-
-export function checkFitSigma(value: unknown, name = 'fitSigma'): number {
-  if (typeof value !== 'number' || !(value >= 0.02 && value <= 2)) throw new RangeError(`${name} must be a number from 0.02 to 2 m, got ${String(value)}`);
-  return value;
-}
-
-export function checkSeconds(seconds: unknown): number {
-  if (typeof seconds !== 'number' || !(seconds > 0 && seconds <= MAX_SIMULATED_SECONDS)) throw new RangeError(`seconds must be a number above 0 and at most ${MAX_SIMULATED_SECONDS}, got ${String(seconds)}`);
-  return seconds;
-}
 
 export class OptimizerRequests {
   private live: { controller: LiveController; seedIndex: number; lock: FootLock } | undefined;

@@ -1,6 +1,7 @@
 // Messages between GeneratorClient (main thread) and generator.worker.ts. Every request carries an id;
 // the worker answers each with exactly one reply carrying the same id (WorkerReply, also used by the
 // dance worker: danceProtocol.ts).
+import type { StepOutputs } from '../model/generatorInfo';
 
 export interface GenerateParams {
   frames: number;
@@ -15,22 +16,6 @@ export interface GenerateParams {
 }
 
 export type StreamParams = Omit<GenerateParams, 'frames'>;
-
-/** The ONNX step's inputs, flattened: x (B×D), h and c (layers×B×H). */
-export interface StepInputs {
-  batch: number;
-  x: ArrayLike<number>;
-  h: ArrayLike<number>;
-  c: ArrayLike<number>;
-}
-
-export interface StepOutputs {
-  weights: Float32Array;
-  mu: Float32Array;
-  sigma: Float32Array;
-  h_out: Float32Array;
-  c_out: Float32Array;
-}
 
 /** The requests every model worker understands (ortWorker.ts serveModel); `P` is the model's stream parameters. */
 export type ModelRequest<P, Inputs> =

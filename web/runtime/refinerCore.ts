@@ -7,11 +7,11 @@
 // like GeneratorCore: the generator worker wraps it, unit tests drive it with onnxruntime-web's Node build.
 import type { InferenceSession, TensorConstructor } from 'onnxruntime-web';
 import { FootLock } from '../motion/footLock';
-import { decodeFeatures, type RootStart } from './featureDecode';
-import type { GeneratorInfo } from './generatorModel';
+import { decodeFeatures, type RootStart } from '../model/featureDecode';
+import type { GeneratorInfo } from '../model/generatorInfo';
 import type { RefinedFrames, RefinerStepInputs, RefinerStepOutputs } from './protocol';
 import { checkRefinerPairing, footLockSettings, type RefinerInfo } from './refinerModel';
-import { denormalise } from './sampler';
+import { denormalise } from '../model/sampler';
 import { SessionCore } from './session';
 
 /** One refined stream: R's state, the previous raw frame's end effectors, the refined root and the foot lock. */

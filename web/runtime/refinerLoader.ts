@@ -2,7 +2,7 @@
 // Loading the refiner inside the generator worker, the first time a `refine` stream asks for it: its JSON
 // and ONNX file come from next to the generator's (models/refiner.json, the ONNX file named in it), and its
 // session runs on the worker's onnxruntime-web (ortWorker.ts), beside the generator's.
-import type { GeneratorInfo } from './generatorModel';
+import type { GeneratorInfo } from '../model/generatorInfo';
 import { describe, loadExtraSession, ort } from './ortWorker';
 import { RefinerCore } from './refinerCore';
 import { checkRefinerPairing, loadRefinerInfo } from './refinerModel';

@@ -3,8 +3,8 @@
 // settings. `parseRefinerInfo` checks everything the runtime relies on and names the first bad field;
 // `checkRefinerPairing` checks that it fits the loaded generator.
 import { FOOT_LOCK_DEFAULTS, type FootLockSettings } from '../motion/footLock';
-import type { GeneratorInfo } from './generatorModel';
-import { modelInfoFormat } from './modelInfo';
+import type { GeneratorInfo } from '../model/generatorInfo';
+import { modelInfoFormat } from '../model/modelInfo';
 
 export interface RefinerInfo {
   id: string;

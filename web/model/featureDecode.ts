@@ -3,7 +3,7 @@
 import { forwardKinematics } from '../motion/skeleton';
 import { quatMultiply, quatNormalize, type Quat } from '../motion/math';
 import type { Skeleton } from '../motion/types';
-import { JOINT_FEATURES_START, type GeneratorInfo } from './generatorModel';
+import { JOINT_FEATURES_START, type GeneratorInfo } from './generatorInfo';
 
 /** Where the character stands before the first decoded frame (metres, radians; heading 0 faces +z). */
 export interface RootStart {

@@ -54,6 +54,22 @@ export interface GeneratorSeed {
 export const EXPECTED_INPUTS = ['x', 'h', 'c'] as const;
 export const EXPECTED_OUTPUTS = ['weights', 'mu', 'sigma', 'h_out', 'c_out'] as const;
 
+/** The ONNX step's inputs, flattened: x (B×D), h and c (layers×B×H). */
+export interface StepInputs {
+  batch: number;
+  x: ArrayLike<number>;
+  h: ArrayLike<number>;
+  c: ArrayLike<number>;
+}
+
+export interface StepOutputs {
+  weights: Float32Array;
+  mu: Float32Array;
+  sigma: Float32Array;
+  h_out: Float32Array;
+  c_out: Float32Array;
+}
+
 /** Index of the first joint rotation vector in a feature row (after dtx, dtz, dry, ty, tilt xyz). */
 export const JOINT_FEATURES_START = 7;
 
