@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .skeleton import Skeleton, canonical_skeleton
+from .mocap.skeleton import Skeleton, canonical_skeleton
 
 # Median height (m) of the toe point (LeftToeBase/RightToeBase) in planted frames of the real training
 # clips (walk and run, 30 fps, floor-fitted): 5th-95th percentile 0.007-0.070 m.

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .skeleton import Skeleton
+from .mocap.skeleton import Skeleton
 
 TOES = ("LeftToeBase", "RightToeBase")
 

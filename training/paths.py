@@ -8,6 +8,7 @@ from pathlib import Path
 REPO_ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_MOCAP = REPO_ROOT.parent / "shared" / "mocap"
 DEFAULT_CACHE = REPO_ROOT / "cache"
+MODELS_DIR = REPO_ROOT / "public" / "models"  # the shipped models the page loads
 ENV_VAR = "MOCAP_DIR"
 
 

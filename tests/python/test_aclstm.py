@@ -5,10 +5,11 @@ import numpy as np
 import pytest
 import torch
 
-from training.aclstm_data import (STYLES, bone_length_error, decode, encode, load_clips, mirror, mirror_pairs,
+from training.data.dance import (STYLES, bone_length_error, decode, encode, load_clips, mirror, mirror_pairs,
                                   resample_positions, rotate_y)
-from training.dance import ShippedDance
-from training.export_aclstm import MODELS_DIR, check_parity, export_onnx
+from training.aclstm.shipped import ShippedDance
+from training.aclstm.export import check_parity, export_onnx
+from training.paths import MODELS_DIR
 from training.models.aclstm import DanceLSTM, DanceStep
 
 

@@ -1,7 +1,7 @@
 import numpy as np
 
-from training.contacts import CONTACT_THRESHOLDS, foot_contacts
-from training.dataset import clip_contacts, load_clip, read_index
+from training.mocap.contacts import CONTACT_THRESHOLDS, foot_contacts
+from training.data.cmu import clip_contacts, load_clip, read_index
 
 
 def test_hysteresis_keeps_contact_through_small_rises():

@@ -3,7 +3,7 @@ import sys
 
 import numpy as np
 
-from training.dataset import build, load_cache
+from training.data.cmu import build, load_cache
 from conftest import REPO
 
 
@@ -22,7 +22,7 @@ def test_build_cache_for_a_category(mocap, tmp_path):
 
 
 def run_cli(*args, env=None):
-    return subprocess.run([sys.executable, "-m", "training.dataset", *args], cwd=REPO, capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "training.data.cmu", *args], cwd=REPO, capture_output=True, text=True,
                           env=env)
 
 

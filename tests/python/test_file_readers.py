@@ -4,8 +4,8 @@ import gzip
 import numpy as np
 import pytest
 
-from training import asf_amc, bvh
-from training.mocap_io import MotionFormatError, read_text
+from training.mocap import asf_amc, bvh
+from training.mocap.files import MotionFormatError, read_text
 
 
 def bone_lengths(names, positions, parents):
@@ -136,7 +136,7 @@ def test_amc_errors(asf16, amc_head):
 
 
 def _read(text):
-    from training.mocap_io import decode_text
+    from training.mocap.files import decode_text
     return decode_text(text.encode("latin-1"), "x.amc")
 
 

@@ -6,12 +6,13 @@ import numpy as np
 import pytest
 import torch
 
-from training.dataset import load_clip, read_index
-from training.export_generator import MODELS_DIR, check_parity, estimate_initial_state, export_onnx
-from training.features import FeatureCodec, heading_of, mirror_clip
+from training.data.cmu import load_clip, read_index
+from training.generator.export import check_parity, estimate_initial_state, export_onnx
+from training.data.features import FeatureCodec, heading_of, mirror_clip
 from training.models.generator import MixtureLSTM, mixture_nll
-from training.rotations import quat_to_matrix
-from training.skeleton import canonical_skeleton, forward_kinematics
+from training.paths import MODELS_DIR
+from training.mocap.rotations import quat_to_matrix
+from training.mocap.skeleton import canonical_skeleton, forward_kinematics
 
 SKEL = canonical_skeleton()
 
@@ -19,7 +20,7 @@ SKEL = canonical_skeleton()
 @pytest.fixture(scope="module")
 def walk(mocap):
     info = next(i for i in read_index(mocap) if i.file.endswith("16_22.amc.gz"))  # walk with a turn
-    from training.dataset import clip_contacts
+    from training.data.cmu import clip_contacts
     clip = load_clip(mocap, info, 30)
     return clip, clip_contacts(clip)
 
@@ -44,7 +45,7 @@ def test_codec_is_invariant_to_where_the_clip_starts(walk):
     codec.fit_references(clip.rotations)
     x = codec.encode(clip.root, clip.rotations, contacts)
     turn = quat_to_matrix(np.array([0, math.sin(0.6), 0, math.cos(0.6)]))  # 1.2 rad about y
-    from training.rotations import matrix_to_quat
+    from training.mocap.rotations import matrix_to_quat
     rot = clip.rotations.copy()
     rot[:, 0] = matrix_to_quat(turn @ quat_to_matrix(rot[:, 0]))
     root = clip.root @ turn.T + [3.0, 0, -2.0]
@@ -96,7 +97,7 @@ def test_initial_state_estimate_makes_real_frames_more_likely():
 
 @pytest.mark.skipif(not (MODELS_DIR / "generator.json").exists(), reason="no generator shipped yet")
 def test_shipped_generator_runs_and_stays_finite():
-    from training.generate import ShippedGenerator
+    from training.generator.shipped import ShippedGenerator
     gen = ShippedGenerator(MODELS_DIR)
     info = json.loads((MODELS_DIR / "generator.json").read_text())
     assert info["bytes"] <= 8 * 1024 * 1024

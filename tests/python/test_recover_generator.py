@@ -5,10 +5,11 @@ import numpy as np
 import pytest
 import torch
 
-from training.export_generator import INPUTS, MODELS_DIR, OUTPUTS, export_onnx, load_generator
+from training.generator.export import INPUTS, OUTPUTS, export_onnx, load_generator
 from training.models.generator import GeneratorStep, MixtureLSTM
-from training.recover_generator import checkpoint_from_shipped, compare_with_onnx, model_from_onnx
-from training.rotations import matrix_to_quat
+from training.generator.recover import checkpoint_from_shipped, compare_with_onnx, model_from_onnx
+from training.paths import MODELS_DIR
+from training.mocap.rotations import matrix_to_quat
 
 
 def export_with_lstm_nodes(model: MixtureLSTM, path) -> None:

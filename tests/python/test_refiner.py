@@ -6,16 +6,16 @@ import onnxruntime as ort
 import pytest
 import torch
 
-from training.dataset import clip_contacts, load_clip, read_index
-from training.export_generator import MODELS_DIR
-from training.export_refiner import (FIXTURE, OUTPUTS, export_onnx, parity_error, refiner_from_onnx, step_parity,
+from training.data.cmu import clip_contacts, load_clip, read_index
+from training.paths import MODELS_DIR
+from training.refiner.export import (FIXTURE, OUTPUTS, export_onnx, parity_error, refiner_from_onnx, step_parity,
                                      stream_inputs)
-from training.features import FeatureCodec
+from training.data.features import FeatureCodec
 from training.footlock import BLEND_IN, TOE_GROUND_HEIGHT, FootLock, foot_lock, two_bone_ik
 from training.models.refiner import (FeatureGeometry, Refiner, RefinerStep, rotvec_to_matrix, straight_through_bits)
-from training.rotations import axis_rotation
-from training.skeleton import canonical_skeleton
-from training.train_refiner import root_loss
+from training.mocap.rotations import axis_rotation
+from training.mocap.skeleton import canonical_skeleton
+from training.refiner.train import root_loss
 
 SKEL = canonical_skeleton()
 
@@ -47,7 +47,7 @@ def normalised(model, x):
 
 
 def test_rotvec_matches_numpy_and_is_finite_at_zero():
-    from training.features import rotvec_to_matrix as np_rotvec
+    from training.data.features import rotvec_to_matrix as np_rotvec
     v = np.random.default_rng(1).normal(size=(50, 3)) * 1.5
     v[0] = 0
     v[1] = 1e-7
@@ -175,7 +175,7 @@ def test_shipped_refiner_matches_its_fixture():
 
 
 def fx_references(info):
-    from training.rotations import quat_to_matrix
+    from training.mocap.rotations import quat_to_matrix
     gen = json.loads((MODELS_DIR / "generator.json").read_text())
     return quat_to_matrix(np.array(gen["features"]["references"]))
 

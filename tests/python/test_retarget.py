@@ -2,11 +2,11 @@
 import numpy as np
 import pytest
 
-from training.dataset import load_clip, read_index
-from training.resample import resample
-from training.retarget import RIGID_BONES, retarget, source_from_amc
-from training.skeleton import GROUND_POINTS, canonical_skeleton, forward_kinematics
-from training import asf_amc
+from training.data.cmu import load_clip, read_index
+from training.mocap.resample import resample
+from training.mocap.retarget import RIGID_BONES, retarget, source_from_amc
+from training.mocap.skeleton import GROUND_POINTS, canonical_skeleton, forward_kinematics
+from training.mocap import asf_amc
 
 SKEL = canonical_skeleton()
 GROUND = [SKEL.index(n) for n in GROUND_POINTS]

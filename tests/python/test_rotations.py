@@ -1,6 +1,6 @@
 import numpy as np
 
-from training.rotations import (euler_matrix, matrix_to_euler_zyx, matrix_to_quat, quat_slerp, quat_to_matrix,
+from training.mocap.rotations import (euler_matrix, matrix_to_euler_zyx, matrix_to_quat, quat_slerp, quat_to_matrix,
                                 rotation_between)
 
 rng = np.random.default_rng(0)

@@ -24,8 +24,8 @@ import numpy as np
 import torch
 from torch import nn
 
-from ..features import feature_joints
-from ..skeleton import Skeleton, canonical_skeleton
+from ..data.features import feature_joints
+from ..mocap.skeleton import Skeleton, canonical_skeleton
 
 END_EFFECTORS = ("LeftHand", "RightHand", "LeftFoot", "LeftToeBase", "RightFoot", "RightToeBase", "Head_end")
 

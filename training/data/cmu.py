@@ -17,12 +17,12 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from .contacts import contacts_for
-from .mocap_io import MotionFormatError
-from .paths import DEFAULT_CACHE, add_mocap_argument, resolve_mocap_dir
-from .resample import resample
-from .retarget import CanonicalClip, retarget, source_from_amc, source_from_cmu_bvh
-from .skeleton import FOOT_POINTS, canonical_skeleton
+from ..mocap.contacts import contacts_for
+from ..mocap.files import MotionFormatError
+from ..paths import DEFAULT_CACHE, add_mocap_argument, resolve_mocap_dir
+from ..mocap.resample import resample
+from ..mocap.retarget import CanonicalClip, retarget, source_from_amc, source_from_cmu_bvh
+from ..mocap.skeleton import FOOT_POINTS, canonical_skeleton
 
 CATEGORIES = ("walk", "run", "jump", "dance", "other")
 

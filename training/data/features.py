@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .rotations import axis_rotation, matrix_to_quat, quat_to_matrix
-from .skeleton import Skeleton, canonical_skeleton, forward_kinematics_matrices
+from ..mocap.rotations import axis_rotation, matrix_to_quat, quat_to_matrix
+from ..mocap.skeleton import Skeleton, canonical_skeleton, forward_kinematics_matrices
 
 # Segments that retargeting keeps rigid (see retarget.RIGID_BONES): nothing to model.
 FIXED_JOINTS = ("LeftUpLeg", "RightUpLeg", "LeftHand_end", "RightHand_end")
@@ -143,7 +143,7 @@ def wraparound_report(rotations: np.ndarray, clip_starts: list[int], small_turn:
     """Wrap-around check: the largest jump in each representation between consecutive frames (same clip)
     whose true rotation changes by less than `small_turn` radians. A jump there is an artefact of the
     representation, not of the motion."""
-    from .rotations import matrix_to_euler_zyx
+    from ..mocap.rotations import matrix_to_euler_zyx
 
     codec = FeatureCodec()
     codec.fit_references(rotations)

@@ -8,9 +8,9 @@ import numpy as np
 import onnxruntime as ort
 from tqdm import tqdm
 
-from .features import FeatureCodec
-from .rotations import quat_to_matrix
-from .skeleton import canonical_skeleton
+from ..data.features import FeatureCodec
+from ..mocap.rotations import quat_to_matrix
+from ..mocap.skeleton import canonical_skeleton
 
 
 class ShippedGenerator:

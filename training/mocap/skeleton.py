@@ -140,7 +140,7 @@ def build_canonical_from_asfs(asf_paths: list[Path]) -> dict:
 def main() -> None:
     import argparse
 
-    from .paths import add_mocap_argument, resolve_mocap_dir
+    from ..paths import add_mocap_argument, resolve_mocap_dir
 
     parser = argparse.ArgumentParser(description="Rebuild canonical_skeleton.json from the CMU ASF files.")
     add_mocap_argument(parser)

@@ -28,13 +28,12 @@ import onnx
 import torch
 from onnx import numpy_helper
 
-from .export_generator import GATE_ORDER, parity_error
-from .models.generator import MixtureLSTM
-from .paths import REPO_ROOT
-from .rotations import quat_to_matrix
-from .runs import RUNS_DIR
+from .export import GATE_ORDER, parity_error
+from ..models.generator import MixtureLSTM
+from ..paths import MODELS_DIR
+from ..mocap.rotations import quat_to_matrix
+from ..runs import RUNS_DIR
 
-MODELS_DIR = REPO_ROOT / "public" / "models"
 ONNX_TO_TORCH_GATES = [0, 2, 3, 1]  # torch (i, f, g, o) from ONNX LSTM blocks (i, o, f, c)
 
 

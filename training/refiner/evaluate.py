@@ -30,15 +30,14 @@ import onnxruntime as ort
 import torch
 from torch import nn
 
-from . import metrics
-from .export_generator import MODELS_DIR
-from .features import FeatureCodec
-from .footlock import foot_lock
-from .generate import ShippedGenerator
-from .models.refiner import FeatureGeometry
-from .paths import REPO_ROOT
-from .rotations import axis_rotation
-from .train_generator import Corpus, load_clips
+from .. import metrics
+from ..data.features import FeatureCodec
+from ..footlock import foot_lock
+from ..generator.shipped import ShippedGenerator
+from ..models.refiner import FeatureGeometry
+from ..paths import MODELS_DIR, REPO_ROOT
+from ..mocap.rotations import axis_rotation
+from ..generator.train import Corpus, load_clips
 
 REPORTS = REPO_ROOT / "docs" / "models"
 TEMPERATURE = 0.5
@@ -303,7 +302,7 @@ def plot(report: dict, speeds: dict, planted: dict, var_a: dict) -> None:
         ax.set(title=f"{key} speed", xlabel="m/s")
     # a stretch of the left toe's height and forward position, raw vs refined vs locked
     s = {v: var_a[v][0] for v in VARIANTS}
-    from .skeleton import canonical_skeleton
+    from ..mocap.skeleton import canonical_skeleton
     toe = canonical_skeleton().index("LeftToeBase")
     t = np.arange(300, 420)
     for v in ("raw", "refined", "refined + foot lock"):

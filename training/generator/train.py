@@ -20,13 +20,13 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from .dataset import DEFAULT_CACHE, build, load_cache
-from .features import FeatureCodec, mirror_clip
-from .models.generator import MixtureLSTM, mixture_nll
-from .paths import add_mocap_argument, resolve_mocap_dir
-from .resample import resample
-from .retarget import CanonicalClip
-from .runs import Run
+from ..data.cmu import DEFAULT_CACHE, build, load_cache
+from ..data.features import FeatureCodec, mirror_clip
+from ..models.generator import MixtureLSTM, mixture_nll
+from ..paths import add_mocap_argument, resolve_mocap_dir
+from ..mocap.resample import resample
+from ..mocap.retarget import CanonicalClip
+from ..runs import Run
 
 FPS = 30
 CATEGORIES = ["walk", "run"]

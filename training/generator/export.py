@@ -16,19 +16,17 @@ import numpy as np
 import onnx
 import onnxruntime as ort
 import torch
-from onnx import numpy_helper
 
-from .features import FIXED_JOINTS, FeatureCodec, feature_names
-from .models.generator import LOG_SIGMA_MIN, GeneratorStep, MixtureLSTM, mixture_nll
-from .manifest import register_model
-from .onnx_graph import OPSET, GraphBuilder
-from .paths import REPO_ROOT
-from .rotations import matrix_to_quat
-from .runs import RUNS_DIR
-from .skeleton import canonical_skeleton
-from .train_generator import load_clips
+from ..data.features import FIXED_JOINTS, FeatureCodec, feature_names
+from ..models.generator import LOG_SIGMA_MIN, GeneratorStep, MixtureLSTM, mixture_nll
+from ..onnx.manifest import register_model
+from ..onnx.graph import OPSET, GraphBuilder
+from ..paths import MODELS_DIR, REPO_ROOT
+from ..mocap.rotations import matrix_to_quat
+from ..runs import RUNS_DIR
+from ..mocap.skeleton import canonical_skeleton
+from .train import load_clips
 
-MODELS_DIR = REPO_ROOT / "public" / "models"
 INPUTS, OUTPUTS = ["x", "h", "c"], ["weights", "mu", "sigma", "h_out", "c_out"]
 PARITY_TOLERANCE = 1e-4
 

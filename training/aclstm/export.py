@@ -17,14 +17,13 @@ import numpy as np
 import onnxruntime as ort
 import torch
 
-from . import metrics
-from .aclstm_data import MODEL_FPS, STYLES, decode, encode, load_clips, resample_positions
-from .manifest import register_model
-from .models.aclstm import DanceLSTM, DanceStep
-from .paths import REPO_ROOT
-from .runs import RUNS_DIR
+from .. import metrics
+from ..data.dance import MODEL_FPS, STYLES, decode, encode, load_clips, resample_positions
+from ..onnx.manifest import register_model
+from ..models.aclstm import DanceLSTM, DanceStep
+from ..paths import MODELS_DIR, REPO_ROOT
+from ..runs import RUNS_DIR
 
-MODELS_DIR = REPO_ROOT / "public" / "models"
 INPUTS, OUTPUTS = ["x", "style", "h", "c"], ["y", "h_out", "c_out"]
 PARITY_TOLERANCE = 1e-4
 SEED_FRAMES = 10  # the paper's seed length (about 170 ms at 60 fps)

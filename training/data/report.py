@@ -13,9 +13,9 @@ from collections import defaultdict
 import numpy as np
 from tqdm import tqdm
 
-from .dataset import clip_contacts, load_clip, read_index
-from .paths import REPO_ROOT, add_mocap_argument, resolve_mocap_dir
-from .skeleton import GROUND_POINTS, canonical_skeleton
+from .cmu import clip_contacts, load_clip, read_index
+from ..paths import REPO_ROOT, add_mocap_argument, resolve_mocap_dir
+from ..mocap.skeleton import GROUND_POINTS, canonical_skeleton
 
 OUT = REPO_ROOT / "docs" / "data.md"
 

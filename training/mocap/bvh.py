@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .mocap_io import MAX_FRAMES, MAX_VALUES, MotionFormatError, parse_floats, read_text
+from .files import MAX_FRAMES, MAX_VALUES, MotionFormatError, parse_floats, read_text
 from .rotations import euler_matrix
 
 CHANNELS = {"xposition", "yposition", "zposition", "xrotation", "yrotation", "zrotation"}

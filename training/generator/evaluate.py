@@ -15,12 +15,11 @@ import time
 from pathlib import Path
 
 import numpy as np
-from . import metrics
-from .export_generator import MODELS_DIR
-from .features import wraparound_report
-from .generate import ShippedGenerator
-from .paths import REPO_ROOT
-from .train_generator import load_clips
+from .. import metrics
+from ..data.features import wraparound_report
+from .shipped import ShippedGenerator
+from ..paths import MODELS_DIR, REPO_ROOT
+from .train import load_clips
 
 REPORTS = REPO_ROOT / "docs" / "models"
 FREEZE_FRACTION = 0.2
@@ -255,12 +254,12 @@ def main(argv: list[str] | None = None) -> None:
                         help="aclstm: another exported dance model to compare (not shipped), e.g. 'acLSTM v=20=/tmp/x/aclstm.json'")
     args = parser.parse_args(argv)
     if args.model == "refiner":
-        from . import evaluate_refiner
+        from ..refiner import evaluate as evaluate_refiner
         evaluate_refiner.run_and_write(args.frames or 3000, args.seeds or 8, args.mocap, args.models)
         return
     args.seeds = args.seeds or 5
     if args.model == "aclstm":
-        from . import evaluate_aclstm
+        from ..aclstm import evaluate as evaluate_aclstm
         evaluate_aclstm.run(args.frames or 20000, args.seeds, args.mocap, args.models, args.also)
         return
     args.frames = args.frames or 10000

@@ -21,8 +21,8 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from .bvh import global_transforms, load_bvh
-from .paths import DEFAULT_CACHE, add_mocap_argument, resolve_mocap_dir
+from ..mocap.bvh import global_transforms, load_bvh
+from ..paths import DEFAULT_CACHE, add_mocap_argument, resolve_mocap_dir
 
 STYLES = ("salsa", "indian", "martial")
 SOURCE_FPS = {"salsa": 60.0, "indian": 120.0, "martial": 120.0}  # from aclstm/readme.txt

@@ -35,13 +35,12 @@ import onnxruntime as ort
 import torch
 from onnx import numpy_helper
 
-from .export_generator import MODELS_DIR
-from .footlock import BLEND_IN, BLEND_OUT, REACH, TOE_GROUND_HEIGHT
-from .manifest import register_model
-from .onnx_graph import OPSET, GraphBuilder
-from .models.refiner import Refiner, RefinerStep
-from .paths import REPO_ROOT
-from .runs import RUNS_DIR
+from ..footlock import BLEND_IN, BLEND_OUT, REACH, TOE_GROUND_HEIGHT
+from ..onnx.manifest import register_model
+from ..onnx.graph import OPSET, GraphBuilder
+from ..models.refiner import Refiner, RefinerStep
+from ..paths import MODELS_DIR, REPO_ROOT
+from ..runs import RUNS_DIR
 
 INPUTS, OUTPUTS = ["x", "ends", "ends_prev", "h", "c"], ["x_refined", "h_out", "c_out"]
 PARITY_TOLERANCE = 1e-4

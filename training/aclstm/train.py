@@ -23,10 +23,10 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from .aclstm_data import MODEL_FPS, STYLES, encode, load_clips, mirror, mirror_pairs, resample_positions, rotate_y
-from .models.aclstm import DanceLSTM
-from .paths import add_mocap_argument
-from .runs import Run
+from ..data.dance import MODEL_FPS, STYLES, encode, load_clips, mirror, mirror_pairs, resample_positions, rotate_y
+from ..models.aclstm import DanceLSTM
+from ..paths import add_mocap_argument
+from ..runs import Run
 
 SPEEDS = (0.8, 1.2)
 

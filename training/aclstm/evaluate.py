@@ -19,11 +19,11 @@ from pathlib import Path
 
 import numpy as np
 
-from . import metrics
-from .aclstm_data import LIMB_MIN_LENGTH, MODEL_FPS, STYLES, bone_length_error, decode, encode, load_clips, resample_positions
-from .dance import ShippedDance
-from .export_aclstm import real_pose_change
-from .paths import REPO_ROOT
+from .. import metrics
+from ..data.dance import LIMB_MIN_LENGTH, MODEL_FPS, STYLES, bone_length_error, decode, encode, load_clips, resample_positions
+from .shipped import ShippedDance
+from .export import real_pose_change
+from ..paths import REPO_ROOT
 
 REPORTS = REPO_ROOT / "docs" / "models"
 FREEZE_FRACTION = 0.2

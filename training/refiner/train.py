@@ -46,13 +46,13 @@ import torch
 import torch.nn.functional as F
 from tqdm import tqdm
 
-from .dataset import DEFAULT_CACHE
-from .export_generator import load_generator
-from .models.generator import MixtureLSTM
-from .models.refiner import Discriminator, Refiner, discriminator_input, discriminator_inputs
-from .paths import add_mocap_argument
-from .runs import RUNS_DIR, Run
-from .train_generator import Corpus, load_clips
+from ..data.cmu import DEFAULT_CACHE
+from ..generator.export import load_generator
+from ..models.generator import MixtureLSTM
+from ..models.refiner import Discriminator, Refiner, discriminator_input, discriminator_inputs
+from ..paths import add_mocap_argument
+from ..runs import RUNS_DIR, Run
+from ..generator.train import Corpus, load_clips
 
 TEMPERATURE = 0.5
 TOE_NAMES = ("LeftToeBase", "RightToeBase")

@@ -1,0 +1,1 @@
+"""The dance models (acLSTM and its vanilla baseline): training, export, evaluation."""

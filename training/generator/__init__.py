@@ -1,0 +1,1 @@
+"""The locomotion generator (LSTM + Gaussian mixture): training, export, evaluation, recovery."""

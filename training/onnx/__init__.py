@@ -1,0 +1,1 @@
+"""Writing ONNX files: the graph builder and the manifest of shipped models."""

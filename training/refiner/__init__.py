@@ -1,0 +1,1 @@
+"""The adversarial refiner: training, export, evaluation."""
