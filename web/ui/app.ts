@@ -10,30 +10,21 @@ import { downloadText } from './download';
 import { baseName, readTextFile, type TextFile } from './files';
 import { DanceClient, type DanceInitResult } from '../runtime/danceClient';
 import { GeneratorClient, type InitResult } from '../runtime/generatorClient';
-import { DanceMode } from './danceMode';
-import type { LiveChunk, LiveMode } from './liveMode';
+import { $, errorMessage } from './dom';
 import { BusyIndicator, ModelHost, pageThreads } from './modelHost';
+import { DanceMode } from './modes/danceMode';
+import type { ModeHost } from './modes/host';
+import type { LiveChunk, LiveMode } from './modes/liveMode';
+import { PathMode } from './modes/pathMode';
+import { RandomWalk } from './modes/randomWalk';
+import { SteerMode } from './modes/steerMode';
 import { Panel } from './panel';
-import { PathMode } from './pathMode';
-import { RandomWalk } from './randomWalk';
-import { SteerMode } from './steerMode';
 import { Toasts } from './toast';
-
-function $(id: string): HTMLElement {
-  const el = document.getElementById(id);
-  if (!el) throw new Error(`missing #${id} in index.html`);
-  return el;
-}
-
-export function errorMessage(e: unknown): string {
-  if (e instanceof Error) return e.message || e.name;
-  return String(e);
-}
 
 export type Mode = 'clip' | 'walk' | 'dance' | 'path' | 'steer';
 const MODES: Mode[] = ['clip', 'walk', 'dance', 'path', 'steer'];
 
-export class App {
+export class App implements ModeHost {
   readonly viewer: Viewer;
   readonly panel: Panel;
   readonly toasts: Toasts;
@@ -44,7 +35,7 @@ export class App {
   private name = '';
   private lastAsf: TextFile | null = null;
   private lastErrorMessage: string | null = null;
-  private readonly exportBtn = $('export-btn') as HTMLButtonElement;
+  private readonly exportBtn = $<HTMLButtonElement>('export-btn');
   readonly walk: RandomWalk;
   readonly danceMode: DanceMode;
   readonly pathMode: PathMode;
@@ -59,7 +50,7 @@ export class App {
     this.toasts = new Toasts($('toasts'));
     this.viewer.onFrame = (s) => this.panel.update(s);
 
-    const input = $('file-input') as HTMLInputElement;
+    const input = $<HTMLInputElement>('file-input');
     for (const id of ['open-btn', 'empty-open']) $(id).addEventListener('click', () => input.click());
     input.addEventListener('change', () => {
       const files = [...(input.files ?? [])];
@@ -153,6 +144,10 @@ export class App {
     this.name = name;
     this.exportBtn.disabled = false;
     document.body.classList.add('has-motion');
+  }
+
+  syncLayers(): void {
+    this.panel.syncLayers();
   }
 
   /** An empty stage ("No motion"). */

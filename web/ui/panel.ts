@@ -2,19 +2,14 @@
 
 import type { Viewer, ViewerLayers } from '../viewer/viewer';
 import type { PlaybackState } from '../viewer/playback';
-
-function $(id: string): HTMLElement {
-  const el = document.getElementById(id);
-  if (!el) throw new Error(`missing #${id} in index.html`);
-  return el;
-}
+import { $, setSliderFill } from './dom';
 
 export class Panel {
-  private readonly playBtn = $('play-btn') as HTMLButtonElement;
-  private readonly timeline = $('timeline') as HTMLInputElement;
+  private readonly playBtn = $<HTMLButtonElement>('play-btn');
+  private readonly timeline = $<HTMLInputElement>('timeline');
   private readonly frameOut = $('frame-out');
   private readonly timeOut = $('time-out');
-  private readonly speed = $('speed') as HTMLInputElement;
+  private readonly speed = $<HTMLInputElement>('speed');
   private readonly speedOut = $('speed-out');
   private readonly fpsOut = $('fps-out');
   private scrubbing = false;
@@ -117,8 +112,7 @@ export class Panel {
     if (s.frame !== sh.frame && (!s.playing || now - this.domAt > 30)) {
       this.domAt = now;
       if (!this.scrubbing) this.timeline.value = String(s.frame);
-      const p = s.frames > 1 ? (s.frame / (s.frames - 1)) * 100 : 0;
-      this.timeline.style.setProperty('--p', `${p}%`);
+      setSliderFill(this.timeline, s.frames > 1 ? s.frame / (s.frames - 1) : 0);
       const last = Math.max(s.frames - 1, 0);
       this.frameOut.textContent = `${s.frame} / ${last}`;
       this.timeOut.textContent = s.frames ? `${(s.frame / s.fps).toFixed(2)} s / ${(last / s.fps).toFixed(2)} s` : '—';

@@ -1,5 +1,7 @@
 // Dismissable messages at the top of the page. Errors stay until dismissed; notes fade by themselves.
 
+import { element } from './dom';
+
 export type ToastKind = 'error' | 'info';
 
 const MAX_TOASTS = 4;
@@ -8,20 +10,13 @@ export class Toasts {
   constructor(private readonly root: HTMLElement) {}
 
   show(message: string, kind: ToastKind = 'info'): HTMLElement {
-    const el = document.createElement('div');
-    el.className = `toast ${kind}`;
+    const el = element('div', `toast ${kind}`);
     el.setAttribute('role', kind === 'error' ? 'alert' : 'status');
-    const icon = document.createElement('span');
-    icon.className = 'toast-icon';
-    icon.textContent = kind === 'error' ? '!' : 'i';
-    const text = document.createElement('div');
-    text.className = 'toast-text';
-    text.textContent = message;
-    const close = document.createElement('button');
-    close.className = 'toast-close';
+    const icon = element('span', 'toast-icon', kind === 'error' ? '!' : 'i');
+    const text = element('div', 'toast-text', message);
+    const close = element('button', 'toast-close', '×');
     close.type = 'button';
     close.setAttribute('aria-label', 'Dismiss');
-    close.textContent = '×';
     close.addEventListener('click', () => this.dismiss(el));
     el.append(icon, text, close);
     this.root.append(el);

@@ -5,11 +5,12 @@
 // A mint arrow on the ground at the character shows the target heading; the readout at the top left
 // compares target and achieved speed.
 
-import { angleDifference } from '../optimizer/path';
-import type { ControlledMotion, GeneratorClient } from '../runtime/generatorClient';
-import { GroundArrow, TARGET_COLOR } from '../viewer/groundPath';
-import type { App } from './app';
-import { $, LiveMode, type LiveStream } from './liveMode';
+import { angleDifference } from '../../optimizer/path';
+import type { ControlledMotion, GeneratorClient } from '../../runtime/generatorClient';
+import { GroundArrow, TARGET_COLOR } from '../../viewer/groundPath';
+import { $, setSliderFill } from '../dom';
+import type { ModeHost } from './host';
+import { LiveMode, type LiveStream } from './liveMode';
 
 type Gait = 'walk' | 'run';
 
@@ -93,7 +94,7 @@ export class SteerMode extends LiveMode<ControlledMotion> {
   /** Until when the camera is left where the user turned it. */
   private chasePausedUntil = 0;
 
-  constructor(app: App) {
+  constructor(app: ModeHost) {
     // 20 s kept behind the playhead.
     super(app, $('steer-status'), { chunk: BATCH, ahead: AHEAD, keep: 600, label: 'Steer', name: 'steer' });
     app.viewer.scene.add(this.arrow.mesh);
@@ -135,13 +136,13 @@ export class SteerMode extends LiveMode<ControlledMotion> {
     this.cruise = Math.min(Math.max(v, 0), MAX_SPEED);
     if (moveSlider) this.speed.value = String(this.cruise);
     this.speedOut.textContent = `${this.cruise.toFixed(1)} m/s`;
-    this.speed.style.setProperty('--p', `${(this.cruise / MAX_SPEED) * 100}%`);
+    setSliderFill(this.speed, this.cruise / MAX_SPEED);
   }
 
   override async begin(): Promise<void> {
     const viewer = this.app.viewer;
     viewer.setLayers({ follow: true });
-    this.app.panel.syncLayers();
+    this.app.syncLayers();
     this.lastTick = performance.now();
     cancelAnimationFrame(this.frameRequest);
     this.frameRequest = requestAnimationFrame((t) => this.tick(t));

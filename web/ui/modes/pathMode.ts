@@ -4,13 +4,12 @@
 // Redrawing replaces the path; a stroke that is too short, or a failed optimisation, keeps what was there.
 
 import * as THREE from 'three';
-import { MAX_PATH_LENGTH, MIN_PATH_LENGTH } from '../optimizer/path';
-import type { Motion } from '../motion/types';
-import type { FollowedPath, GeneratorClient } from '../runtime/generatorClient';
-import { GroundLine, TARGET_COLOR } from '../viewer/groundPath';
-import type { App } from './app';
-import { errorMessage } from './app';
-import { $ } from './liveMode';
+import { MAX_PATH_LENGTH, MIN_PATH_LENGTH } from '../../optimizer/path';
+import type { Motion } from '../../motion/types';
+import type { FollowedPath, GeneratorClient } from '../../runtime/generatorClient';
+import { GroundLine, TARGET_COLOR } from '../../viewer/groundPath';
+import { $, element, errorMessage, readSeed, setSliderFill } from '../dom';
+import type { ModeHost } from './host';
 
 type Gait = 'walk' | 'run';
 type Point = [number, number];
@@ -70,7 +69,7 @@ export class PathMode {
   private readonly plane = new THREE.Plane(new THREE.Vector3(0, 1, 0), 0);
   private readonly hit = new THREE.Vector3();
 
-  constructor(private readonly app: App) {
+  constructor(private readonly app: ModeHost) {
     app.viewer.scene.add(this.line.mesh);
     this.fit.value = String(DEFAULT_FIT);
     this.showFit();
@@ -101,7 +100,7 @@ export class PathMode {
       this.line.set(flat(this.points));
       if (this.points.length) viewer.frameGround(flat(this.points), RISE);
       else this.drawingView();
-      this.app.panel.syncLayers();
+      this.app.syncLayers();
     }
     this.showState();
   }
@@ -113,7 +112,7 @@ export class PathMode {
     const viewer = this.app.viewer;
     viewer.controls.mouseButtons.RIGHT = THREE.MOUSE.PAN;
     viewer.setLayers({ follow: this.followBefore });
-    this.app.panel.syncLayers();
+    this.app.syncLayers();
     viewer.invalidate();
   }
 
@@ -133,13 +132,11 @@ export class PathMode {
   private showFit(): void {
     const v = Number(this.fit.value);
     this.fitOut.textContent = `${v.toFixed(2)} m`;
-    this.fit.style.setProperty('--p', `${((v - Number(this.fit.min)) / (Number(this.fit.max) - Number(this.fit.min))) * 100}%`);
+    setSliderFill(this.fit, (v - Number(this.fit.min)) / (Number(this.fit.max) - Number(this.fit.min)));
   }
 
   private params(): { gait: Gait; seed: number; fitSigma: number } {
-    let seed = Math.floor(Number(this.seed.value));
-    if (!Number.isFinite(seed) || seed < 0) seed = 0;
-    seed = Math.min(seed, 0xffffffff);
+    const seed = readSeed(this.seed);
     const fitSigma = Math.min(Math.max(Number(this.fit.value) || DEFAULT_FIT, 0.05), 0.5);
     return { gait: this.gait.value === 'run' ? 'run' : 'walk', seed, fitSigma };
   }
@@ -311,7 +308,7 @@ export class PathMode {
     controls.target.y -= drop;
     camera.position.y -= drop;
     controls.update();
-    this.app.panel.syncLayers();
+    this.app.syncLayers();
   }
 
   // ---------- status ----------
@@ -346,8 +343,5 @@ export class PathMode {
 }
 
 function legend(kind: string, text: string): HTMLElement {
-  const el = document.createElement('span');
-  el.className = `legend legend-${kind}`;
-  el.textContent = text;
-  return el;
+  return element('span', `legend legend-${kind}`, text);
 }

@@ -3,11 +3,12 @@
 // plot shows the pose change per second against real dance (the baseline's curve falls to the freeze
 // line within seconds: it stops moving).
 
-import { PoseChangeMeter } from '../motion/poseChange';
-import type { DanceClient, DanceInitResult, DanceMotion } from '../runtime/danceClient';
-import type { App } from './app';
-import { $, LiveMode, type LiveStream } from './liveMode';
-import { PoseChangePlot } from './poseChangePlot';
+import { PoseChangeMeter } from '../../motion/poseChange';
+import type { DanceClient, DanceInitResult, DanceMotion } from '../../runtime/danceClient';
+import { $ } from '../dom';
+import { PoseChangePlot } from '../poseChangePlot';
+import type { ModeHost } from './host';
+import { LiveMode, type LiveStream } from './liveMode';
 
 export class DanceMode extends LiveMode<DanceMotion> {
   private readonly model = $<HTMLSelectElement>('dance-model');
@@ -21,7 +22,7 @@ export class DanceMode extends LiveMode<DanceMotion> {
   private client: { id: string; client: DanceClient } | null = null;
   private seedName = '';
 
-  constructor(app: App) {
+  constructor(app: ModeHost) {
     // 1 s chunks at the models' 30 fps, at least 1.5 s ahead, 20 s kept.
     super(app, $('dance-status'), { chunk: 30, ahead: 45, keep: 600, label: 'Dance', name: 'dance' });
     this.model.addEventListener('change', () => this.restartIfActive());

@@ -2,10 +2,10 @@
 // time, a little ahead of the playhead; the viewer shows a rolling window of the last seconds
 // (interpolated at the display rate), so memory and drawing stay bounded for hours.
 
-import { detectContacts } from '../motion/contacts';
-import type { Motion } from '../motion/types';
-import type { App } from './app';
-import { errorMessage } from './app';
+import { detectContacts } from '../../motion/contacts';
+import type { Motion } from '../../motion/types';
+import { errorMessage } from '../dom';
+import type { ModeHost } from './host';
 
 /** Frames as a stream delivers them. Without contacts they are detected over the shown window. */
 export interface LiveChunk {
@@ -37,12 +37,6 @@ export interface LiveSettings {
   name: string;
 }
 
-export function $<T extends HTMLElement>(id: string): T {
-  const el = document.getElementById(id);
-  if (!el) throw new Error(`missing #${id} in index.html`);
-  return el as T;
-}
-
 export abstract class LiveMode<Chunk extends LiveChunk> {
   private active = false;
   /** Bumped on every (re)start and stop: a running loop whose token is stale ends. */
@@ -59,7 +53,7 @@ export abstract class LiveMode<Chunk extends LiveChunk> {
   onFailed: (() => void) | null = null;
 
   constructor(
-    protected readonly app: App,
+    protected readonly app: ModeHost,
     private readonly status: HTMLElement,
     private readonly settings: LiveSettings,
   ) {}

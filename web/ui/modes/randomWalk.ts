@@ -3,12 +3,13 @@
 // figure shows the refined, foot-locked frames; **side by side** also draws the raw frames of the same
 // samples (grey, to the left). A readout shows the foot skating of what is drawn over the last seconds.
 
-import { skatingSample } from '../motion/footSkating';
-import type { Motion } from '../motion/types';
-import type { GeneratedMotion, GeneratorClient } from '../runtime/generatorClient';
-import { CompanionAligner } from '../viewer/sideBySide';
-import type { App } from './app';
-import { $, LiveMode, type LiveStream } from './liveMode';
+import { skatingSample } from '../../motion/footSkating';
+import type { Motion } from '../../motion/types';
+import type { GeneratedMotion, GeneratorClient } from '../../runtime/generatorClient';
+import { CompanionAligner } from '../../viewer/sideBySide';
+import { $, readSeed } from '../dom';
+import type { ModeHost } from './host';
+import { LiveMode, type LiveStream } from './liveMode';
 
 const DEFAULT_TEMPERATURE = 0.5;
 /** Seconds of motion up to the playhead the skating readout averages over. */
@@ -46,7 +47,7 @@ export class RandomWalk extends LiveMode<WalkChunk> {
   private readonly skatingRaw = $('walk-skating-raw');
   private readonly skatingRefined = $('walk-skating-refined');
 
-  constructor(app: App) {
+  constructor(app: ModeHost) {
     // 1 s chunks at 30 fps, at least 1.5 s ahead, 20 s kept.
     super(app, $('walk-status'), { chunk: 30, ahead: 45, keep: 600, label: 'Random walk', name: 'random-walk' });
     this.temperature.value = String(DEFAULT_TEMPERATURE);
@@ -80,9 +81,7 @@ export class RandomWalk extends LiveMode<WalkChunk> {
   }
 
   private params(): { seed: number; temperature: number; seedIndex?: number; refine: boolean } {
-    let seed = Math.floor(Number(this.seed.value));
-    if (!Number.isFinite(seed) || seed < 0) seed = 0;
-    seed = Math.min(seed, 0xffffffff);
+    const seed = readSeed(this.seed);
     const temperature = Math.min(Math.max(Number(this.temperature.value) || 0, 0), 2);
     const idx = this.seedState.value === '' ? undefined : Number(this.seedState.value);
     return { seed, temperature, ...(idx === undefined ? {} : { seedIndex: idx }), refine: this.refine.checked };

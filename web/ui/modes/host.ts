@@ -1,0 +1,44 @@
+// What a mode (Random walk, Dance, Steer, Path) gets from the page: the stage it draws on, the models
+// it runs, and the page's title line and messages. The page controller (ui/app.ts) implements it; a mode
+// never sees the rest of the page (the import, export and mode switching).
+
+import type { Motion } from '../../motion/types';
+import type { DanceClient, DanceInitResult } from '../../runtime/danceClient';
+import type { GeneratorClient, InitResult } from '../../runtime/generatorClient';
+import type { Viewer } from '../../viewer/viewer';
+import type { ModelHost } from '../modelHost';
+
+/**
+ * The parts of the viewer a mode uses: the camera rig (camera, orbit controls, framing), the scene for
+ * its ground markers, the canvas for pointer input, the playhead, the shown motion and its companion
+ * figure, and the layers (a mode may follow the character or stop following it). Showing a motion goes
+ * through the host instead, which also keeps the page's export and title in step.
+ */
+export type ModeViewer = Pick<
+  Viewer,
+  | 'camera' | 'controls' | 'frameGround' | 'invalidate'
+  | 'scene' | 'renderer' | 'playback' | 'current' | 'footprintCount' | 'rootPosition' | 'setCompanion'
+  | 'layers' | 'setLayers'
+>;
+
+export interface ModeHost {
+  readonly viewer: ModeViewer;
+  /** The generator model (Random walk, Steer, Path), loaded on first use and shared with the API. */
+  readonly generator: ModelHost<GeneratorClient, InitResult>;
+  /** A dance model (`id` "aclstm" or "aclstm-vanilla"), loaded on first use. */
+  dance(id: string): ModelHost<DanceClient, DanceInitResult>;
+  /** Shows a live mode's window of streamed frames (`dropped` < 0: a new stream); `name` names exports. */
+  showLive(motion: Motion, dropped: number, name: string): void;
+  /** Shows a finished motion (Path mode's walk) without leaving the mode; `name` names exports. */
+  showInMode(motion: Motion, name: string): void;
+  /** An empty stage. */
+  clearMotion(): void;
+  /** The title line: the mode's name and what it shows. */
+  setLiveLabel(name: string, meta: string): void;
+  /** An error message for the user (also `playground.lastError()`). */
+  reportError(message: string): void;
+  /** A passing note for the user (a hint). */
+  note(message: string): void;
+  /** The panel's layer toggles show the viewer's layers again, after a mode changed them. */
+  syncLayers(): void;
+}
