@@ -186,9 +186,94 @@ async function loadManifest(): Promise<ModelInfo[]> {
   return parseManifest(await res.json());
 }
 
-export function createPlayground(app: App): Playground {
-  let models: ModelInfo[] = [];
+type GeneratorCall = { kind: 'lstm-gmm'; model: string; frames: number; seed: number; temperature: number; refine: boolean };
+type DanceCall = { kind: 'aclstm'; model: string; frames: number; seed: number; style: string };
 
+/** Checks generate's options against the model they name (`models`: the manifest); the error says what is wrong. */
+function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorCall | DanceCall {
+  if (typeof options !== 'object' || options === null || Array.isArray(options)) {
+    throw new TypeError('options must be an object: { model, frames, seed, temperature? } (acLSTM: { model, style, frames, seed })');
+  }
+  const o = options as Partial<Record<keyof GenerateOptions, unknown>>;
+  const usable = models.filter((m) => m.kind === 'lstm-gmm' || m.kind === 'aclstm');
+  const available = usable.map((m) => m.id).join(', ');
+  if (typeof o.model !== 'string') throw new TypeError(`model must be a model id string (available: ${available || 'none'})`);
+  const entry = usable.find((m) => m.id === o.model);
+  if (!entry) throw new Error(`unknown model "${o.model}" (available: ${available || 'none — the model list did not load'})`);
+  const dance = entry.kind === 'aclstm';
+  if (dance) {
+    // Dance models have no sampling and no refiner: say so rather than silently ignoring the option.
+    if ('temperature' in o) throw new TypeError(`temperature is not meaningful for acLSTM models: they are deterministic (the seed only picks the seed motion); leave it out`);
+    if ('refine' in o) throw new TypeError(`refine is not available for acLSTM models (there is no refiner for dance); leave it out`);
+  }
+  const known = dance ? ['model', 'style', 'frames', 'seed'] : ['model', 'frames', 'seed', 'temperature', 'refine'];
+  for (const k of Object.keys(options)) {
+    if (!known.includes(k)) throw new TypeError(`unknown option "${k}" for model "${entry.id}" (known: ${known.join(', ')})`);
+  }
+  if (typeof o.frames !== 'number' || !Number.isInteger(o.frames) || o.frames < 1 || o.frames > GENERATE_MAX_FRAMES) {
+    throw new RangeError(`frames must be an integer from 1 to ${GENERATE_MAX_FRAMES}, got ${String(o.frames)}`);
+  }
+  if (typeof o.seed !== 'number' || !Number.isInteger(o.seed) || o.seed < 0 || o.seed > 0xffffffff) {
+    throw new RangeError(`seed must be an integer from 0 to 4294967295, got ${String(o.seed)}`);
+  }
+  if (dance) {
+    const styles = entry.styles ?? [];
+    if (o.style === undefined) throw new TypeError(`style is required for model "${entry.id}" (styles: ${styles.join(', ')})`);
+    if (typeof o.style !== 'string' || !styles.includes(o.style)) {
+      throw new RangeError(`unknown style ${typeof o.style === 'string' ? `"${o.style}"` : String(o.style)} for model "${entry.id}" (styles: ${styles.join(', ')})`);
+    }
+    return { kind: 'aclstm', model: entry.id, frames: o.frames, seed: o.seed, style: o.style };
+  }
+  const temperature = o.temperature ?? GENERATE_DEFAULT_TEMPERATURE;
+  if (typeof temperature !== 'number' || !Number.isFinite(temperature) || temperature < 0 || temperature > 2) {
+    throw new RangeError(`temperature must be a number from 0 to 2, got ${String(o.temperature)}`);
+  }
+  if (o.refine !== undefined && typeof o.refine !== 'boolean') throw new TypeError(`refine must be true or false, got ${String(o.refine)}`);
+  const refine = o.refine === true;
+  if (refine && !models.some((m) => m.kind === 'refiner')) throw new Error('refine is not available: no refiner model is listed in models/index.json');
+  return { kind: 'lstm-gmm', model: entry.id, frames: o.frames, seed: o.seed, temperature, refine };
+}
+
+/** Throws unless `options` is a plain object whose keys are all in `known`. */
+function checkKeys(options: unknown, known: string[], shape: string): Record<string, unknown> {
+  if (typeof options !== 'object' || options === null || Array.isArray(options)) throw new TypeError(`options must be an object: ${shape}`);
+  for (const k of Object.keys(options)) {
+    if (!known.includes(k)) throw new TypeError(`unknown option "${k}" (known: ${known.join(', ')})`);
+  }
+  return options as Record<string, unknown>;
+}
+
+/** Throws unless `options` are view options: layer switches true or false, framing "character" or "all". */
+function checkView(options: unknown): ViewOptions {
+  if (typeof options !== 'object' || options === null) throw new TypeError('options must be an object');
+  const known = ['follow', 'trail', 'footprints', 'framing'];
+  for (const [k, v] of Object.entries(options)) {
+    if (!known.includes(k)) throw new TypeError(`unknown option "${k}" (known: ${known.join(', ')})`);
+    if (k === 'framing' ? v !== 'character' && v !== 'all' : typeof v !== 'boolean') {
+      throw new TypeError(k === 'framing' ? 'framing must be "character" or "all"' : `${k} must be true or false`);
+    }
+  }
+  return options as ViewOptions;
+}
+
+/** A dance as a Motion: the fitted positions, and foot contacts detected as for imported clips. */
+async function generateDance(app: App, o: DanceCall): Promise<Motion> {
+  const { client } = await app.dance(o.model).load();
+  const m = await client.generate({ style: o.style, seed: o.seed, frames: o.frames });
+  const motion: Motion = { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions };
+  try {
+    motion.contacts = detectContacts(motion);
+  } catch {
+    // no recognisable feet: no contacts
+  }
+  return motion;
+}
+
+/**
+ * How the API's calls fail: `guarded(context, fn)` runs `fn`, and a failure is shown on the page as
+ * `context: message` and thrown as an Error with that message (the original as its cause).
+ */
+function errorGuards(app: App) {
   /** Shows `context: message` on the page and returns an Error with that message (the original as cause). */
   function reported(context: string, e: unknown): Error {
     const message = `${context}: ${errorMessage(e)}`;
@@ -216,75 +301,12 @@ export function createPlayground(app: App): Playground {
     }
   }
 
-  type GeneratorCall = { kind: 'lstm-gmm'; model: string; frames: number; seed: number; temperature: number; refine: boolean };
-  type DanceCall = { kind: 'aclstm'; model: string; frames: number; seed: number; style: string };
+  return { guarded, guardedAsync };
+}
 
-  /** Checks generate's options against the model they name; the error says what is wrong. */
-  function checkGenerate(options: unknown): GeneratorCall | DanceCall {
-    if (typeof options !== 'object' || options === null || Array.isArray(options)) {
-      throw new TypeError('options must be an object: { model, frames, seed, temperature? } (acLSTM: { model, style, frames, seed })');
-    }
-    const o = options as Partial<Record<keyof GenerateOptions, unknown>>;
-    const usable = models.filter((m) => m.kind === 'lstm-gmm' || m.kind === 'aclstm');
-    const available = usable.map((m) => m.id).join(', ');
-    if (typeof o.model !== 'string') throw new TypeError(`model must be a model id string (available: ${available || 'none'})`);
-    const entry = usable.find((m) => m.id === o.model);
-    if (!entry) throw new Error(`unknown model "${o.model}" (available: ${available || 'none — the model list did not load'})`);
-    const dance = entry.kind === 'aclstm';
-    if (dance) {
-      // Dance models have no sampling and no refiner: say so rather than silently ignoring the option.
-      if ('temperature' in o) throw new TypeError(`temperature is not meaningful for acLSTM models: they are deterministic (the seed only picks the seed motion); leave it out`);
-      if ('refine' in o) throw new TypeError(`refine is not available for acLSTM models (there is no refiner for dance); leave it out`);
-    }
-    const known = dance ? ['model', 'style', 'frames', 'seed'] : ['model', 'frames', 'seed', 'temperature', 'refine'];
-    for (const k of Object.keys(options)) {
-      if (!known.includes(k)) throw new TypeError(`unknown option "${k}" for model "${entry.id}" (known: ${known.join(', ')})`);
-    }
-    if (typeof o.frames !== 'number' || !Number.isInteger(o.frames) || o.frames < 1 || o.frames > GENERATE_MAX_FRAMES) {
-      throw new RangeError(`frames must be an integer from 1 to ${GENERATE_MAX_FRAMES}, got ${String(o.frames)}`);
-    }
-    if (typeof o.seed !== 'number' || !Number.isInteger(o.seed) || o.seed < 0 || o.seed > 0xffffffff) {
-      throw new RangeError(`seed must be an integer from 0 to 4294967295, got ${String(o.seed)}`);
-    }
-    if (dance) {
-      const styles = entry.styles ?? [];
-      if (o.style === undefined) throw new TypeError(`style is required for model "${entry.id}" (styles: ${styles.join(', ')})`);
-      if (typeof o.style !== 'string' || !styles.includes(o.style)) {
-        throw new RangeError(`unknown style ${typeof o.style === 'string' ? `"${o.style}"` : String(o.style)} for model "${entry.id}" (styles: ${styles.join(', ')})`);
-      }
-      return { kind: 'aclstm', model: entry.id, frames: o.frames, seed: o.seed, style: o.style };
-    }
-    const temperature = o.temperature ?? GENERATE_DEFAULT_TEMPERATURE;
-    if (typeof temperature !== 'number' || !Number.isFinite(temperature) || temperature < 0 || temperature > 2) {
-      throw new RangeError(`temperature must be a number from 0 to 2, got ${String(o.temperature)}`);
-    }
-    if (o.refine !== undefined && typeof o.refine !== 'boolean') throw new TypeError(`refine must be true or false, got ${String(o.refine)}`);
-    const refine = o.refine === true;
-    if (refine && !models.some((m) => m.kind === 'refiner')) throw new Error('refine is not available: no refiner model is listed in models/index.json');
-    return { kind: 'lstm-gmm', model: entry.id, frames: o.frames, seed: o.seed, temperature, refine };
-  }
-
-  /** Throws unless `options` is a plain object whose keys are all in `known`. */
-  function checkKeys(options: unknown, known: string[], shape: string): Record<string, unknown> {
-    if (typeof options !== 'object' || options === null || Array.isArray(options)) throw new TypeError(`options must be an object: ${shape}`);
-    for (const k of Object.keys(options)) {
-      if (!known.includes(k)) throw new TypeError(`unknown option "${k}" (known: ${known.join(', ')})`);
-    }
-    return options as Record<string, unknown>;
-  }
-
-  /** A dance as a Motion: the fitted positions, and foot contacts detected as for imported clips. */
-  async function generateDance(o: DanceCall): Promise<Motion> {
-    const { client } = await app.dance(o.model).load();
-    const m = await client.generate({ style: o.style, seed: o.seed, frames: o.frames });
-    const motion: Motion = { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions };
-    try {
-      motion.contacts = detectContacts(motion);
-    } catch {
-      // no recognisable feet: no contacts
-    }
-    return motion;
-  }
+export function createPlayground(app: App): Playground {
+  let models: ModelInfo[] = [];
+  const { guarded, guardedAsync } = errorGuards(app);
 
   const ready = loadManifest().then(
     (m) => {
@@ -344,15 +366,7 @@ export function createPlayground(app: App): Playground {
     lastError: () => app.lastError,
     setView(options) {
       guarded('setView', () => {
-        if (typeof options !== 'object' || options === null) throw new TypeError('options must be an object');
-        const known = ['follow', 'trail', 'footprints', 'framing'];
-        for (const [k, v] of Object.entries(options)) {
-          if (!known.includes(k)) throw new TypeError(`unknown option "${k}" (known: ${known.join(', ')})`);
-          if (k === 'framing' ? v !== 'character' && v !== 'all' : typeof v !== 'boolean') {
-            throw new TypeError(k === 'framing' ? 'framing must be "character" or "all"' : `${k} must be true or false`);
-          }
-        }
-        const { framing, ...layers } = options;
+        const { framing, ...layers } = checkView(options);
         app.viewer.setLayers(layers);
         if (framing === 'character') app.viewer.frameCharacter();
         if (framing === 'all') app.viewer.frameAll();
@@ -364,20 +378,13 @@ export function createPlayground(app: App): Playground {
     generate(options) {
       return guardedAsync('generate', async () => {
         await ready;
-        const o = checkGenerate(options);
-        if (o.kind === 'aclstm') return generateDance(o);
+        const o = checkGenerate(options, models);
+        if (o.kind === 'aclstm') return generateDance(app, o);
         const { client } = await app.generator.load();
         const m = await client.generate({ frames: o.frames, seed: o.seed, temperature: o.temperature, ...(o.refine ? { refine: true } : {}) });
         const shown = o.refine ? m.refined : m;
         if (!shown) throw new Error('the generator worker returned no refined frames');
-        const motion: Motion = {
-          fps: m.fps,
-          frames: m.frames,
-          joints: [...m.joints],
-          parents: [...m.parents],
-          positions: shown.positions,
-          contacts: shown.contacts,
-        };
+        const motion: Motion = { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: shown.positions, contacts: shown.contacts };
         return motion;
       });
     },
