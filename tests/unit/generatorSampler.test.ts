@@ -1,7 +1,7 @@
 // The mixture sampler: seeded determinism, τ = 0, draw statistics against the analytic moments of a
 // known mixture, temperature sharpening, and contact snapping.
 import { describe, expect, it } from 'vitest';
-import { denormalise, Rng, sampleMixture, snapContacts, type MixtureBatch } from '../../web/model/sampler';
+import { chooseComponent, denormalise, Rng, sampleMixture, snapContacts, type MixtureBatch } from '../../web/model/sampler';
 
 // Batch of 2 rows, 3 components, 2 dimensions.
 const WEIGHTS = [0.2, 0.5, 0.3];
@@ -105,6 +105,17 @@ describe('sampleMixture', () => {
     const total = sharpened.reduce((a, b) => a + b);
     counts.forEach((n, k) => expect(Math.abs(n / batch - sharpened[k] / total)).toBeLessThan(0.01));
     expect(Math.sqrt(spread / counts[1])).toBeCloseTo(SIGMA[1][0] * tau, 1);
+  });
+});
+
+describe('chooseComponent', () => {
+  it('walks the cumulative tempered weights with the uniform (what sampleMixture and the optimiser both use)', () => {
+    // τ = 1: boundaries at 0.2 and 0.7.
+    expect([0, 0.19, 0.21, 0.69, 0.71, 0.9999].map((u) => chooseComponent(WEIGHTS, 1, u))).toEqual([0, 0, 1, 1, 2, 2]);
+    // τ = 0.5: w² / Σw² = 0.105, 0.658, 0.237, so boundaries at 0.105 and 0.763.
+    expect([0.1, 0.11, 0.76, 0.77].map((u) => chooseComponent(WEIGHTS, 0.5, u))).toEqual([0, 1, 1, 2]);
+    // A tiny τ still picks the heaviest component rather than underflowing to the last.
+    expect(chooseComponent(WEIGHTS, 1e-3, 0.5)).toBe(1);
   });
 });
 

@@ -43,6 +43,17 @@ export function generatorSkeleton(info: GeneratorInfo): Skeleton {
   };
 }
 
+/**
+ * Moves `root` by one frame's root channels: the step (dtx, dtz), expressed in the previous frame's
+ * heading frame, then the heading change dry.
+ */
+export function integrateRoot(root: RootStart, dtx: number, dtz: number, dry: number): void {
+  const c = Math.cos(root.heading), s = Math.sin(root.heading);
+  root.x += c * dtx + s * dtz;
+  root.z += -s * dtx + c * dtz;
+  root.heading += dry;
+}
+
 export function decodeFeatures(info: GeneratorInfo, features: Float32Array, start: RootStart = { x: 0, z: 0, heading: 0 }): DecodedFeatures {
   const D = info.onnx.dim;
   const skeleton = generatorSkeleton(info);
@@ -57,26 +68,19 @@ export function decodeFeatures(info: GeneratorInfo, features: Float32Array, star
   const contacts = new Uint8Array(frames * 2);
   const rootHeading = new Float32Array(frames);
 
-  let x = start.x;
-  let z = start.z;
-  let heading = start.heading;
+  const root = { ...start };
   for (let f = 0; f < frames; f++) {
     const row = f * D;
-    const dtx = features[row], dtz = features[row + 1];
-    // The step is expressed in the previous frame's heading frame.
-    const c = Math.cos(heading), s = Math.sin(heading);
-    x += c * dtx + s * dtz;
-    z += -s * dtx + c * dtz;
-    heading += features[row + 2];
-    rootPositions[f * 3] = x;
+    integrateRoot(root, features[row], features[row + 1], features[row + 2]);
+    rootPositions[f * 3] = root.x;
     rootPositions[f * 3 + 1] = features[row + 3];
-    rootPositions[f * 3 + 2] = z;
-    rootHeading[f] = heading;
+    rootPositions[f * 3 + 2] = root.z;
+    rootHeading[f] = root.heading;
 
     const base = f * J * 4;
     for (let j = 0; j < J; j++) rotations.set(references[j], base + j * 4); // fixed joints keep their reference
     const tilt = quatMultiply(references[0], rotvecToQuat(features[row + 4], features[row + 5], features[row + 6]));
-    rotations.set(quatMultiply(yawQuat(heading), tilt), base);
+    rotations.set(quatMultiply(yawQuat(root.heading), tilt), base);
     for (let k = 0; k < featureJoints.length; k++) {
       const j = featureJoints[k];
       const o = row + JOINT_FEATURES_START + 3 * k;
@@ -90,6 +94,6 @@ export function decodeFeatures(info: GeneratorInfo, features: Float32Array, star
     positions: forwardKinematics(skeleton, rootPositions, rotations),
     contacts,
     rootHeading,
-    end: { x, z, heading },
+    end: root,
   };
 }

@@ -44,6 +44,28 @@ export interface MixtureBatch {
 }
 
 /**
+ * The mixture component a uniform u in [0, 1) picks when component k has probability ∝ w_k^(1/τ), τ > 0:
+ * the cumulative walk over the tempered weights. `scratch` (≥ weights.length values) saves an allocation.
+ */
+export function chooseComponent(weights: ArrayLike<number>, temperature: number, u: number, scratch = new Float64Array(weights.length)): number {
+  const M = weights.length;
+  // w^(1/τ) through logs, shifted by the largest, so small τ cannot underflow every weight to 0.
+  let largest = -Infinity;
+  for (let i = 0; i < M; i++) {
+    scratch[i] = Math.log(Math.max(weights[i], 1e-12)) / temperature;
+    largest = Math.max(largest, scratch[i]);
+  }
+  let total = 0;
+  for (let i = 0; i < M; i++) total += scratch[i] = Math.exp(scratch[i] - largest);
+  let left = u * total;
+  for (let i = 0; i < M; i++) {
+    left -= scratch[i];
+    if (left < 0) return i;
+  }
+  return M - 1;
+}
+
+/**
  * One draw per batch row: component k with probability ∝ w_k^(1/τ), then mu_k + sigma_k·τ·N(0, 1) per
  * dimension. τ ≤ 0 takes the heaviest component's mean and uses no random numbers.
  */
@@ -53,30 +75,14 @@ export function sampleMixture(m: MixtureBatch, temperature: number, rng: Rng, ou
     throw new Error(`sampleMixture: output sizes (${m.weights.length}, ${m.mu.length}, ${m.sigma.length}) do not fit batch ${batch}, ${M} mixtures, dim ${D}`);
   }
   if (out.length !== batch * D) throw new Error(`sampleMixture: out has ${out.length} values, expected ${batch * D}`);
-  const p = new Float64Array(M);
+  const scratch = new Float64Array(M);
   for (let b = 0; b < batch; b++) {
     const w = m.weights.subarray(b * M, (b + 1) * M);
     let k = 0;
     if (temperature <= 0) {
       for (let i = 1; i < M; i++) if (w[i] > w[k]) k = i;
     } else {
-      // w^(1/τ) through logs, shifted by the largest, so small τ cannot underflow every weight to 0.
-      let largest = -Infinity;
-      for (let i = 0; i < M; i++) {
-        p[i] = Math.log(Math.max(w[i], 1e-12)) / temperature;
-        largest = Math.max(largest, p[i]);
-      }
-      let total = 0;
-      for (let i = 0; i < M; i++) total += p[i] = Math.exp(p[i] - largest);
-      let u = rng.uniform() * total;
-      k = M - 1;
-      for (let i = 0; i < M; i++) {
-        u -= p[i];
-        if (u < 0) {
-          k = i;
-          break;
-        }
-      }
+      k = chooseComponent(w, temperature, rng.uniform(), scratch);
     }
     const src = (b * M + k) * D;
     for (let d = 0; d < D; d++) {

@@ -1,14 +1,16 @@
 // Online control by speed and direction (Wang, Chai, Xia §5.3): each short batch of frames is optimised
 // for the speed term (eq. 22: the batch's mean speed near the asked speed) and the direction term
 // (eq. 23: the last frame's facing near the asked heading), with the prior, noise and contact terms of
-// the path follower. Particles look a little past the batch so the choice is not greedy; only the batch
-// is kept. `LiveController` is what both the live page loop and `simulateControl` run.
+// the path follower, by the same cross-entropy search (search.ts). Particles look a little past the
+// batch so the choice is not greedy; only the batch is kept. `LiveController` is what both the live page
+// loop and `simulateControl` run.
 import { decodeFeatures } from '../model/featureDecode';
 import type { GeneratorInfo } from '../model/generatorInfo';
 import { Rng } from '../model/sampler';
-import { contactCost, lastToes, lowest, particleFeatures, type ToeState } from './objective';
+import { contactCost, lastToes, particleFeatures, type ToeState } from './objective';
 import { angleDifference } from './path';
-import { perturbInto, randomVariables, rollout, type RolloutResult, type SteerRequest, type StepFn, type Steering, type StreamState, type Variables } from './rollout';
+import { seedStreamState, type RolloutResult, type SteerRequest, type StepFn, type Steering, type StreamState } from './rollout';
+import { crossEntropySearch } from './search';
 
 export interface ControlTarget {
   /** m/s, 0…MAX_CONTROL_SPEED. */
@@ -39,6 +41,16 @@ const LIVE_CONTACT_SIGMA = 0.01;
 const NOISE_SCALE = 0.25;
 /** Achieved speed is the root's mean horizontal speed over this many frames (half a second: about a step). */
 export const SPEED_WINDOW = 15;
+/**
+ * The best quarter of a round seeds the next (the path follower keeps an eighth): a 12-frame horizon's
+ * speed and direction terms rank particles less surely than a 34-frame window's fit, so more are kept.
+ */
+export const CONTROL_ELITE_SHARE = 1 / 4;
+/**
+ * β of every perturbation, with knob jitter at full size every round (the path follower's shrink with the
+ * round): a batch's latency budget allows few rounds (2 by default), so there is no long schedule to shrink.
+ */
+export const CONTROL_BETA = 0.5;
 
 interface Knobs {
   /** Share of the heading error asked for per frame. */
@@ -55,6 +67,18 @@ interface Knobs {
 function randomKnobs(rng: Rng): Knobs {
   return { gain: 0.08 + 0.2 * rng.uniform(), push: 0.8 + 1.2 * rng.uniform(), authority: 0.3 + 0.65 * rng.uniform(), turnAuthority: 0.5 + 0.5 * rng.uniform(), reach: 0.5 + 3.5 * rng.uniform() };
 }
+
+function jitterKnobs(k: Knobs, rng: Rng): Knobs {
+  return {
+    gain: clamp(k.gain + 0.04 * rng.normal(), 0.03, 0.4),
+    push: clamp(k.push + 0.1 * rng.normal(), 0.6, 2),
+    authority: clamp(k.authority + 0.1 * rng.normal(), 0.05, 0.98),
+    turnAuthority: clamp(k.turnAuthority + 0.1 * rng.normal(), 0.05, 1),
+    reach: clamp(k.reach + 0.4 * rng.normal(), 0.2, 6),
+  };
+}
+
+const clamp = (v: number, a: number, b: number) => Math.min(Math.max(v, a), b);
 
 class ControlSteering implements Steering {
   constructor(
@@ -115,7 +139,7 @@ export class LiveController {
   constructor(private readonly o: LiveControllerOptions) {
     const seed = o.info.seeds[o.seedIndex];
     if (!seed) throw new Error(`seedIndex ${o.seedIndex} is not one of the generator's ${o.info.seeds.length} seed states`);
-    this.state = { x: Float32Array.from(seed.x), h: Float32Array.from(seed.h), c: Float32Array.from(seed.c), root: { ...(o.start ?? { x: 0, z: 0, heading: 0 }) } };
+    this.state = seedStreamState(seed, o.start ?? { x: 0, z: 0, heading: 0 });
     this.rng = new Rng(o.seed);
   }
 
@@ -132,44 +156,24 @@ export class LiveController {
     if (!Number.isInteger(frames) || frames < 1 || frames > CONTROL_HORIZON) throw new RangeError(`frames must be an integer from 1 to ${CONTROL_HORIZON}, got ${frames}`);
     const started = performance.now();
     const { info, step, mean, std } = this.o;
-    const D = info.onnx.dim, fps = info.fps;
+    const fps = info.fps;
     const P = particles ?? this.o.particles ?? DEFAULT_CONTROL_PARTICLES, rounds = this.o.rounds ?? 2;
     if (!Number.isInteger(P) || P < MIN_CONTROL_PARTICLES || P > MAX_CONTROL_PARTICLES) {
       throw new RangeError(`particles must be an integer from ${MIN_CONTROL_PARTICLES} to ${MAX_CONTROL_PARTICLES}, got ${P}`);
     }
-    const T = CONTROL_HORIZON;
-    const elites = Math.max(1, Math.round(P / 4));
-    let variables: Variables = randomVariables(P, T, D, this.rng);
-    let knobs = Array.from({ length: P }, () => randomKnobs(this.rng));
-    let best: { cost: number; result: RolloutResult; b: number } | null = null;
-    for (let round = 0; round < rounds; round++) {
-      const result = await rollout({ step, info, mean, std, start: this.state, variables, steering: new ControlSteering(knobs, goal, fps), temperature: this.o.temperature ?? 0.5, commit: frames, noiseScale: NOISE_SCALE });
-      const costs = new Float64Array(P);
-      for (let b = 0; b < P; b++) {
-        costs[b] = result.priorCost[b] + result.noiseCost[b] + controlCost(result, b, goal, this.state.root, fps) + contactCost(info, particleFeatures(result, b), this.state.root, this.toes, LIVE_CONTACT_SIGMA);
-        if (!Number.isFinite(costs[b])) costs[b] = Infinity;
-        if (!best || costs[b] < best.cost) best = { cost: costs[b], result, b };
-      }
-      if (round === rounds - 1) break;
-      const top = lowest(costs, elites);
-      const next: Variables = { P, T, u: new Float64Array(P * T), z: new Float32Array(variables.z.length), d: new Float32Array(variables.d.length) };
-      knobs = Array.from({ length: P }, (_, b) => {
-        const from = top[b % top.length];
-        perturbInto(variables, from, next, b, 0.5, this.rng, D);
-        const k = knobs[from];
-        if (b < top.length) return k;
-        const r = this.rng;
-        return {
-          gain: clamp(k.gain + 0.04 * r.normal(), 0.03, 0.4),
-          push: clamp(k.push + 0.1 * r.normal(), 0.6, 2),
-          authority: clamp(k.authority + 0.1 * r.normal(), 0.05, 0.98),
-          turnAuthority: clamp(k.turnAuthority + 0.1 * r.normal(), 0.05, 1),
-          reach: clamp(k.reach + 0.4 * r.normal(), 0.2, 6),
-        };
-      });
-      variables = next;
-    }
-    const { result, b } = best!;
+    const { result, particle: b } = await crossEntropySearch({
+      rollout: { step, info, mean, std, start: this.state, temperature: this.o.temperature ?? 0.5, commit: frames, noiseScale: NOISE_SCALE },
+      particles: P,
+      frames: CONTROL_HORIZON,
+      rounds,
+      eliteShare: CONTROL_ELITE_SHARE,
+      beta: () => CONTROL_BETA,
+      rng: this.rng,
+      randomKnobs,
+      jitterKnobs: (k, _round, rng) => jitterKnobs(k, rng),
+      steering: (knobs) => new ControlSteering(knobs, goal, fps),
+      cost: (r, b) => r.priorCost[b] + r.noiseCost[b] + controlCost(r, b, goal, this.state.root, fps) + contactCost(info, particleFeatures(r, b), this.state.root, this.toes, LIVE_CONTACT_SIGMA),
+    });
     const features = particleFeatures(result, b, frames).slice();
     const decoded = decodeFeatures(info, features, this.state.root);
     this.toes = lastToes(info, decoded.positions, decoded.contacts);
@@ -189,8 +193,6 @@ export class LiveController {
     return { frames, features, positions: decoded.positions, contacts: decoded.contacts, rootHeading: decoded.rootHeading, speed, heading, computeMs: performance.now() - started };
   }
 }
-
-const clamp = (v: number, a: number, b: number) => Math.min(Math.max(v, a), b);
 
 export function checkTarget(goal: ControlTarget): void {
   if (typeof goal?.speed !== 'number' || !Number.isFinite(goal.speed) || goal.speed < 0 || goal.speed > MAX_CONTROL_SPEED) {

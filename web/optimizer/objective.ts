@@ -66,10 +66,3 @@ export function lastToes(info: GeneratorInfo, positions: Float32Array, contacts:
     planted: [contacts[f * 2] === 1, contacts[f * 2 + 1] === 1],
   };
 }
-
-/** Indices of the `count` lowest costs, best first. */
-export function lowest(costs: ArrayLike<number>, count: number): number[] {
-  return Array.from(costs, (_, i) => i)
-    .sort((a, b) => costs[a] - costs[b])
-    .slice(0, count);
-}

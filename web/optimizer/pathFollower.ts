@@ -2,14 +2,15 @@
 // window a population of particles — sampling variables plus a few steering parameters — is run through
 // the generator in one batched call per frame and ranked by E = −log(P_prior · P_noise · P_curve ·
 // P_contact) (eq. 19) with a progress term; the best few seed the next rounds, which perturb them ever
-// more locally (a cross-entropy search). The best particle's first 17 frames are kept and the next
-// window starts from its state.
+// more locally (the cross-entropy search of search.ts). The best particle's first 17 frames are kept and
+// the next window starts from its state.
 import { decodeFeatures, type RootStart } from '../model/featureDecode';
 import type { GeneratorInfo } from '../model/generatorInfo';
 import { Rng } from '../model/sampler';
-import { contactCost, lastToes, lowest, particleFeatures, type ToeState } from './objective';
+import { contactCost, lastToes, particleFeatures, type ToeState } from './objective';
 import { angleDifference, GroundPath } from './path';
-import { perturbInto, randomVariables, rollout, type RolloutResult, type SteerRequest, type StepFn, type Steering, type StreamState, type Variables } from './rollout';
+import { seedStreamState, type RolloutResult, type SteerRequest, type StepFn, type Steering } from './rollout';
+import { crossEntropySearch } from './search';
 
 export type Gait = 'walk' | 'run';
 export const WINDOW_FRAMES = 34;
@@ -31,6 +32,18 @@ const PROGRESS_SIGMA = 0.05;
  */
 const FIT_MARGIN = 0.15;
 const FIT_MARGIN_SIGMA = 0.03;
+/**
+ * The best eighth of a round seeds the next (live control keeps a quarter): over a 34-frame window the
+ * fit and progress terms separate particles clearly, so the search can narrow to the few best.
+ */
+export const PATH_ELITE_SHARE = 1 / 8;
+/**
+ * Perturbation after round r: β = PATH_BETA / (r + 1) and knob jitter × 1 / (r + 1), ever more local
+ * (live control's stays fixed): offline windows can afford more rounds, each refining the last.
+ */
+export const PATH_BETA = 0.6;
+const pathBeta = (round: number) => PATH_BETA / (round + 1);
+const pathJitterScale = (round: number) => 1 / (round + 1);
 
 export interface FollowPathOptions {
   step: StepFn;
@@ -190,13 +203,11 @@ export async function followPath(o: FollowPathOptions): Promise<FollowPathResult
   const rounds = o.rounds ?? 2;
   const fitSigma = o.fitSigma ?? 0.1;
   const temperature = o.temperature ?? 0.5;
-  const elites = Math.max(1, Math.round(P / 8));
   const rng = new Rng(o.seed);
   const seeds = gaitSeeds(info, gait);
   const seedIndex = seeds[(o.seed >>> 0) % seeds.length];
-  const seed = info.seeds[seedIndex];
   const start: RootStart = { x: path.xs[0], z: path.zs[0], heading: path.headingAt(0) };
-  let state: StreamState = { x: Float32Array.from(seed.x), h: Float32Array.from(seed.h), c: Float32Array.from(seed.c), root: { ...start } };
+  let state = seedStreamState(info.seeds[seedIndex], start);
   // A slow walker still gets 2.5× the time the pace needs before the follower gives up.
   const maxFrames = Math.ceil(((path.length / GAITS[gait].pace) * 2.5 + 2) * fps);
 
@@ -205,64 +216,33 @@ export async function followPath(o: FollowPathOptions): Promise<FollowPathResult
   let toes: ToeState | null = null;
 
   while (frames < maxFrames) {
-    let variables: Variables = randomVariables(P, WINDOW_FRAMES, D, rng);
-    let knobs = Array.from({ length: P }, () => randomKnobs(rng, gait));
-    let best: { cost: number; result: RolloutResult; b: number } | null = null;
-    for (let round = 0; round < rounds; round++) {
-      const steering = new PathSteering(path, knobs, arc, fps);
-      const result = await rollout({ step: o.step, info, mean: o.mean, std: o.std, start: state, variables, steering, temperature, commit: COMMIT_FRAMES });
-      particleSteps += P * WINDOW_FRAMES;
-      const costs = new Float64Array(P);
-      for (let b = 0; b < P; b++) {
-        costs[b] =
-          result.priorCost[b] +
-          result.noiseCost[b] +
-          pathCost(result, b, path, arc, fitSigma, GAITS[gait].pace, fps) +
-          contactCost(info, particleFeatures(result, b), state.root, toes);
-        if (!Number.isFinite(costs[b])) costs[b] = Infinity;
-        if (!best || costs[b] < best.cost) best = { cost: costs[b], result, b };
-      }
-      if (round === rounds - 1) break;
-      // Next round: every particle a perturbation of one of the elites, ever more local.
-      const top = lowest(costs, elites);
-      const beta = 0.6 / (round + 1);
-      const next: Variables = { P, T: WINDOW_FRAMES, u: new Float64Array(P * WINDOW_FRAMES), z: new Float32Array(variables.z.length), d: new Float32Array(variables.d.length) };
-      const nextKnobs: Knobs[] = [];
-      for (let b = 0; b < P; b++) {
-        const from = top[b % top.length];
-        perturbInto(variables, from, next, b, beta, rng, D);
-        nextKnobs.push(b < top.length ? knobs[from] : jitterKnobs(knobs[from], 1 / (round + 1), rng, gait));
-      }
-      variables = next;
-      knobs = nextKnobs;
-    }
-    if (!best) throw new Error('followPath: no particle was evaluated');
+    const best = await crossEntropySearch({
+      rollout: { step: o.step, info, mean: o.mean, std: o.std, start: state, temperature, commit: COMMIT_FRAMES },
+      particles: P,
+      frames: WINDOW_FRAMES,
+      rounds,
+      eliteShare: PATH_ELITE_SHARE,
+      beta: pathBeta,
+      rng,
+      randomKnobs: (r) => randomKnobs(r, gait),
+      jitterKnobs: (k, round, r) => jitterKnobs(k, pathJitterScale(round), r, gait),
+      steering: (knobs) => new PathSteering(path, knobs, arc, fps),
+      cost: (result, b) =>
+        result.priorCost[b] + result.noiseCost[b] + pathCost(result, b, path, arc, fitSigma, GAITS[gait].pace, fps) + contactCost(info, particleFeatures(result, b), state.root, toes),
+    });
+    particleSteps += best.particleSteps;
     windows++;
 
-    // Keep the first 17 frames, or fewer if the best particle reaches the end before.
-    const { result, b } = best;
-    let keep = COMMIT_FRAMES, s = arc, finished = false;
-    const [ex, ez] = path.pointAt(path.length);
-    for (let t = 0; t < WINDOW_FRAMES; t++) {
-      const i = (b * WINDOW_FRAMES + t) * 3;
-      s = trackArc(path, result.roots[i], result.roots[i + 1], s);
-      if (s >= path.length - 0.05 || (path.length - s < 0.3 && Math.hypot(result.roots[i] - ex, result.roots[i + 1] - ez) < 0.1)) {
-        if (t < COMMIT_FRAMES) {
-          keep = t + 1;
-          finished = true;
-        }
-        break;
-      }
-      if (t === COMMIT_FRAMES - 1) arc = s;
-    }
-    const chunk = particleFeatures(result, b, keep);
+    const { result, particle: b } = best;
+    const end = framesToKeep(path, result, b, arc);
+    arc = end.arc;
+    const chunk = particleFeatures(result, b, end.keep);
     kept.push(chunk.slice());
     // Toe state for the next window's contact term.
     const decoded = decodeFeatures(info, chunk, state.root);
     toes = lastToes(info, decoded.positions, decoded.contacts);
-    frames += keep;
-    if (finished) {
-      arc = s;
+    frames += end.keep;
+    if (end.finished) {
       o.onProgress?.(1);
       break;
     }
@@ -277,15 +257,6 @@ export async function followPath(o: FollowPathOptions): Promise<FollowPathResult
     at += chunk.length;
   }
   const decoded = decodeFeatures(info, features, start);
-  const J = info.skeleton.joints.length;
-  let sum = 0, worst = 0, s = 0;
-  for (let f = 0; f < frames; f++) {
-    const x = decoded.positions[f * J * 3], z = decoded.positions[f * J * 3 + 2];
-    const e = path.distance(x, z);
-    sum += e;
-    worst = Math.max(worst, e);
-    s = trackArc(path, x, z, s);
-  }
   return {
     features,
     positions: decoded.positions,
@@ -293,13 +264,38 @@ export async function followPath(o: FollowPathOptions): Promise<FollowPathResult
     rootHeading: decoded.rootHeading,
     seedIndex,
     frames,
-    stats: {
-      meanError: frames ? sum / frames : NaN,
-      maxError: worst,
-      arcProgress: s / path.length,
-      optimizeMs: performance.now() - started,
-      windows,
-      particleSteps,
-    },
+    stats: { ...pathErrors(path, decoded.positions, info.skeleton.joints.length, frames), optimizeMs: performance.now() - started, windows, particleSteps },
   };
+}
+
+/**
+ * How many of the best particle's frames a window keeps: COMMIT_FRAMES, or fewer where it reaches the
+ * path's end before; and the arc length where the kept frames end.
+ */
+function framesToKeep(path: GroundPath, result: RolloutResult, b: number, arc: number): { keep: number; arc: number; finished: boolean } {
+  const [ex, ez] = path.pointAt(path.length);
+  let s = arc, committedArc = arc;
+  for (let t = 0; t < result.T; t++) {
+    const i = (b * result.T + t) * 3;
+    s = trackArc(path, result.roots[i], result.roots[i + 1], s);
+    if (s >= path.length - 0.05 || (path.length - s < 0.3 && Math.hypot(result.roots[i] - ex, result.roots[i + 1] - ez) < 0.1)) {
+      if (t < COMMIT_FRAMES) return { keep: t + 1, arc: s, finished: true };
+      break;
+    }
+    if (t === COMMIT_FRAMES - 1) committedArc = s;
+  }
+  return { keep: COMMIT_FRAMES, arc: committedArc, finished: false };
+}
+
+/** Mean and largest distance from the root (on the ground) to the path, and the share of the path covered. */
+function pathErrors(path: GroundPath, positions: Float32Array, J: number, frames: number): Pick<FollowPathStats, 'meanError' | 'maxError' | 'arcProgress'> {
+  let sum = 0, worst = 0, s = 0;
+  for (let f = 0; f < frames; f++) {
+    const x = positions[f * J * 3], z = positions[f * J * 3 + 2];
+    const e = path.distance(x, z);
+    sum += e;
+    worst = Math.max(worst, e);
+    s = trackArc(path, x, z, s);
+  }
+  return { meanError: frames ? sum / frames : NaN, maxError: worst, arcProgress: s / path.length };
 }

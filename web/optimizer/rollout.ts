@@ -8,8 +8,9 @@
 // reach: the move is clipped to that many model σ, because the model is sure of its next root step (σ
 // of a few cm/s) and a change of pace has to be spread over many frames to stay likely. The window objective (prior NLL, noise prior, control and contact terms)
 // then ranks whole particles.
-import type { GeneratorInfo, StepOutputs } from '../model/generatorInfo';
-import type { Rng } from '../model/sampler';
+import { integrateRoot, type RootStart } from '../model/featureDecode';
+import type { GeneratorInfo, GeneratorSeed, StepOutputs } from '../model/generatorInfo';
+import { chooseComponent, denormalise, snapContacts } from '../model/sampler';
 
 /** The paper's input-noise prior: d ~ N(0, 0.05²) on the normalised network input (eq. 16). */
 export const INPUT_NOISE_SIGMA = 0.05;
@@ -22,7 +23,12 @@ export interface StreamState {
   x: Float32Array;
   h: Float32Array;
   c: Float32Array;
-  root: { x: number; z: number; heading: number };
+  root: RootStart;
+}
+
+/** A stream at `root` from one of the generator's seed states (copied, so the seed stays as it is). */
+export function seedStreamState(seed: GeneratorSeed, root: RootStart): StreamState {
+  return { x: Float32Array.from(seed.x), h: Float32Array.from(seed.h), c: Float32Array.from(seed.c), root: { ...root } };
 }
 
 /** The sampling variables of P particles over T frames. */
@@ -35,34 +41,6 @@ export interface Variables {
   z: Float32Array;
   /** P×T×D standard normals; the input noise is INPUT_NOISE_SIGMA times these. */
   d: Float32Array;
-}
-
-export function randomVariables(P: number, T: number, D: number, rng: Rng): Variables {
-  const v: Variables = { P, T, u: new Float64Array(P * T), z: new Float32Array(P * T * D), d: new Float32Array(P * T * D) };
-  for (let i = 0; i < v.u.length; i++) v.u[i] = rng.uniform();
-  for (let i = 0; i < v.z.length; i++) v.z[i] = rng.normal();
-  for (let i = 0; i < v.d.length; i++) v.d[i] = rng.normal();
-  return v;
-}
-
-/**
- * Particle `to` becomes a perturbation of particle `from` of `source` (preconditioned Crank–Nicolson:
- * √(1−β²)·old + β·new keeps the N(0, 1) prior; β = 1 is a fresh draw, small β a local move).
- * Component choices are redrawn with probability β².
- */
-export function perturbInto(source: Variables, from: number, target: Variables, to: number, beta: number, rng: Rng, D: number): void {
-  const T = source.T;
-  const keep = Math.sqrt(1 - beta * beta);
-  for (let t = 0; t < T; t++) {
-    const i = from * T + t, j = to * T + t;
-    target.u[j] = rng.uniform() < beta * beta ? rng.uniform() : source.u[i];
-  }
-  const n = T * D;
-  const a = from * n, b = to * n;
-  for (let k = 0; k < n; k++) {
-    target.z[b + k] = keep * source.z[a + k] + beta * rng.normal();
-    target.d[b + k] = keep * source.d[a + k] + beta * rng.normal();
-  }
 }
 
 /** What steering asks of one frame's root channels Δtx, Δtz (m, previous frame's heading frame), Δry (rad). */
@@ -120,6 +98,45 @@ function stateRow(src: Float32Array, L: number, B: number, H: number, b: number)
   return out;
 }
 
+/** One stream's L×H state repeated for B batch rows (the inverse of stateRow). */
+function repeatState(src: Float32Array, L: number, B: number, H: number): Float32Array {
+  const out = new Float32Array(L * B * H);
+  for (let l = 0; l < L; l++) for (let b = 0; b < B; b++) out.set(src.subarray(l * H, (l + 1) * H), (l * B + b) * H);
+  return out;
+}
+
+/**
+ * MAP of the root channels (normalised `row`) under proposal × control: the precision-weighted blend,
+ * in physical units, its move clipped to `reach` of the chosen component's σ.
+ */
+function steerRoot(row: Float32Array, sigma: Float32Array, request: SteerRequest, mean: Float32Array, std: Float32Array): void {
+  for (let k = 0; k < 3; k++) {
+    const proposal = row[k] * std[k] + mean[k];
+    const limit = request.reach[k] * sigma[k] * std[k];
+    const move = Math.max(-limit, Math.min(limit, request.authority[k] * (request.target[k] - proposal)));
+    row[k] = (proposal + move - mean[k]) / std[k];
+  }
+}
+
+/** −log density of `row` (normalised units) under batch row b's full mixture; `logp` is M values of scratch. */
+function mixtureNll(out: StepOutputs, b: number, row: Float32Array, M: number, D: number, logp: Float64Array): number {
+  let best = -Infinity;
+  for (let k = 0; k < M; k++) {
+    const m = out.mu.subarray((b * M + k) * D, (b * M + k + 1) * D);
+    const sg = out.sigma.subarray((b * M + k) * D, (b * M + k + 1) * D);
+    let lp = Math.log(Math.max(out.weights[b * M + k], 1e-30));
+    for (let q = 0; q < D; q++) {
+      const e = (row[q] - m[q]) / sg[q];
+      lp -= Math.log(sg[q]) + 0.5 * e * e;
+    }
+    logp[k] = lp;
+    best = Math.max(best, lp);
+  }
+  let sum = 0;
+  for (let k = 0; k < M; k++) sum += Math.exp(logp[k] - best);
+  return -(best + Math.log(sum)) + 0.5 * D * LOG_2PI;
+}
+
 /** Runs all particles for T frames from the same start state. */
 export async function rollout(o: RolloutOptions): Promise<RolloutResult> {
   const { info, mean, std, variables: v, steering, temperature, commit } = o;
@@ -130,26 +147,18 @@ export async function rollout(o: RolloutOptions): Promise<RolloutResult> {
   const noiseScale = o.noiseScale ?? 1;
 
   // Every particle starts from the same state.
-  let h: Float32Array = new Float32Array(L * P * H), c: Float32Array = new Float32Array(L * P * H);
-  for (let l = 0; l < L; l++) {
-    for (let b = 0; b < P; b++) {
-      h.set(o.start.h.subarray(l * H, (l + 1) * H), (l * P + b) * H);
-      c.set(o.start.c.subarray(l * H, (l + 1) * H), (l * P + b) * H);
-    }
-  }
+  let h = repeatState(o.start.h, L, P, H), c = repeatState(o.start.c, L, P, H);
   const x = new Float32Array(P * D);
   for (let b = 0; b < P; b++) x.set(o.start.x, b * D);
   const input = new Float32Array(P * D);
   const features = new Float32Array(P * T * D);
   const roots = new Float64Array(P * T * 3);
-  const rx = new Float64Array(P).fill(o.start.root.x);
-  const rz = new Float64Array(P).fill(o.start.root.z);
-  const rh = new Float64Array(P).fill(o.start.root.heading);
+  const root: RootStart[] = Array.from({ length: P }, () => ({ ...o.start.root }));
   const priorCost = new Float64Array(P);
   const noiseCost = new Float64Array(P);
   const states: StreamState[] = [];
   const request: SteerRequest = { target: new Float64Array(3), authority: new Float64Array(3), reach: new Float64Array(3).fill(Infinity) };
-  const weightsTemp = new Float64Array(M);
+  const scratch = new Float64Array(M);
   const logp = new Float64Array(M);
 
   for (let t = 0; t < T; t++) {
@@ -165,64 +174,25 @@ export async function rollout(o: RolloutOptions): Promise<RolloutResult> {
     const out = await o.step(P, input, h, c);
     for (let b = 0; b < P; b++) {
       const w = out.weights.subarray(b * M, (b + 1) * M);
-      // Component: k with probability ∝ w^(1/τ), chosen by this particle's uniform.
-      let largest = -Infinity;
-      for (let k = 0; k < M; k++) largest = Math.max(largest, (weightsTemp[k] = Math.log(Math.max(w[k], 1e-12)) / tau));
-      let total = 0;
-      for (let k = 0; k < M; k++) total += weightsTemp[k] = Math.exp(weightsTemp[k] - largest);
-      let u = v.u[b * T + t] * total, comp = M - 1;
-      for (let k = 0; k < M; k++) {
-        u -= weightsTemp[k];
-        if (u < 0) {
-          comp = k;
-          break;
-        }
-      }
+      const comp = chooseComponent(w, tau, v.u[b * T + t], scratch);
       const mu = out.mu.subarray((b * M + comp) * D, (b * M + comp + 1) * D);
       const sigma = out.sigma.subarray((b * M + comp) * D, (b * M + comp + 1) * D);
       const zz = v.z.subarray((b * T + t) * D, (b * T + t + 1) * D);
       const row = x.subarray(b * D, (b + 1) * D);
       for (let k = 0; k < D; k++) row[k] = mu[k] + sigma[k] * temperature * zz[k];
 
-      // MAP of the root channels under proposal × control: precision-weighted blend, in physical units.
-      steering.target(b, t, rx[b], rz[b], rh[b], request);
-      for (let k = 0; k < 3; k++) {
-        const proposal = row[k] * std[k] + mean[k];
-        const limit = request.reach[k] * sigma[k] * std[k];
-        const move = Math.max(-limit, Math.min(limit, request.authority[k] * (request.target[k] - proposal)));
-        row[k] = (proposal + move - mean[k]) / std[k];
-      }
+      steering.target(b, t, root[b].x, root[b].z, root[b].heading, request);
+      steerRoot(row, sigma, request, mean, std);
       // Contacts are bits, as in free generation.
-      for (let k = D - 2; k < D; k++) row[k] = ((row[k] * std[k] + mean[k] > 0.5 ? 1 : 0) - mean[k]) / std[k];
-
+      snapContacts(row, D, mean, std);
       // Prior: the chosen frame's NLL under the full (untempered) mixture.
-      let best = -Infinity;
-      for (let k = 0; k < M; k++) {
-        const m = out.mu.subarray((b * M + k) * D, (b * M + k + 1) * D);
-        const sg = out.sigma.subarray((b * M + k) * D, (b * M + k + 1) * D);
-        let lp = Math.log(Math.max(w[k], 1e-30));
-        for (let q = 0; q < D; q++) {
-          const e = (row[q] - m[q]) / sg[q];
-          lp -= Math.log(sg[q]) + 0.5 * e * e;
-        }
-        logp[k] = lp;
-        best = Math.max(best, lp);
-      }
-      let sum = 0;
-      for (let k = 0; k < M; k++) sum += Math.exp(logp[k] - best);
-      priorCost[b] += -(best + Math.log(sum)) + 0.5 * D * LOG_2PI;
+      priorCost[b] += mixtureNll(out, b, row, M, D, logp);
 
-      // Physical frame and root integration (as featureDecode.ts).
+      // Physical frame and root integration.
       const f = (b * T + t) * D;
-      for (let k = 0; k < D; k++) features[f + k] = row[k] * std[k] + mean[k];
-      const cs = Math.cos(rh[b]), sn = Math.sin(rh[b]);
-      rx[b] += cs * features[f] + sn * features[f + 1];
-      rz[b] += -sn * features[f] + cs * features[f + 1];
-      rh[b] += features[f + 2];
-      const r = (b * T + t) * 3;
-      roots[r] = rx[b];
-      roots[r + 1] = rz[b];
-      roots[r + 2] = rh[b];
+      denormalise(row, mean, std, features.subarray(f, f + D));
+      integrateRoot(root[b], features[f], features[f + 1], features[f + 2]);
+      roots.set([root[b].x, root[b].z, root[b].heading], (b * T + t) * 3);
     }
     h = out.h_out;
     c = out.c_out;
@@ -232,7 +202,7 @@ export async function rollout(o: RolloutOptions): Promise<RolloutResult> {
           x: x.slice(b * D, (b + 1) * D),
           h: stateRow(h, L, P, H, b),
           c: stateRow(c, L, P, H, b),
-          root: { x: rx[b], z: rz[b], heading: rh[b] },
+          root: { ...root[b] },
         });
       }
     }

@@ -1,0 +1,62 @@
+// The optimiser's output for fixed seeds, pinned by hash: a refactor of the search, the rollout or the
+// sampler/decoder pieces they share must give the same motion bit for bit. The hashes are of the shipped
+// generator run by onnxruntime-web's Node build; a new model or runtime version changes them — rerun
+// with OPTIMIZER_OUTPUT=print to get the new ones, and check the change is meant.
+import { createHash } from 'node:crypto';
+import { afterAll, beforeAll, describe, expect, it } from 'vitest';
+import { GeneratorCore } from '../../web/runtime/generatorCore';
+import { parseGeneratorInfo } from '../../web/model/generatorInfo';
+import { checkSchedule, LiveController, simulateControl } from '../../web/optimizer/liveControl';
+import { GroundPath, type GroundPoint } from '../../web/optimizer/path';
+import { followPath } from '../../web/optimizer/pathFollower';
+import { readRepoFile } from './corpus';
+import { ort, shippedSession } from './shippedModel';
+
+const info = parseGeneratorInfo(JSON.parse(readRepoFile('public/models/generator.json')), 'public/models/generator.json');
+const PATHS = JSON.parse(readRepoFile('tests/fixtures/benchmark_paths.json')).paths as Record<string, { points: GroundPoint[] }>;
+let core: GeneratorCore;
+const step = (b: number, x: Float32Array, h: Float32Array, c: Float32Array) => core.step(b, x, h, c);
+
+beforeAll(async () => {
+  core = new GeneratorCore(await shippedSession(info.file), info, ort.Tensor);
+});
+afterAll(() => core?.release());
+
+/** SHA-256 of the values, each as a float64, in order. */
+function hash(parts: ArrayLike<number>[]): string {
+  const values = Float64Array.from(parts.flatMap((p) => Array.from(p)));
+  const digest = createHash('sha256').update(new Uint8Array(values.buffer)).digest('hex');
+  if (process.env.OPTIMIZER_OUTPUT === 'print') console.log(digest);
+  return digest;
+}
+
+describe('optimiser output for fixed seeds', () => {
+  it('followPath: a short walk with 3 rounds (two perturbation steps) and a run around the circle', async () => {
+    const walk = await followPath({ step, info, mean: core.mean, std: core.std, path: GroundPath.fromPoints([[0, 0], [0, 2], [1.5, 3.5]]), gait: 'walk', seed: 4, particles: 16, rounds: 3 });
+    const run = await followPath({ step, info, mean: core.mean, std: core.std, path: GroundPath.fromPoints(PATHS.circle.points), gait: 'run', seed: 1, particles: 24, rounds: 2 });
+    for (const [r, expected] of [
+      [walk, 'b50694fe52b634934d1a1233630b7128da7f6e409f3d6bd558a1be12aaa8566e'],
+      [run, '4b05b5ea578e7a1769187ec28360cb417dcd7637fcc0e1914a2ff1f6da47af8e'],
+    ] as const) {
+      const { optimizeMs: _, ...stats } = r.stats;
+      expect(hash([r.features, r.positions, r.contacts, r.rootHeading, [r.seedIndex, r.frames], Object.values(stats)])).toBe(expected);
+    }
+  }, 60000);
+
+  it('simulateControl with 3 rounds, then a 5-frame batch at 8 particles', async () => {
+    const controller = new LiveController({ step, info, mean: core.mean, std: core.std, seed: 1, seedIndex: 2, particles: 24, rounds: 3 });
+    const sim = await simulateControl(controller, checkSchedule([{ t: 0, speed: 0.8, heading: 0 }, { t: 1.5, speed: 1.5, heading: 0 }]), 3, 30);
+    const chunks = [...sim.chunks, await controller.advance({ speed: 1, heading: 2 }, 5, 8)];
+    expect(hash(chunks.flatMap((c) => [c.features, c.positions, c.contacts, c.rootHeading, c.speed, c.heading, [c.frames]]))).toBe('7edec13b568c20910fbba4ad5d8fbecef881d8ec3d1363a6c6cf6f4729e8b214');
+  }, 60000);
+
+  it('free generation (the sampler the rollout shares its component choice with)', async () => {
+    for (const [seed, temperature, seedIndex, expected] of [
+      [1, 0.5, 3, '1c0c9a3ae69199fc983dc96bf477b8012248663446830c3be59e50ad6a832b3a'],
+      [3, 0.05, 1, '43850e1221510f0797aceea191337032d24f0cbf5606e5cbf89c3fa39a33ea40'],
+    ] as const) {
+      const g = await core.generate({ frames: 60, seed, temperature, seedIndex });
+      expect(hash([g.features, g.positions])).toBe(expected);
+    }
+  });
+});
