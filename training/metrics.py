@@ -8,28 +8,27 @@ from .mocap.skeleton import Skeleton
 TOES = ("LeftToeBase", "RightToeBase")
 
 
-def foot_skating(positions: np.ndarray, contacts: np.ndarray, fps: float, skel: Skeleton) -> float:
-    """Mean horizontal speed (m/s) of the toe of a foot while that foot is labelled as planted."""
+def planted_toe_speeds(positions: np.ndarray, contacts: np.ndarray, fps: float, skel: Skeleton) -> np.ndarray:
+    """Horizontal toe speeds (m/s) over the frame pairs in which that foot is labelled as planted in both
+    frames; the left toe's, then the right toe's."""
     speeds = []
     for side, name in enumerate(TOES):
         toe = positions[:, skel.index(name)][:, [0, 2]]
         v = np.linalg.norm(np.diff(toe, axis=0), axis=-1) * fps
-        planted = (contacts[1:, side] > 0) & (contacts[:-1, side] > 0)
-        speeds.append(v[planted])
-    allv = np.concatenate(speeds)
+        speeds.append(v[(contacts[1:, side] > 0) & (contacts[:-1, side] > 0)])
+    return np.concatenate(speeds)
+
+
+def foot_skating(positions: np.ndarray, contacts: np.ndarray, fps: float, skel: Skeleton) -> float:
+    """Mean horizontal speed (m/s) of the toe of a foot while that foot is labelled as planted."""
+    allv = planted_toe_speeds(positions, contacts, fps, skel)
     return float(allv.mean()) if len(allv) else float("nan")
 
 
 def foot_skating_clips(clips: list[tuple[np.ndarray, np.ndarray]], fps: float, skel: Skeleton) -> float:
     """foot_skating pooled over separate clips (positions, contacts), each measured on its own: frame pairs
     never span two clips (joining clips end to end would count the jump between them as skating)."""
-    speeds = []
-    for positions, contacts in clips:
-        for side, name in enumerate(TOES):
-            toe = positions[:, skel.index(name)][:, [0, 2]]
-            v = np.linalg.norm(np.diff(toe, axis=0), axis=-1) * fps
-            speeds.append(v[(contacts[1:, side] > 0) & (contacts[:-1, side] > 0)])
-    allv = np.concatenate(speeds) if speeds else np.zeros(0)
+    allv = np.concatenate([planted_toe_speeds(p, c, fps, skel) for p, c in clips]) if clips else np.zeros(0)
     return float(allv.mean()) if len(allv) else float("nan")
 
 

@@ -9,6 +9,7 @@ REPO_ROOT = Path(__file__).resolve().parent.parent
 DEFAULT_MOCAP = REPO_ROOT.parent / "shared" / "mocap"
 DEFAULT_CACHE = REPO_ROOT / "cache"
 MODELS_DIR = REPO_ROOT / "public" / "models"  # the shipped models the page loads
+REPORTS_DIR = REPO_ROOT / "docs" / "models"  # the model reports
 ENV_VAR = "MOCAP_DIR"
 
 

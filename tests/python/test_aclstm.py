@@ -8,7 +8,7 @@ import torch
 from training.data.dance import (STYLES, bone_length_error, decode, encode, load_clips, mirror, mirror_pairs,
                                   resample_positions, rotate_y)
 from training.aclstm.shipped import ShippedDance
-from training.aclstm.export import check_parity, export_onnx
+from training.aclstm.exporting import check_parity, export_onnx
 from training.paths import MODELS_DIR
 from training.models.aclstm import DanceLSTM, DanceStep
 
@@ -22,21 +22,21 @@ def test_every_style_loads_on_one_skeleton_with_held_out_clips(dance):
     skel, clips = dance
     assert len(skel.names) == 57 and skel.parents[0] == -1
     for style in STYLES:
-        mine = [c for c in clips if c["style"] == style]
-        assert any(c["held_out"] for c in mine) and any(not c["held_out"] for c in mine)
+        mine = [c for c in clips if c.style == style]
+        assert any(c.held_out for c in mine) and any(not c.held_out for c in mine)
     # The readme's rates: salsa's 28 files add up to about 15 minutes only at 60 fps.
-    salsa_minutes = sum(len(c["positions"]) / c["fps"] for c in clips if c["style"] == "salsa") / 60
+    salsa_minutes = sum(c.seconds for c in clips if c.style == "salsa") / 60
     assert 14 < salsa_minutes < 17
     for c in clips:
-        assert np.isfinite(c["positions"]).all()
-        lowest = np.percentile(c["positions"][..., 1].min(axis=1), 50)
-        assert -0.03 < lowest < 0.08, (c["file"], lowest)  # feet on the floor
-        assert bone_length_error(c["positions"][::50], skel).max() < 1e-5  # real FK keeps bone lengths
+        assert np.isfinite(c.positions).all()
+        lowest = np.percentile(c.positions[..., 1].min(axis=1), 50)
+        assert -0.03 < lowest < 0.08, (c.file, lowest)  # feet on the floor
+        assert bone_length_error(c.positions[::50], skel).max() < 1e-5  # real FK keeps bone lengths
 
 
 def test_features_round_trip_and_rotation(dance):
     _, clips = dance
-    pos = resample_positions(clips[0]["positions"], clips[0]["fps"], 2.0, 30)
+    pos = resample_positions(clips[0].positions, clips[0].fps, 2.0, 30)
     feats = encode(pos)
     assert feats.shape == (29, 171)
     back = decode(feats, start_xz=pos[0, 0, [0, 2]])
@@ -55,7 +55,7 @@ def test_mirroring_swaps_sides_and_keeps_the_body(dance):
     name = skel.names.index
     assert pairs[name("lHand")] == name("rHand") and pairs[name("rightEye")] == name("leftEye")
     assert pairs[name("hip")] == name("hip") and pairs[name("head")] == name("head")
-    pos = clips[0]["positions"][::40]
+    pos = clips[0].positions[::40]
     out = mirror(pos, pairs)
     assert np.abs(mirror(out, pairs) - pos).max() < 1e-12
     # The left hand goes where the right hand was, mirrored in x; heights stay.
@@ -68,11 +68,11 @@ def test_mirroring_swaps_sides_and_keeps_the_body(dance):
 
 def test_resampling_plays_faster_and_slower(dance):
     _, clips = dance
-    c = next(c for c in clips if c["style"] == "martial")  # 120 fps source
-    normal = resample_positions(c["positions"], c["fps"], 1.0, 61)
-    fast = resample_positions(c["positions"], c["fps"], 1.0, 31, speed=2.0)
+    c = next(c for c in clips if c.style == "martial")  # 120 fps source
+    normal = resample_positions(c.positions, c.fps, 1.0, 61)
+    fast = resample_positions(c.positions, c.fps, 1.0, 31, speed=2.0)
     assert np.abs(normal[::2] - fast).max() < 1e-9
-    assert np.abs(normal[0] - c["positions"][120]).max() < 1e-9
+    assert np.abs(normal[0] - c.positions[120]).max() < 1e-9
 
 
 def test_auto_conditioning_feeds_outputs_back():

@@ -3,26 +3,27 @@ import sys
 
 import numpy as np
 
-from training.data.cmu import build, load_cache
+from training.data.cmu import build_cache, load_cache
 from conftest import REPO
 
 
 def test_build_cache_for_a_category(mocap, tmp_path):
-    path = build(mocap, 30.0, ["other"], tmp_path)
+    path = build_cache(mocap, 30.0, ["other"], tmp_path)
     data = load_cache(path)
-    clips = data["clips"]
-    assert len(clips) == 5 and all(c["category"] == "other" for c in clips)
-    n = sum(c["frames"] for c in clips)
-    assert data["root"].shape == (n, 3)
-    assert data["rotations"].shape == (n, len(data["joints"]), 4)
-    assert data["positions"].shape == (n, len(data["joints"]), 3)
-    assert data["contacts"].shape == (n, 2) and set(np.unique(data["contacts"])) <= {0, 1}
-    assert np.allclose(np.linalg.norm(data["rotations"], axis=-1), 1, atol=1e-5)
-    assert clips[1]["start"] == clips[0]["frames"]
+    clips = data.clips
+    assert len(clips) == 5 and all(c.category == "other" for c in clips)
+    n = sum(c.frames for c in clips)
+    assert data.fps == 30.0
+    assert data.root.shape == (n, 3)
+    assert data.rotations.shape == (n, len(data.joints), 4)
+    assert data.positions.shape == (n, len(data.joints), 3)
+    assert data.contacts.shape == (n, 2) and set(np.unique(data.contacts)) <= {0, 1}
+    assert np.allclose(np.linalg.norm(data.rotations, axis=-1), 1, atol=1e-5)
+    assert clips[1].start == clips[0].frames
 
 
 def run_cli(*args, env=None):
-    return subprocess.run([sys.executable, "-m", "training.data.cmu", *args], cwd=REPO, capture_output=True, text=True,
+    return subprocess.run([sys.executable, "-m", "training.data.build_locomotion", *args], cwd=REPO, capture_output=True, text=True,
                           env=env)
 
 

@@ -7,7 +7,8 @@ import pytest
 import torch
 
 from training.data.cmu import load_clip, read_index
-from training.generator.export import check_parity, estimate_initial_state, export_onnx
+from training.generator.exporting import estimate_initial_state
+from training.generator.graph import check_parity, export_onnx
 from training.data.features import FeatureCodec, heading_of, mirror_clip
 from training.models.generator import MixtureLSTM, mixture_nll
 from training.paths import MODELS_DIR

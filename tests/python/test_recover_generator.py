@@ -1,13 +1,14 @@
-"""recover_generator: the torch checkpoint rebuilt from an ONNX export computes what the export computes."""
+"""training/generator/recovery.py: the torch checkpoint rebuilt from an ONNX export computes what the export computes."""
 import json
 
 import numpy as np
 import pytest
 import torch
 
-from training.generator.export import INPUTS, OUTPUTS, export_onnx, load_generator
+from training.generator.graph import INPUTS, OUTPUTS, export_onnx
+from training.generator.training import load_generator
 from training.models.generator import GeneratorStep, MixtureLSTM
-from training.generator.recover import checkpoint_from_shipped, compare_with_onnx, model_from_onnx
+from training.generator.recovery import checkpoint_from_shipped, compare_with_onnx, model_from_onnx
 from training.paths import MODELS_DIR
 from training.mocap.rotations import matrix_to_quat
 

@@ -8,14 +8,14 @@ import torch
 
 from training.data.cmu import clip_contacts, load_clip, read_index
 from training.paths import MODELS_DIR
-from training.refiner.export import (FIXTURE, OUTPUTS, export_onnx, parity_error, refiner_from_onnx, step_parity,
-                                     stream_inputs)
+from training.refiner.exporting import FIXTURE
+from training.refiner.graph import OUTPUTS, export_onnx, parity_error, refiner_from_onnx, step_parity, stream_inputs
 from training.data.features import FeatureCodec
 from training.footlock import BLEND_IN, TOE_GROUND_HEIGHT, FootLock, foot_lock, two_bone_ik
 from training.models.refiner import (FeatureGeometry, Refiner, RefinerStep, rotvec_to_matrix, straight_through_bits)
 from training.mocap.rotations import axis_rotation
 from training.mocap.skeleton import canonical_skeleton
-from training.refiner.train import root_loss
+from training.refiner.training import root_loss
 
 SKEL = canonical_skeleton()
 

@@ -5,16 +5,15 @@ import json
 from pathlib import Path
 
 import numpy as np
-import onnxruntime as ort
 from tqdm import tqdm
+
+from ..onnx.sessions import cpu_session
 
 
 class ShippedDance:
     def __init__(self, models_dir: Path, model_id: str = "aclstm"):
         self.info = json.loads((models_dir / f"{model_id}.json").read_text())
-        options = ort.SessionOptions()
-        options.intra_op_num_threads = 1
-        self.session = ort.InferenceSession(str(models_dir / self.info["file"]), options, providers=["CPUExecutionProvider"])
+        self.session = cpu_session(models_dir / self.info["file"], threads=1)
         self.mean = np.array(self.info["normalisation"]["mean"], np.float32)
         self.std = np.array(self.info["normalisation"]["std"], np.float32)
         self.styles = self.info["styles"]

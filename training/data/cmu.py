@@ -1,17 +1,14 @@
-"""Build cached arrays of the CMU corpus on the canonical skeleton.
+"""The CMU corpus on the canonical skeleton: the clip index, one clip loaded and retargeted, and the cached
+arrays of many clips (built by python -m training.data.build_locomotion).
 
-    python -m training.dataset [--fps 30] [--categories walk,run] [--mocap DIR] [--out cache/]
-
-Writes one .npz with every clip concatenated (root, local rotations, positions, contacts) plus a
-clip table, so training scripts never parse mocap files. Caches live in cache/ (not in git).
+A cache is one .npz with every clip concatenated (root, local rotations, positions, contacts) plus a clip
+table, so training scripts never parse mocap files. Caches live in cache/ (not in git).
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import json
-import sys
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
@@ -19,7 +16,6 @@ from tqdm import tqdm
 
 from ..mocap.contacts import contacts_for
 from ..mocap.files import MotionFormatError
-from ..paths import DEFAULT_CACHE, add_mocap_argument, resolve_mocap_dir
 from ..mocap.resample import resample
 from ..mocap.retarget import CanonicalClip, retarget, source_from_amc, source_from_cmu_bvh
 from ..mocap.skeleton import FOOT_POINTS, canonical_skeleton
@@ -29,12 +25,36 @@ CATEGORIES = ("walk", "run", "jump", "dance", "other")
 
 @dataclass
 class ClipInfo:
+    """One row of cmu/index.tsv."""
     file: str  # relative to the corpus root
     subject: str
     trial: str
     fps: float
     category: str
     description: str
+
+
+@dataclass
+class CachedClip:
+    """One row of a cache's clip table: which frames of the concatenated arrays belong to which clip."""
+    file: str
+    subject: str
+    category: str
+    description: str
+    start: int
+    frames: int
+
+
+@dataclass
+class LocomotionCache:
+    """A built cache: the clip table and the concatenated per-frame arrays."""
+    fps: float
+    joints: list[str]
+    clips: list[CachedClip]
+    root: np.ndarray       # (frames, 3) metres
+    rotations: np.ndarray  # (frames, joints, 4) local quaternions
+    positions: np.ndarray  # (frames, joints, 3) metres
+    contacts: np.ndarray   # (frames, 2) left, right
 
 
 def read_index(mocap: Path) -> list[ClipInfo]:
@@ -58,7 +78,12 @@ def clip_contacts(clip: CanonicalClip) -> np.ndarray:
     return contacts_for(clip.positions, canonical_skeleton().joints, clip.fps, FOOT_POINTS)
 
 
-def build(mocap: Path, fps: float, categories: list[str], out: Path) -> Path:
+def cache_name(fps: float, categories: list[str]) -> str:
+    return f"cmu_{'-'.join(categories)}_{fps:g}fps.npz"
+
+
+def build_cache(mocap: Path, fps: float, categories: list[str], out: Path) -> Path:
+    """Load every clip of `categories` at `fps` and write them to out/cache_name(...); returns the path."""
     infos = [i for i in read_index(mocap) if i.category in categories]
     if not infos:
         raise SystemExit(f"error: no clips in categories {categories} under {mocap}")
@@ -75,43 +100,20 @@ def build(mocap: Path, fps: float, categories: list[str], out: Path) -> Path:
         arrays["rotations"].append(clip.rotations.astype(np.float32))
         arrays["positions"].append(clip.positions.astype(np.float32))
         arrays["contacts"].append(clip_contacts(clip))
-        table.append({"file": info.file, "subject": info.subject, "category": info.category,
-                      "description": info.description, "start": start, "frames": clip.frames})
+        table.append(CachedClip(info.file, info.subject, info.category, info.description, start, clip.frames))
         start += clip.frames
     out.mkdir(parents=True, exist_ok=True)
-    name = f"cmu_{'-'.join(categories)}_{fps:g}fps.npz"
-    path = out / name
-    np.savez_compressed(path, fps=np.float32(fps), clips=json.dumps(table), joints=json.dumps(canonical_skeleton().joints),
-                        **{k: np.concatenate(v) for k, v in arrays.items()})
+    path = out / cache_name(fps, categories)
+    np.savez_compressed(path, fps=np.float32(fps), clips=json.dumps([asdict(c) for c in table]),
+                        joints=json.dumps(canonical_skeleton().joints), **{k: np.concatenate(v) for k, v in arrays.items()})
     seconds = start / fps
     print(f"wrote {path} ({len(table)} clips, {start} frames, {seconds / 60:.1f} min)")
     return path
 
 
-def load_cache(path: Path) -> dict:
-    """The arrays of a built cache plus its clip table as a list of dicts."""
+def load_cache(path: Path) -> LocomotionCache:
     with np.load(path) as data:
-        out = {k: data[k] for k in data.files}
-    out["clips"] = json.loads(str(out["clips"]))
-    out["joints"] = json.loads(str(out["joints"]))
-    return out
-
-
-def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    add_mocap_argument(parser)
-    parser.add_argument("--fps", type=float, default=30.0, help="output frame rate (default 30)")
-    parser.add_argument("--categories", default="walk,run", help=f"comma-separated, from {','.join(CATEGORIES)}")
-    parser.add_argument("--out", type=Path, default=DEFAULT_CACHE, help=f"cache directory (default {DEFAULT_CACHE})")
-    args = parser.parse_args(argv)
-    categories = [c.strip() for c in args.categories.split(",") if c.strip()]
-    unknown = [c for c in categories if c not in CATEGORIES]
-    if unknown:
-        parser.error(f"unknown category {unknown[0]!r}; choose from {', '.join(CATEGORIES)}")
-    if args.fps <= 0 or args.fps > 120:
-        parser.error("--fps must be in (0, 120]")
-    build(resolve_mocap_dir(args.mocap), args.fps, categories, args.out)
-
-
-if __name__ == "__main__":
-    main(sys.argv[1:])
+        return LocomotionCache(fps=float(data["fps"]), joints=json.loads(str(data["joints"])),
+                               clips=[CachedClip(**c) for c in json.loads(str(data["clips"]))],
+                               root=data["root"], rotations=data["rotations"], positions=data["positions"],
+                               contacts=data["contacts"])

@@ -1,6 +1,5 @@
 """The acLSTM dance set as joint positions, and the acLSTM feature layout (Zhou et al., "Data Representation").
-
-    python -m training.aclstm_data          # builds cache/aclstm_positions.npz and prints a summary
+The cache (cache/aclstm_positions.npz) is built by python -m training.data.build_dance, or on first use.
 
 Every file in ../shared/mocap/aclstm/{salsa,indian,martial} is on one standard 57-point skeleton
 (43 joints + 14 end sites). The BVH headers all say 120 fps, but the set's readme gives salsa at 60 fps
@@ -14,15 +13,15 @@ body's heading frame), as in the paper, so training rotates every window about t
 """
 from __future__ import annotations
 
-import argparse
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from tqdm import tqdm
 
+from .. import metrics
 from ..mocap.bvh import global_transforms, load_bvh
-from ..paths import DEFAULT_CACHE, add_mocap_argument, resolve_mocap_dir
+from ..paths import DEFAULT_CACHE, resolve_mocap_dir
 
 STYLES = ("salsa", "indian", "martial")
 SOURCE_FPS = {"salsa": 60.0, "indian": 120.0, "martial": 120.0}  # from aclstm/readme.txt
@@ -48,6 +47,19 @@ class DanceSkeleton:
     def to_json(self) -> dict:
         return {"joints": self.names, "parents": self.parents,
                 "offsets": [round(float(v), 6) for v in self.offsets.ravel()]}
+
+
+@dataclass
+class DanceClip:
+    style: str
+    file: str  # relative to the corpus root
+    fps: float  # the source rate (SOURCE_FPS of its style)
+    positions: np.ndarray  # (frames, 57, 3) world metres, feet on the floor
+    held_out: bool
+
+    @property
+    def seconds(self) -> float:
+        return len(self.positions) / self.fps
 
 
 def point_names(clip) -> list[str]:
@@ -94,8 +106,8 @@ def build_cache(mocap: Path, out: Path = CACHE) -> Path:
     return out
 
 
-def load_clips(mocap_flag: str | None = None) -> tuple[DanceSkeleton, list[dict]]:
-    """The skeleton and every clip: {style, file, fps, positions (frames, 57, 3), held_out}."""
+def load_clips(mocap_flag: str | None = None) -> tuple[DanceSkeleton, list[DanceClip]]:
+    """The skeleton and every clip, from the cache (built first when missing)."""
     if not CACHE.exists():
         build_cache(resolve_mocap_dir(mocap_flag))
     d = np.load(CACHE)
@@ -103,9 +115,8 @@ def load_clips(mocap_flag: str | None = None) -> tuple[DanceSkeleton, list[dict]
     clips = []
     for style, file, start, frames in zip(d["style"], d["files"], d["start"], d["frames"]):
         style = str(style)
-        clips.append({"style": style, "file": str(file), "fps": SOURCE_FPS[style],
-                      "positions": d["positions"][start:start + frames].astype(np.float64),
-                      "held_out": is_held_out(style, str(file))})
+        clips.append(DanceClip(style, str(file), SOURCE_FPS[style], d["positions"][start:start + frames].astype(np.float64),
+                               is_held_out(style, str(file))))
     return skel, clips
 
 
@@ -178,19 +189,14 @@ def bone_length_error(pos: np.ndarray, skel: DanceSkeleton, min_length: float = 
     return np.abs(got / lengths[bones] - 1).mean(axis=1)
 
 
-def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    add_mocap_argument(parser)
-    args = parser.parse_args(argv)
-    out = build_cache(resolve_mocap_dir(args.mocap))
-    skel, clips = load_clips(args.mocap)
-    print(f"wrote {out}: {len(skel.names)} points")
+def real_pose_change(clips: list[DanceClip]) -> dict:
+    """Median per-second pose change (m/s, joints relative to the root) of the real held-out clips, per style."""
+    out = {}
     for style in STYLES:
-        mine = [c for c in clips if c["style"] == style]
-        secs = sum(len(c["positions"]) / c["fps"] for c in mine)
-        held = [c["file"] for c in mine if c["held_out"]]
-        print(f"  {style}: {len(mine)} clips, {secs / 60:.1f} min at {SOURCE_FPS[style]:.0f} fps; held out {held}")
-
-
-if __name__ == "__main__":
-    main()
+        changes = []
+        for c in clips:
+            if c.style == style and c.held_out:
+                pos = resample_positions(c.positions, c.fps, 0.0, int(len(c.positions) / c.fps * MODEL_FPS) - 1)
+                changes.append(metrics.pose_change_per_second(pos, MODEL_FPS))
+        out[style] = round(float(np.median(np.concatenate(changes))), 4)
+    return out

@@ -8,7 +8,7 @@ x_t = [Δtx, Δtz, Δry, ty, root tilt (3), joint rotations (3 per joint), conta
 - Root tilt and joint rotations are rotation vectors (axis × angle) of each rotation relative to a
   fixed reference rotation per joint (its mean over the training data). Human joints stay far from
   180° away from their mean, so this representation has no wrap-around jumps, unlike Euler angles;
-  `python -m training.features` measures that claim on the corpus.
+  wraparound_report measures that claim on the corpus (in the generator report).
 """
 from __future__ import annotations
 

@@ -2,23 +2,36 @@
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import onnxruntime as ort
 from tqdm import tqdm
 
 from ..data.features import FeatureCodec
+from ..data.locomotion import LocomotionClip
 from ..mocap.rotations import quat_to_matrix
 from ..mocap.skeleton import canonical_skeleton
+from ..onnx.sessions import cpu_session
+
+
+@dataclass
+class DecodedMotion:
+    """Generator features of one stream or clip and the world motion they decode to."""
+    features: np.ndarray   # (frames, dim) physical units
+    positions: np.ndarray  # (frames, joints, 3) world metres
+    contacts: np.ndarray   # (frames, 2) 0/1
+
+    @property
+    def yaw(self) -> np.ndarray:
+        """Heading per frame (rad), integrated from the features' heading changes."""
+        return np.cumsum(self.features[:, 2])
 
 
 class ShippedGenerator:
     def __init__(self, models_dir: Path):
         self.info = json.loads((models_dir / "generator.json").read_text())
-        options = ort.SessionOptions()
-        options.intra_op_num_threads = 1
-        self.session = ort.InferenceSession(str(models_dir / self.info["file"]), options, providers=["CPUExecutionProvider"])
+        self.session = cpu_session(models_dir / self.info["file"], threads=1)
         self.mean = np.array(self.info["normalisation"]["mean"], np.float32)
         self.std = np.array(self.info["normalisation"]["std"], np.float32)
         self.hidden = self.info["onnx"]["hidden"]
@@ -48,6 +61,17 @@ class ShippedGenerator:
 
     def positions(self, features: np.ndarray) -> np.ndarray:
         return self.codec.positions(features.astype(np.float64))
+
+    def held_out(self, clips: list[LocomotionClip]) -> list[DecodedMotion]:
+        """The generator's held-out validation clips among `clips`, encoded with its codec and decoded again
+        (each clip on its own, root starting at the origin)."""
+        held_out = set(self.info["training"]["valid_files"])
+        out = []
+        for c in clips:
+            if c.file in held_out:
+                features = self.codec.encode(c.root, c.rotations, c.contacts)
+                out.append(DecodedMotion(features, self.codec.positions(features), c.contacts[1:]))
+        return out
 
 
 def sample_mixture(w: np.ndarray, mu: np.ndarray, sigma: np.ndarray, temperature: float, rng: np.random.Generator) -> np.ndarray:

@@ -190,3 +190,9 @@ def global_transforms(clip: BvhClip) -> tuple[np.ndarray, np.ndarray]:
 
 def load_bvh(path: str | Path) -> BvhClip:
     return parse_bvh(read_text(path), str(path))
+
+
+def viewer_points(clip: BvhClip, positions: np.ndarray) -> tuple[list[str], np.ndarray]:
+    """Joints as the viewer lists them: zero-offset joints (other than the root) coincide with their parent and are left out."""
+    keep = [i for i, j in enumerate(clip.joints) if j.parent < 0 or np.linalg.norm(j.offset) > 0]
+    return [clip.joints[i].name for i in keep], positions[:, keep]

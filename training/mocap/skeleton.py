@@ -5,7 +5,7 @@ Each point is where a bone ends; the rotation stored at a point rotates the segm
 the pelvis orientation. Point names follow the common CMU BVH conversion (LeftUpLeg = hip joint,
 LeftLeg = knee, LeftFoot = ankle, ...), so imported CMU BVH files and model output share names.
 
-The offsets are fixed numbers (metres, symmetric left/right), made by `python -m training.skeleton`
+The offsets are fixed numbers (metres, symmetric left/right), made by `python -m training.mocap.rebuild_skeleton`
 from the mean bone lengths and directions of all CMU subjects, and stored in canonical_skeleton.json.
 """
 from __future__ import annotations
@@ -92,7 +92,7 @@ def canonical_skeleton() -> Skeleton:
     data = json.loads(SKELETON_JSON.read_text())
     names = [p for p, _, _ in CANONICAL_LAYOUT]
     if data["joints"] != names:
-        raise RuntimeError(f"{SKELETON_JSON} is out of date with CANONICAL_LAYOUT; run python -m training.skeleton")
+        raise RuntimeError(f"{SKELETON_JSON} is out of date with CANONICAL_LAYOUT; run python -m training.mocap.rebuild_skeleton")
     return Skeleton(names, data["parents"], np.array(data["offsets"], dtype=np.float64).reshape(-1, 3),
                     [b for _, _, b in CANONICAL_LAYOUT])
 
@@ -135,21 +135,3 @@ def build_canonical_from_asfs(asf_paths: list[Path]) -> dict:
     parents = [names.index(p) if p else -1 for _, p, _ in CANONICAL_LAYOUT]
     return {"joints": names, "parents": parents, "offsets": [round(float(v), 6) for v in offsets.reshape(-1)],
             "made_from": [p.name for p in asf_paths]}
-
-
-def main() -> None:
-    import argparse
-
-    from ..paths import add_mocap_argument, resolve_mocap_dir
-
-    parser = argparse.ArgumentParser(description="Rebuild canonical_skeleton.json from the CMU ASF files.")
-    add_mocap_argument(parser)
-    args = parser.parse_args()
-    root = resolve_mocap_dir(args.mocap)
-    data = build_canonical_from_asfs(sorted((root / "cmu" / "asf").glob("*.asf")))
-    SKELETON_JSON.write_text(json.dumps(data, indent=1) + "\n")
-    print(f"wrote {SKELETON_JSON} from {len(data['made_from'])} subjects")
-
-
-if __name__ == "__main__":
-    main()

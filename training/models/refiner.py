@@ -3,12 +3,12 @@
 R (causal, streams frame by frame right behind the generator):
     R_input = [x, p_end(x), v_end(x)]                                    (eq. 11)
     R(x)    = FC2(LSTM(relu(FC1(R_input)))) + x                          (residual)
-x is the generator's normalised feature frame (training/features.py, contacts included), so R refines the
+x is the generator's normalised feature frame (training/data/features.py, contacts included), so R refines the
 contact bits too. FC2 starts at zero, so an untrained R is the identity.
 
 D (sees whole windows, bidirectional):
     d_input = [p_end(x), v_end(x), contacts(x)]                           (eq. 12 plus the contact bits, §4.3)
-    optionally + the rest of x (train_refiner --d-pose): D then judges the whole pose, not only the end effectors
+    optionally + the rest of x (training.refiner.train --d-pose): D then judges the whole pose, not only the end effectors
     D(x)    = FC2(BiLSTM(relu(FC1(d_input))))   -> one logit per frame
 
 End effectors (END_EFFECTORS: wrists, ankles, toes, top of the head) are expressed in the character's root

@@ -1,4 +1,4 @@
-"""A small helper for ONNX step graphs written directly with onnx.helper (export_generator, export_refiner):
+"""A small helper for ONNX step graphs written directly with onnx.helper (the generator and refiner exports):
 initialisers and nodes collected in order, float inputs/outputs with symbolic dims, one checked model."""
 from __future__ import annotations
 

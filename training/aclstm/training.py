@@ -1,0 +1,183 @@
+"""Training the dance model: acLSTM (auto-conditioned) or the vanilla teacher-forced baseline of the same size
+(python -m training.aclstm.train).
+
+Recipe from Zhou et al.: windows of 100 frames, u = v = 5 (5 real frames, then 5 of the network's own
+output), Euclidean loss, Adam. Every window is rotated by a random angle about the vertical axis and
+played at a random speed between 0.8x and 1.2x (the paper's multiple frame rates). Beyond the paper:
+the model runs at 30 fps (see data/dance.MODEL_FPS), and half the windows are mirrored left to right,
+which doubles the 2.5 minutes each of Indian and martial arts (the 60 fps model overfit them: training
+loss 0.015 against 0.076 on held-out clips).
+One model for all three styles (a one-hot style input): Indian and martial arts have 2.5 minutes each,
+too little for a model of their own, and they share the body's kinematics with salsa's 15 minutes.
+Styles are drawn equally often. Losses are in normalised units (per-feature mean and std).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+from tqdm import tqdm
+
+from ..data.dance import MODEL_FPS, STYLES, DanceClip, encode, load_clips, mirror, mirror_pairs, resample_positions, rotate_y
+from ..models.aclstm import DanceLSTM
+from ..runs import Run
+
+SPEEDS = (0.8, 1.2)
+
+
+class DanceCorpus:
+    """Training windows drawn on the fly (rotation and speed augmentation) and fixed validation windows."""
+
+    def __init__(self, clips: list[DanceClip], window: int, rng: np.random.Generator, names: list[str], use_mirror: bool):
+        self.window = window
+        self.pairs = mirror_pairs(names) if use_mirror else None
+        self.train = {s: [c for c in clips if c.style == s and not c.held_out] for s in STYLES}
+        # Clips of a style are drawn in proportion to their duration.
+        self.clip_p = {}
+        for s, mine in self.train.items():
+            secs = np.array([c.seconds for c in mine])
+            self.clip_p[s] = secs / secs.sum()
+        self.valid_files = [c.file for c in clips if c.held_out]
+        sample = np.concatenate([self._features(rng, s)[0] for s in STYLES for _ in range(200)])
+        self.mean = sample.mean(axis=0)
+        self.std = np.maximum(sample.std(axis=0), 1e-3)
+        # Rotation makes x and z statistically alike: give them one spread, and zero mean.
+        pts = self.std.reshape(-1, 3)
+        pts[:, [0, 2]] = np.sqrt((pts[:, 0:1] ** 2 + pts[:, 2:3] ** 2) / 2)
+        means = self.mean.reshape(-1, 3)
+        means[:, [0, 2]] = 0.0
+        self.valid = self._validation_windows(clips)
+
+    def _features(self, rng, style, speed=None, angle=None):
+        clips = self.train[style]
+        c = clips[rng.choice(len(clips), p=self.clip_p[style])]
+        speed = rng.uniform(*SPEEDS) if speed is None else speed
+        span = (self.window + 2) * speed / MODEL_FPS
+        start = rng.uniform(0, max(1e-6, c.seconds - span))
+        pos = resample_positions(c.positions, c.fps, start, self.window + 2, speed)
+        if self.pairs is not None and angle is None and rng.random() < 0.5:
+            pos = mirror(pos, self.pairs)
+        pos = rotate_y(pos, rng.uniform(0, 2 * np.pi) if angle is None else angle)
+        return encode(pos), style
+
+    def normalise(self, x):
+        return ((x - self.mean) / self.std).astype(np.float32)
+
+    def one_hot(self, styles):
+        return torch.eye(len(STYLES))[[STYLES.index(s) for s in styles]]
+
+    def batch(self, rng, size):
+        styles = [STYLES[i] for i in rng.integers(0, len(STYLES), size)]
+        x = np.stack([self.normalise(self._features(rng, s)[0]) for s in styles])
+        return torch.from_numpy(x), self.one_hot(styles)
+
+    def _validation_windows(self, clips, per_style=48):
+        out = {}
+        for s in STYLES:
+            held = [c for c in clips if c.style == s and c.held_out]
+            wins = []
+            for k in range(per_style):
+                c = held[k % len(held)]
+                secs = c.seconds
+                start = (k // len(held) + 0.5) / (per_style // len(held) + 1) * (secs - (self.window + 2) / MODEL_FPS)
+                wins.append(self.normalise(encode(resample_positions(c.positions, c.fps, start, self.window + 2))))
+            out[s] = torch.from_numpy(np.stack(wins))
+        return out
+
+
+def validation_losses(model: DanceLSTM, corpus: DanceCorpus, condition: int) -> dict:
+    """Mean squared error per style on held-out windows: teacher-forced and auto-conditioned (u = v = 5)."""
+    model.eval()
+    out = {}
+    with torch.no_grad():
+        for s, x in corpus.valid.items():
+            style = corpus.one_hot([s] * len(x))
+            tf = ((model.auto_conditioned(x[:, :-1], style, 5, 0) - x[:, 1:]) ** 2).mean()
+            ac = ((model.auto_conditioned(x[:, :-1], style, 5, 5) - x[:, 1:]) ** 2).mean()
+            out[s] = {"teacher_forced": float(tf), "auto_conditioned": float(ac)}
+    model.train()
+    key = "auto_conditioned" if condition else "teacher_forced"
+    out["objective"] = float(np.mean([out[s][key] for s in STYLES]))
+    return out
+
+
+def train_dance_model(args: argparse.Namespace) -> tuple[str, float, Path]:
+    """One training run with the options of python -m training.aclstm.train (kept in the checkpoint's meta);
+    returns why it stopped, the best validation loss and the run directory."""
+    torch.set_num_threads(args.threads)
+    run = Run(args.run, args.checkpoint_minutes)
+    rng = np.random.default_rng(args.seed)
+    torch.manual_seed(args.seed)
+    skel, clips = load_clips(args.mocap)
+    corpus = DanceCorpus(clips, args.window, np.random.default_rng(12345), skel.names, not args.no_mirror)
+    dim = corpus.mean.shape[0]
+    model = DanceLSTM(dim, len(STYLES), args.hidden, args.layers)
+    optimiser = torch.optim.Adam(model.parameters(), lr=args.lr)
+    scheduler = torch.optim.lr_scheduler.ExponentialLR(optimiser, gamma=args.decay)
+    iteration, best, elapsed_before, history = 0, float("inf"), 0.0, []
+    if args.resume:
+        state = run.resume(rng, model=model, optimiser=optimiser, scheduler=scheduler)
+        iteration, best, elapsed_before, history = state["iteration"], state["best"], state["elapsed"], state["history"]
+        run.log.info("resumed at iteration %d", iteration)
+    meta = {"dim": dim, "styles": list(STYLES), "hidden": args.hidden, "layers": args.layers, "fps": MODEL_FPS,
+            "mean": corpus.mean.tolist(), "std": corpus.std.tolist(), "skeleton": skel.to_json(),
+            "valid_files": corpus.valid_files, "args": vars(args)}
+    params = sum(p.numel() for p in model.parameters())
+    run.log.info("start: %s, u=%d v=%d, %d features, %d parameters, batch %d x %d frames", args.run,
+                 args.ground_truth, args.condition, dim, params, args.batch, args.window)
+    t0 = time.monotonic()
+
+    def elapsed() -> float:
+        return elapsed_before + time.monotonic() - t0
+
+    def checkpoint() -> dict:
+        return {"model": model.state_dict(), "optimiser": optimiser.state_dict(), "scheduler": scheduler.state_dict(),
+                "rng": rng.bit_generator.state, "torch_rng": torch.get_rng_state(), "iteration": iteration,
+                "best": best, "elapsed": elapsed(), "history": history, "meta": meta}
+
+    bar = tqdm(total=args.iterations, initial=iteration, desc=args.run, unit="it")
+    losses, stopped = [], "iterations done"
+    while iteration < args.iterations:
+        x, style = corpus.batch(rng, args.batch)
+        pred = model.auto_conditioned(x[:, :-1], style, args.ground_truth, args.condition)
+        loss = ((pred - x[:, 1:]) ** 2).mean()
+        optimiser.zero_grad()
+        loss.backward()
+        torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
+        optimiser.step()
+        iteration += 1
+        losses.append(loss.item())
+        bar.update(1)
+        bar.set_postfix(loss=f"{np.mean(losses[-50:]):.4f}")
+        if iteration % args.iters_per_epoch == 0:
+            scheduler.step()
+            val = validation_losses(model, corpus, args.condition)
+            history.append({"iteration": iteration, "minutes": round(elapsed() / 60, 2), "train": float(np.mean(losses)),
+                            "valid": val})
+            if val["objective"] < best:
+                best = val["objective"]
+                run.save({"model": model.state_dict(), "iteration": iteration, "valid": val, "meta": meta}, run.best_path)
+            run.log.info("iteration %d train %.4f valid %.4f (tf %s, ac %s) best %.4f lr %.2e minutes %.1f", iteration,
+                         np.mean(losses), val["objective"],
+                         "/".join(f"{val[s]['teacher_forced']:.3f}" for s in STYLES),
+                         "/".join(f"{val[s]['auto_conditioned']:.3f}" for s in STYLES),
+                         best, scheduler.get_last_lr()[0], elapsed() / 60)
+            losses = []
+            run.save(checkpoint())
+        elif run.due():
+            run.save(checkpoint())
+        if elapsed() > args.minutes * 60:
+            stopped = f"time budget of {args.minutes:.0f} minutes used"
+            break
+    run.save(checkpoint())
+    # The last weights also count as a candidate: save them as "last.pt" for the evaluation to compare.
+    run.save({"model": model.state_dict(), "iteration": iteration, "meta": meta}, run.dir / "last.pt")
+    bar.close()
+    run.log.info("stopped: %s at iteration %d", stopped, iteration)
+    (run.dir / "summary.json").write_text(json.dumps({"best_valid": best, "iterations": iteration, "stopped": stopped,
+                                                       "minutes": elapsed() / 60, "parameters": params}, indent=1))
+    return stopped, best, run.dir

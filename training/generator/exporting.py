@@ -1,0 +1,148 @@
+"""Exporting a trained generator: the ONNX step (graph.py), generator.json with seed states estimated as in
+eq. 26, the manifest entry, and tests/fixtures/generator_reference.json for the browser's parity tests."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from ..data.features import FIXED_JOINTS, FeatureCodec, feature_names
+from ..data.locomotion import LocomotionClip, load_clips
+from ..mocap.rotations import matrix_to_quat
+from ..mocap.skeleton import canonical_skeleton
+from ..models.generator import MixtureLSTM, mixture_nll
+from ..onnx.graph import OPSET
+from ..onnx.manifest import register_model
+from ..onnx.sessions import cpu_session
+from ..paths import MODELS_DIR, REPO_ROOT
+from .graph import INPUTS, OUTPUTS, check_parity, export_onnx
+from .training import load_generator
+
+FIXTURE = REPO_ROOT / "tests" / "fixtures" / "generator_reference.json"
+
+
+def estimate_initial_state(model: MixtureLSTM, x: torch.Tensor, iterations: int = 300) -> tuple[torch.Tensor, torch.Tensor, float, float]:
+    """Eq. 26: find (h, c) for the first frame that make the following real frames likely.
+
+    x holds a few real normalised frames (time, dim). Returns h, c and the NLL of the frames after the
+    first, from a zero state and from the estimated one."""
+    h0, c0 = model.zero_state(1)
+    h = h0.clone().requires_grad_(True)
+    c = c0.clone().requires_grad_(True)
+    inputs, targets = x[:-1].unsqueeze(0), x[1:].unsqueeze(0)
+
+    def nll(h_, c_):
+        logits, mu, log_sigma, _ = model(inputs, (h_, c_))
+        return mixture_nll(logits, mu, log_sigma, targets).mean()
+
+    with torch.no_grad():
+        zero_nll = float(nll(h0, c0))
+    opt = torch.optim.Adam([h, c], lr=0.05)
+    for _ in range(iterations):
+        opt.zero_grad()
+        loss = nll(h, c)
+        loss.backward()
+        opt.step()
+    with torch.no_grad():
+        return h.detach(), c.detach(), zero_nll, float(nll(h, c))
+
+
+def pick_seeds(clips: list[LocomotionClip], codec: FeatureCodec, mean: np.ndarray, std: np.ndarray,
+               count_per_category=(6, 2)) -> list[dict]:
+    """Seed frames from held-out and training clips: a spread of walking speeds and some running."""
+    seeds = []
+    for category, count in zip(("walk", "run"), count_per_category):
+        pool = sorted((c for c in clips if c.category == category and len(c.root) > 12), key=lambda c: c.file)
+        for k in np.linspace(0, len(pool) - 1, count).round().astype(int):
+            c = pool[k]
+            x = codec.encode(c.root, c.rotations, c.contacts)
+            start = len(x) // 3
+            seeds.append({"name": f"{category} {c.file.split('/')[-1].split('.')[0]}", "file": c.file,
+                          "category": category, "frames": ((x[start:start + 6] - mean) / std).astype(np.float32)})
+    return seeds
+
+
+def estimated_seeds(model: MixtureLSTM, clips: list[LocomotionClip], codec: FeatureCodec, mean: np.ndarray,
+                    std: np.ndarray) -> list[dict]:
+    """generator.json's seeds: pick_seeds with their first frame and estimated (h, c), rounded."""
+    seeds = []
+    for seed in pick_seeds(clips, codec, mean, std):
+        frames = torch.from_numpy(seed["frames"])
+        h, c, zero_nll, est_nll = estimate_initial_state(model, frames)
+        seeds.append({"name": seed["name"], "file": seed["file"], "category": seed["category"],
+                      "x": [round(float(v), 6) for v in seed["frames"][0]],
+                      "h": [round(float(v), 6) for v in h.reshape(-1)], "c": [round(float(v), 6) for v in c.reshape(-1)],
+                      "nll_zero_state": round(zero_nll, 3), "nll_estimated_state": round(est_nll, 3)})
+        print(f"seed {seed['name']}: NLL of the next frames {zero_nll:.1f} from a zero state, {est_nll:.1f} estimated")
+    return seeds
+
+
+def write_reference_fixture(onnx_path: Path, info: dict, codec: FeatureCodec) -> None:
+    """Numbers the browser tests compare against: one ONNX step at batch 2 (onnxruntime-web parity) and
+    the decoding of a few real feature frames into joint positions (TypeScript decoder parity)."""
+    session = cpu_session(onnx_path)
+    hidden = info["onnx"]["hidden"]
+    s0, s1 = info["seeds"][0], info["seeds"][-1]
+    x = np.array([s0["x"], s1["x"]], np.float32)
+    h = np.stack([np.array(s["h"], np.float32).reshape(2, hidden) for s in (s0, s1)], axis=1)
+    c = np.stack([np.array(s["c"], np.float32).reshape(2, hidden) for s in (s0, s1)], axis=1)
+    outs = session.run(OUTPUTS, {"x": x, "h": h, "c": c})
+    mean, std = np.array(info["normalisation"]["mean"]), np.array(info["normalisation"]["std"])
+    frames = np.array([s["x"] for s in info["seeds"]]) * std + mean  # physical units, one real frame per seed
+    frames[:, 0] += 0.01  # keep the character moving so the decoder's integration is exercised
+    positions = codec.positions(frames)
+    step = {"inputs": {"x": x.ravel().tolist(), "h": h.ravel().tolist(), "c": c.ravel().tolist(), "batch": 2},
+            "outputs": {name: np.asarray(o).ravel().tolist() for name, o in zip(OUTPUTS, outs)}}
+    decode = {"features": frames.ravel().tolist(), "frames": len(frames), "positions": positions.ravel().tolist()}
+    FIXTURE.write_text(json.dumps({"model": info["file"], "step": step, "decode": decode}) + "\n")
+    print(f"wrote {FIXTURE}")
+
+
+def export_generator(checkpoint: Path, out: Path, mocap: str | None) -> Path:
+    """Writes out/generator.onnx and out/generator.json (skeleton, feature layout, normalisation, rotation
+    references, seed states, training and parity numbers); into MODELS_DIR also the fixture and the manifest
+    entry. Returns the ONNX path."""
+    model, meta, state = load_generator(checkpoint)
+    out.mkdir(parents=True, exist_ok=True)
+    onnx_path = out / "generator.onnx"
+    export_onnx(model, onnx_path)
+    parity = check_parity(model, onnx_path)
+    print(f"parity ok: max |torch - onnxruntime| = {parity['max_abs_diff']:.2e}")
+
+    skel = canonical_skeleton()
+    codec = FeatureCodec(skel, np.array(meta["references"]))
+    mean, std = np.array(meta["mean"]), np.array(meta["std"])
+    seeds = estimated_seeds(model, load_clips(mocap), codec, mean, std)
+    fixed = [skel.index(n) for n in FIXED_JOINTS]
+    info = {
+        "id": "generator", "kind": "lstm-gmm", "fps": meta["fps"], "file": "generator.onnx",
+        "bytes": onnx_path.stat().st_size,
+        "description": "Contact-aware LSTM with a 5-component Gaussian mixture over the next frame (Wang, Chai, Xia §4.1), "
+                       "trained on CMU walking and running.",
+        "skeleton": skel.to_json(),
+        "onnx": {"inputs": INPUTS, "outputs": OUTPUTS, "opset": OPSET, "layers": 2, "hidden": meta["hidden"],
+                 "graph": "gate-level LSTM layers (Gemm + gate maths, no LSTM op), fc3 as three Gemms",
+                 "mixtures": meta["mixtures"], "dim": meta["dim"]},
+        "features": {
+            "names": feature_names(skel), "joints": codec.joints, "fixed_joints": fixed,
+            "layout": "x = [dtx, dtz, dry, ty, root tilt rotvec(3), joint rotvecs (3 per joint in `joints`), contact L, contact R]; "
+                      "dtx/dtz: root step in the previous frame's heading frame (m); dry: heading change (rad, about +y); "
+                      "rotvecs are relative to `references` (local rotation = reference * exp(rotvec)); "
+                      "references[0] is the root tilt's, references[j] joint j's; fixed joints keep their reference.",
+            "references": [[round(float(v), 7) for v in q] for q in matrix_to_quat(codec.references)],
+        },
+        "normalisation": {"mean": [round(float(v), 7) for v in mean], "std": [round(float(v), 7) for v in std]},
+        "seeds": seeds,
+        "training": {"epochs": state.get("epoch"), "valid_nll_per_frame": state.get("valid_nll"),
+                     "valid_files": meta["valid_files"], "train_frames": meta["train_frames"],
+                     "args": meta["args"]},
+        "parity": parity,
+    }
+    (out / "generator.json").write_text(json.dumps(info) + "\n")
+    if out == MODELS_DIR:  # a candidate exported elsewhere must not replace the shipped model's fixture
+        write_reference_fixture(onnx_path, info, codec)
+        register_model({"id": "generator", "kind": info["kind"], "skeleton": "cmu-canonical", "fps": info["fps"],
+                        "bytes": info["bytes"], "file": info["file"]})
+    return onnx_path
