@@ -2,7 +2,7 @@
 import json
 import math
 
-from training.fixtures.measures import OUT, build
+from training.fixtures.measures_parity import OUT, build
 
 
 def _same(a, b, where="") -> None:
