@@ -64,45 +64,47 @@ function vec3(parts: string[], from: number, line: number, what: string): Vec3 {
   return [parseNumber(parts[from], 'asf', line, what), parseNumber(parts[from + 1], 'asf', line, what), parseNumber(parts[from + 2], 'asf', line, what)];
 }
 
+type BoneChildren = Map<string, { names: string[]; line: number }>;
+
+/** What parseASF has read so far: the skeleton, the open section and the bone or block being read. */
+interface AsfReader {
+  skeleton: AsfSkeleton;
+  section: string;
+  sawBonedata: boolean;
+  sawHierarchy: boolean;
+  /** The :bonedata entry between "begin" and "end", with the line of its "begin". */
+  bone: (Partial<AsfBone> & { line: number }) | undefined;
+  inHierarchyBlock: boolean;
+  /** :hierarchy lines: parent name → children, with the line that first names the parent. */
+  children: BoneChildren;
+}
+
 export function parseASF(text: string): AsfSkeleton {
   checkText(text, 'asf');
-  const lines = splitLines(text);
-  const skeleton: AsfSkeleton = {
-    name: '',
-    lengthScale: 0.0254,
-    angleUnit: 'deg',
-    root: { order: ['TX', 'TY', 'TZ', 'RX', 'RY', 'RZ'], axisOrder: 'XYZ', position: [0, 0, 0], orientation: [0, 0, 0] },
-    bones: [],
-    joints: [],
-    parents: [],
-  };
-  const children = new Map<string, { names: string[]; line: number }>();
-  let section = '';
-  let sawBonedata = false;
-  let sawHierarchy = false;
-  let bone: (Partial<AsfBone> & { line: number }) | undefined;
-  let inHierarchyBlock = false;
+  const reader = readASFSections(splitLines(text));
+  orderJoints(reader.skeleton, reader.children);
+  return reader.skeleton;
+}
 
-  const finishBone = (endLine: number) => {
-    if (!bone) throw new MotionFormatError('asf', '"end" without "begin" in :bonedata', endLine);
-    for (const field of ['name', 'direction', 'length'] as const) {
-      if (bone[field] === undefined) throw new MotionFormatError('asf', `bone starting at line ${bone.line} has no ${field}`, endLine);
-    }
-    const name = bone.name!;
-    if (name === 'root' || skeleton.bones.some((b) => b.name === name)) throw new MotionFormatError('asf', `duplicate bone name "${name}"`, bone.line);
-    const d = bone.direction!;
-    const n = Math.hypot(d[0], d[1], d[2]);
-    skeleton.bones.push({
-      name,
-      direction: n > 0 ? [d[0] / n, d[1] / n, d[2] / n] : [0, 0, 0],
-      length: bone.length!,
-      axis: bone.axis ?? [0, 0, 0],
-      axisOrder: bone.axisOrder ?? 'XYZ',
-      dof: bone.dof ?? [],
-    });
-    bone = undefined;
+/** Reads every line into the skeleton's header, root and bones, and the :hierarchy lists. */
+function readASFSections(lines: string[]): AsfReader {
+  const reader: AsfReader = {
+    skeleton: {
+      name: '',
+      lengthScale: 0.0254,
+      angleUnit: 'deg',
+      root: { order: ['TX', 'TY', 'TZ', 'RX', 'RY', 'RZ'], axisOrder: 'XYZ', position: [0, 0, 0], orientation: [0, 0, 0] },
+      bones: [],
+      joints: [],
+      parents: [],
+    },
+    section: '',
+    sawBonedata: false,
+    sawHierarchy: false,
+    bone: undefined,
+    inHierarchyBlock: false,
+    children: new Map(),
   };
-
   for (let i = 0; i < lines.length; i++) {
     const lineNo = i + 1;
     const hash = lines[i].indexOf('#');
@@ -110,77 +112,126 @@ export function parseASF(text: string): AsfSkeleton {
     if (parts.length === 0) continue;
     const key = parts[0];
     if (key.startsWith(':')) {
-      if (bone) throw new MotionFormatError('asf', `bone starting at line ${bone.line} has no "end"`, lineNo);
-      if (inHierarchyBlock) throw new MotionFormatError('asf', ':hierarchy block has no "end"', lineNo);
-      section = key.toLowerCase();
-      if (section === ':name') skeleton.name = parts.slice(1).join(' ');
-      if (section === ':bonedata') sawBonedata = true;
-      if (section === ':hierarchy') sawHierarchy = true;
+      openSection(reader, key, parts, lineNo);
       continue;
     }
     const k = key.toLowerCase();
-    if (section === ':units') {
-      if (k === 'length') {
-        const l = parseNumber(parts[1] ?? '', 'asf', lineNo, 'a length unit');
-        if (!(l > 0)) throw new MotionFormatError('asf', `expected a positive length unit, found ${parts[1]}`, lineNo);
-        skeleton.lengthScale = 0.0254 / l;
-      } else if (k === 'angle') {
-        const unit = (parts[1] ?? '').toLowerCase();
-        if (unit.startsWith('deg')) skeleton.angleUnit = 'deg';
-        else if (unit.startsWith('rad')) skeleton.angleUnit = 'rad';
-        else throw new MotionFormatError('asf', `expected angle unit "deg" or "rad", found "${parts[1] ?? ''}"`, lineNo);
-      }
-    } else if (section === ':root') {
-      if (k === 'order') {
-        const order = parts.slice(1).map((p) => p.toUpperCase());
-        for (const o of order) if (!ROOT_ORDER_NAMES.has(o)) throw new MotionFormatError('asf', `unknown root order entry "${o}" (expected TX TY TZ RX RY RZ)`, lineNo);
-        skeleton.root.order = order;
-      } else if (k === 'axis') skeleton.root.axisOrder = axisOrder(parts[1], lineNo);
-      else if (k === 'position') skeleton.root.position = vec3(parts, 1, lineNo, 'the root position');
-      else if (k === 'orientation') skeleton.root.orientation = vec3(parts, 1, lineNo, 'the root orientation');
-    } else if (section === ':bonedata') {
-      if (k === 'begin') {
-        if (bone) throw new MotionFormatError('asf', `bone starting at line ${bone.line} has no "end"`, lineNo);
-        bone = { line: lineNo };
-      } else if (k === 'end') {
-        finishBone(lineNo);
-      } else if (!bone) {
-        throw new MotionFormatError('asf', `expected "begin" in :bonedata, found "${key}"`, lineNo);
-      } else if (k === 'name') {
-        if (!parts[1]) throw new MotionFormatError('asf', 'expected a bone name', lineNo);
-        bone.name = parts[1];
-      } else if (k === 'direction') {
-        bone.direction = vec3(parts, 1, lineNo, 'the bone direction');
-      } else if (k === 'length') {
-        const len = parseNumber(parts[1] ?? '', 'asf', lineNo, 'a bone length');
-        if (len < 0) throw new MotionFormatError('asf', `expected a non-negative bone length, found ${len}`, lineNo);
-        bone.length = len;
-      } else if (k === 'axis') {
-        bone.axis = vec3(parts, 1, lineNo, 'the bone axis');
-        bone.axisOrder = axisOrder(parts[4], lineNo);
-      } else if (k === 'dof') {
-        const dof = parts.slice(1).map((d) => d.toLowerCase());
-        for (const d of dof) if (!DOF_NAMES.has(d)) throw new MotionFormatError('asf', `unknown dof "${d}" (expected rx ry rz tx ty tz l)`, lineNo);
-        bone.dof = dof;
-      }
-      // id, limits (and their continuation lines), bodymass, cofmass: not needed.
-    } else if (section === ':hierarchy') {
-      if (k === 'begin') inHierarchyBlock = true;
-      else if (k === 'end') inHierarchyBlock = false;
-      else {
-        if (!inHierarchyBlock) throw new MotionFormatError('asf', `expected "begin" in :hierarchy, found "${key}"`, lineNo);
-        const entry = children.get(key);
-        if (entry) entry.names.push(...parts.slice(1));
-        else children.set(key, { names: parts.slice(1), line: lineNo });
-      }
-    }
+    if (reader.section === ':units') readUnitsLine(reader.skeleton, k, parts, lineNo);
+    else if (reader.section === ':root') readRootLine(reader.skeleton, k, parts, lineNo);
+    else if (reader.section === ':bonedata') readBonedataLine(reader, k, key, parts, lineNo);
+    else if (reader.section === ':hierarchy') readHierarchyLine(reader, k, key, parts, lineNo);
   }
-  if (bone) throw new MotionFormatError('asf', `bone starting at line ${bone.line} has no "end" (file truncated?)`, lines.length);
-  if (inHierarchyBlock) throw new MotionFormatError('asf', ':hierarchy block has no "end" (file truncated?)', lines.length);
-  if (!sawBonedata) throw new MotionFormatError('asf', 'missing :bonedata section (expected the bone definitions)');
-  if (!sawHierarchy) throw new MotionFormatError('asf', 'missing :hierarchy section (expected the bone parent/child lists)');
+  if (reader.bone) throw new MotionFormatError('asf', `bone starting at line ${reader.bone.line} has no "end" (file truncated?)`, lines.length);
+  if (reader.inHierarchyBlock) throw new MotionFormatError('asf', ':hierarchy block has no "end" (file truncated?)', lines.length);
+  if (!reader.sawBonedata) throw new MotionFormatError('asf', 'missing :bonedata section (expected the bone definitions)');
+  if (!reader.sawHierarchy) throw new MotionFormatError('asf', 'missing :hierarchy section (expected the bone parent/child lists)');
+  return reader;
+}
 
-  // Depth-first order from the root, children in the order listed.
+/** A ":keyword" line: closes the previous section (which must not be mid-bone or mid-block). */
+function openSection(reader: AsfReader, key: string, parts: string[], lineNo: number): void {
+  if (reader.bone) throw new MotionFormatError('asf', `bone starting at line ${reader.bone.line} has no "end"`, lineNo);
+  if (reader.inHierarchyBlock) throw new MotionFormatError('asf', ':hierarchy block has no "end"', lineNo);
+  reader.section = key.toLowerCase();
+  if (reader.section === ':name') reader.skeleton.name = parts.slice(1).join(' ');
+  if (reader.section === ':bonedata') reader.sawBonedata = true;
+  if (reader.section === ':hierarchy') reader.sawHierarchy = true;
+}
+
+function readUnitsLine(skeleton: AsfSkeleton, k: string, parts: string[], lineNo: number): void {
+  if (k === 'length') {
+    const l = parseNumber(parts[1] ?? '', 'asf', lineNo, 'a length unit');
+    if (!(l > 0)) throw new MotionFormatError('asf', `expected a positive length unit, found ${parts[1]}`, lineNo);
+    skeleton.lengthScale = 0.0254 / l;
+  } else if (k === 'angle') {
+    const unit = (parts[1] ?? '').toLowerCase();
+    if (unit.startsWith('deg')) skeleton.angleUnit = 'deg';
+    else if (unit.startsWith('rad')) skeleton.angleUnit = 'rad';
+    else throw new MotionFormatError('asf', `expected angle unit "deg" or "rad", found "${parts[1] ?? ''}"`, lineNo);
+  }
+}
+
+function readRootLine(skeleton: AsfSkeleton, k: string, parts: string[], lineNo: number): void {
+  if (k === 'order') {
+    const order = parts.slice(1).map((p) => p.toUpperCase());
+    for (const o of order) if (!ROOT_ORDER_NAMES.has(o)) throw new MotionFormatError('asf', `unknown root order entry "${o}" (expected TX TY TZ RX RY RZ)`, lineNo);
+    skeleton.root.order = order;
+  } else if (k === 'axis') skeleton.root.axisOrder = axisOrder(parts[1], lineNo);
+  else if (k === 'position') skeleton.root.position = vec3(parts, 1, lineNo, 'the root position');
+  else if (k === 'orientation') skeleton.root.orientation = vec3(parts, 1, lineNo, 'the root orientation');
+}
+
+/** One :bonedata line: "begin" … "end" around name, direction, length, axis and dof lines. */
+function readBonedataLine(reader: AsfReader, k: string, key: string, parts: string[], lineNo: number): void {
+  if (k === 'begin') {
+    if (reader.bone) throw new MotionFormatError('asf', `bone starting at line ${reader.bone.line} has no "end"`, lineNo);
+    reader.bone = { line: lineNo };
+    return;
+  }
+  if (k === 'end') {
+    finishBone(reader, lineNo);
+    return;
+  }
+  const bone = reader.bone;
+  if (!bone) {
+    throw new MotionFormatError('asf', `expected "begin" in :bonedata, found "${key}"`, lineNo);
+  } else if (k === 'name') {
+    if (!parts[1]) throw new MotionFormatError('asf', 'expected a bone name', lineNo);
+    bone.name = parts[1];
+  } else if (k === 'direction') {
+    bone.direction = vec3(parts, 1, lineNo, 'the bone direction');
+  } else if (k === 'length') {
+    const len = parseNumber(parts[1] ?? '', 'asf', lineNo, 'a bone length');
+    if (len < 0) throw new MotionFormatError('asf', `expected a non-negative bone length, found ${len}`, lineNo);
+    bone.length = len;
+  } else if (k === 'axis') {
+    bone.axis = vec3(parts, 1, lineNo, 'the bone axis');
+    bone.axisOrder = axisOrder(parts[4], lineNo);
+  } else if (k === 'dof') {
+    const dof = parts.slice(1).map((d) => d.toLowerCase());
+    for (const d of dof) if (!DOF_NAMES.has(d)) throw new MotionFormatError('asf', `unknown dof "${d}" (expected rx ry rz tx ty tz l)`, lineNo);
+    bone.dof = dof;
+  }
+  // id, limits (and their continuation lines), bodymass, cofmass: not needed.
+}
+
+/** The bone's "end" line: checks the entry and adds it to the skeleton. */
+function finishBone(reader: AsfReader, endLine: number): void {
+  const bone = reader.bone;
+  if (!bone) throw new MotionFormatError('asf', '"end" without "begin" in :bonedata', endLine);
+  for (const field of ['name', 'direction', 'length'] as const) {
+    if (bone[field] === undefined) throw new MotionFormatError('asf', `bone starting at line ${bone.line} has no ${field}`, endLine);
+  }
+  const bones = reader.skeleton.bones;
+  const name = bone.name!;
+  if (name === 'root' || bones.some((b) => b.name === name)) throw new MotionFormatError('asf', `duplicate bone name "${name}"`, bone.line);
+  const d = bone.direction!;
+  const n = Math.hypot(d[0], d[1], d[2]);
+  bones.push({
+    name,
+    direction: n > 0 ? [d[0] / n, d[1] / n, d[2] / n] : [0, 0, 0],
+    length: bone.length!,
+    axis: bone.axis ?? [0, 0, 0],
+    axisOrder: bone.axisOrder ?? 'XYZ',
+    dof: bone.dof ?? [],
+  });
+  reader.bone = undefined;
+}
+
+/** One :hierarchy line: "begin", "end", or "parent child1 child2 …" inside the block. */
+function readHierarchyLine(reader: AsfReader, k: string, key: string, parts: string[], lineNo: number): void {
+  if (k === 'begin') reader.inHierarchyBlock = true;
+  else if (k === 'end') reader.inHierarchyBlock = false;
+  else {
+    if (!reader.inHierarchyBlock) throw new MotionFormatError('asf', `expected "begin" in :hierarchy, found "${key}"`, lineNo);
+    const entry = reader.children.get(key);
+    if (entry) entry.names.push(...parts.slice(1));
+    else reader.children.set(key, { names: parts.slice(1), line: lineNo });
+  }
+}
+
+/** Fills skeleton.joints and .parents depth first from the root, children in the order listed. */
+function orderJoints(skeleton: AsfSkeleton, children: BoneChildren): void {
   const known = new Set(skeleton.bones.map((b) => b.name));
   for (const [parent, { names, line }] of children) {
     if (parent !== 'root' && !known.has(parent)) throw new MotionFormatError('asf', `:hierarchy names unknown bone "${parent}"`, line);
@@ -197,7 +248,6 @@ export function parseASF(text: string): AsfSkeleton {
   for (const b of skeleton.bones) {
     if (!skeleton.joints.includes(b.name)) throw new MotionFormatError('asf', `bone "${b.name}" is not connected to the root in :hierarchy`);
   }
-  return skeleton;
 }
 
 export interface AMCOptions {
@@ -217,17 +267,24 @@ interface JointKinematics {
   firstValue: number; // index of the first value in a frame vector
 }
 
+const angleScale = (unit: 'deg' | 'rad') => (unit === 'deg' ? DEG : 1);
+
 export function parseAMC(text: string, asf: AsfSkeleton | string, options: AMCOptions = {}): Motion {
   const skeleton = typeof asf === 'string' ? parseASF(asf) : asf;
   checkText(text, 'amc');
   const fps = options.fps ?? 120;
   if (!(fps > 0 && Number.isFinite(fps))) throw new Error(`parseAMC: fps must be a positive number, got ${fps}`);
 
-  const angleScale = (unit: 'deg' | 'rad') => (unit === 'deg' ? DEG : 1);
-  const byName = new Map(skeleton.bones.map((b) => [b.name, b]));
-  const J = skeleton.joints.length;
+  const { kin, valuesPerFrame } = jointKinematics(skeleton);
+  const { frameValues, angleUnit } = readAMCFrames(splitLines(text), skeleton, kin, valuesPerFrame);
+  setAxisRotations(skeleton, kin);
+  const positions = amcPositions(skeleton, kin, frameValues, angleScale(angleUnit));
+  return { fps, frames: frameValues.length, joints: skeleton.joints.slice(), parents: skeleton.parents.slice(), positions };
+}
 
-  // Per joint: where its values live in a frame vector and which rotation they make.
+/** Per joint: where its values live in a frame vector and which rotation they make (C still identity). */
+function jointKinematics(skeleton: AsfSkeleton): { kin: JointKinematics[]; valuesPerFrame: number } {
+  const byName = new Map(skeleton.bones.map((b) => [b.name, b]));
   let valuesPerFrame = 0;
   const kin: JointKinematics[] = skeleton.joints.map((name) => {
     const bone = name === 'root' ? undefined : byName.get(name)!;
@@ -253,9 +310,17 @@ export function parseAMC(text: string, asf: AsfSkeleton | string, options: AMCOp
     valuesPerFrame += dof.length;
     return k;
   });
+  return { kin, valuesPerFrame };
+}
 
-  // AMC lines: ":DEGREES" / ":RADIANS" / other headers, "#" comments, frame numbers, "bone v1 v2 …".
-  const lines = splitLines(text);
+/**
+ * The frame vectors of an AMC file, and its angle unit. AMC lines: ":DEGREES" / ":RADIANS" / other
+ * headers, "#" comments, frame numbers, "bone v1 v2 …".
+ */
+function readAMCFrames(
+  lines: string[], skeleton: AsfSkeleton, kin: JointKinematics[], valuesPerFrame: number,
+): { frameValues: Float64Array[]; angleUnit: 'deg' | 'rad' } {
+  const J = skeleton.joints.length;
   let angleUnit = skeleton.angleUnit;
   const jointIndex = new Map(skeleton.joints.map((n, j) => [n, j]));
   const frameValues: Float64Array[] = [];
@@ -277,8 +342,7 @@ export function parseAMC(text: string, asf: AsfSkeleton | string, options: AMCOp
 
   for (let i = 0; i < lines.length; i++) {
     const lineNo = i + 1;
-    const raw = lines[i];
-    const trimmed = raw.trim();
+    const trimmed = lines[i].trim();
     if (trimmed === '' || trimmed.startsWith('#')) continue;
     if (trimmed.startsWith(':')) {
       const key = trimmed.split(/\s+/)[0].toUpperCase();
@@ -305,17 +369,24 @@ export function parseAMC(text: string, asf: AsfSkeleton | string, options: AMCOp
     const j = jointIndex.get(parts[0]);
     if (j === undefined) throw new MotionFormatError('amc', `unknown bone "${parts[0]}" (not in the ASF skeleton)`, lineNo);
     if (seen[j]) throw new MotionFormatError('amc', `bone "${parts[0]}" appears twice in frame ${expectedNumber - 1}`, lineNo);
-    const k = kin[j];
-    if (parts.length - 1 !== k.valueCount) {
-      throw new MotionFormatError('amc', `expected ${k.valueCount} numbers for "${parts[0]}", found ${parts.length - 1}`, lineNo);
-    }
-    for (let v = 0; v < k.valueCount; v++) current[k.firstValue + v] = parseNumber(parts[v + 1], 'amc', lineNo);
+    readBoneValues(kin[j], parts, current, lineNo);
     seen[j] = 1;
   }
   closeFrame(true);
   if (frameValues.length === 0) throw new MotionFormatError('amc', 'no frames found (expected a frame number followed by bone lines)');
+  return { frameValues, angleUnit };
+}
 
-  // Axis rotations, in the ASF's own angle unit.
+/** A "bone v1 v2 …" line: its values into the bone's slots of the frame vector. */
+function readBoneValues(k: JointKinematics, parts: string[], frame: Float64Array, lineNo: number): void {
+  if (parts.length - 1 !== k.valueCount) {
+    throw new MotionFormatError('amc', `expected ${k.valueCount} numbers for "${parts[0]}", found ${parts.length - 1}`, lineNo);
+  }
+  for (let v = 0; v < k.valueCount; v++) frame[k.firstValue + v] = parseNumber(parts[v + 1], 'amc', lineNo);
+}
+
+/** Axis rotations C (and C⁻¹), in the ASF's own angle unit. */
+function setAxisRotations(skeleton: AsfSkeleton, kin: JointKinematics[]): void {
   const asfAngle = angleScale(skeleton.angleUnit);
   kin.forEach((k, j) => {
     if (j === 0) {
@@ -327,10 +398,13 @@ export function parseAMC(text: string, asf: AsfSkeleton | string, options: AMCOp
     }
     k.cInv = quatConjugate(k.c);
   });
+}
 
+/** Forward kinematics: frames × joints × 3 positions in metres (see the header comment). */
+function amcPositions(skeleton: AsfSkeleton, kin: JointKinematics[], frameValues: Float64Array[], motionAngle: number): Float32Array {
+  const J = skeleton.joints.length;
   const frames = frameValues.length;
   const positions = new Float32Array(frames * J * 3);
-  const motionAngle = angleScale(angleUnit);
   const rootOrder = skeleton.root.order;
   const s = skeleton.lengthScale;
   const globals: Quat[] = new Array(J);
@@ -362,5 +436,5 @@ export function parseAMC(text: string, asf: AsfSkeleton | string, options: AMCOp
   for (let v = 0; v < positions.length; v++) {
     if (!Number.isFinite(positions[v])) throw new MotionFormatError('amc', 'joint positions overflow (values too large)');
   }
-  return { fps, frames, joints: skeleton.joints.slice(), parents: skeleton.parents.slice(), positions };
+  return positions;
 }

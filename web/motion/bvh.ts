@@ -72,103 +72,134 @@ function tokenizeHierarchy(lines: string[]): { toks: Token[]; motionLine: number
   return { toks, motionLine: -1 };
 }
 
-function parseHierarchy(lines: string[]): { nodes: BvhNode[]; channelCount: number; motionLine: number } {
-  const { toks, motionLine } = tokenizeHierarchy(lines);
-  const nodes: BvhNode[] = [];
-  let pos = 0;
-  let channelCount = 0;
-  const lastLine = lines.length;
+/** The nodes read so far, in depth-first order, and the channel count of a frame line. */
+interface BvhHierarchy {
+  nodes: BvhNode[];
+  channelCount: number;
+}
 
-  const peek = (): Token | undefined => toks[pos];
-  const next = (expected: string): Token => {
-    const t = toks[pos++];
-    if (!t) throw new MotionFormatError('bvh', `unexpected end of file, expected ${expected} (file truncated?)`, motionLine >= 0 ? motionLine + 1 : lastLine);
+/** The hierarchy tokens, read in order; running out of them throws "unexpected end of file". */
+class HierarchyCursor {
+  pos = 0;
+  /** @param endLine line reported when the tokens run out: the MOTION line, else the file's last line. */
+  constructor(private readonly toks: Token[], private readonly endLine: number) {}
+
+  peek(): Token | undefined {
+    return this.toks[this.pos];
+  }
+
+  next(expected: string): Token {
+    const t = this.toks[this.pos++];
+    if (!t) throw new MotionFormatError('bvh', `unexpected end of file, expected ${expected} (file truncated?)`, this.endLine);
     return t;
-  };
-  const expect = (word: string): Token => {
-    const t = next(`"${word}"`);
+  }
+
+  expect(word: string): Token {
+    const t = this.next(`"${word}"`);
     if (t.text !== word) throw new MotionFormatError('bvh', `expected "${word}", found "${t.text}"`, t.line);
     return t;
-  };
-  const number = (what: string): number => {
-    const t = next(what);
-    return parseNumber(t.text, 'bvh', t.line, what);
-  };
+  }
 
-  // Reads "NAME {" (name may contain spaces); the '{' must follow on the same or a later line.
-  const readName = (keywordLine: number): string => {
+  number(what: string): number {
+    const t = this.next(what);
+    return parseNumber(t.text, 'bvh', t.line, what);
+  }
+
+  offset(): Vec3 {
+    return [this.number('an OFFSET x value'), this.number('an OFFSET y value'), this.number('an OFFSET z value')];
+  }
+
+  /** Reads "NAME {" (name may contain spaces); the '{' must follow on the same or a later line. */
+  name(keywordLine: number): string {
     const parts: string[] = [];
-    while (peek() && peek()!.text !== '{' && peek()!.line === keywordLine) parts.push(next('a name').text);
+    while (this.peek() && this.peek()!.text !== '{' && this.peek()!.line === keywordLine) parts.push(this.next('a name').text);
     if (parts.length === 0) throw new MotionFormatError('bvh', 'expected a joint name', keywordLine);
     return parts.join(' ');
-  };
+  }
+}
 
-  const parseJoint = (name: string, parent: number, depth: number, openLine: number): void => {
-    if (depth > MAX_DEPTH) throw new MotionFormatError('bvh', `hierarchy nested deeper than ${MAX_DEPTH} joints`, openLine);
-    const index = nodes.length;
-    const node: BvhNode = { name, parent, offset: [0, 0, 0], channels: [], firstChannel: channelCount, endSite: false };
-    nodes.push(node);
-    expect('{');
-    let sawOffset = false;
-    let sawChannels = false;
-    for (;;) {
-      const t = next(`"}" closing joint "${name}" (opened at line ${openLine})`);
-      if (t.text === '}') break;
-      if (t.text === 'OFFSET') {
-        node.offset = [number('an OFFSET x value'), number('an OFFSET y value'), number('an OFFSET z value')];
-        sawOffset = true;
-      } else if (t.text === 'CHANNELS') {
-        if (sawChannels) throw new MotionFormatError('bvh', `joint "${name}" has two CHANNELS lines`, t.line);
-        const countTok = next('a channel count');
-        const count = parseNumber(countTok.text, 'bvh', countTok.line, 'a channel count');
-        if (!Number.isInteger(count) || count < 0 || count > 6) {
-          throw new MotionFormatError('bvh', `expected a channel count from 0 to 6, found ${countTok.text}`, countTok.line);
-        }
-        for (let c = 0; c < count; c++) {
-          const ch = next(`${count} channel names`);
-          if (!CHANNELS.has(ch.text)) {
-            throw new MotionFormatError('bvh', `joint "${name}" declares ${count} channels but "${ch.text}" is not a channel name (Xposition … Zrotation)`, ch.line);
-          }
-          node.channels.push(ch.text as Channel);
-        }
-        if (peek() && peek()!.line === countTok.line && CHANNELS.has(peek()!.text)) {
-          throw new MotionFormatError('bvh', `joint "${name}" declares ${count} channels but lists more`, countTok.line);
-        }
-        channelCount += count;
-        sawChannels = true;
-      } else if (t.text === 'JOINT') {
-        if (!sawOffset) throw new MotionFormatError('bvh', `joint "${name}" has no OFFSET before its children`, t.line);
-        parseJoint(readName(t.line), index, depth + 1, t.line);
-      } else if (t.text === 'End') {
-        const site = next('"Site"');
-        if (site.text !== 'Site') throw new MotionFormatError('bvh', `expected "End Site", found "End ${site.text}"`, site.line);
-        expect('{');
-        expect('OFFSET');
-        const offset: Vec3 = [number('an OFFSET x value'), number('an OFFSET y value'), number('an OFFSET z value')];
-        expect('}');
-        nodes.push({ name: `${name}_end`, parent: index, offset, channels: [], firstChannel: channelCount, endSite: true });
-      } else {
-        throw new MotionFormatError('bvh', `unexpected "${t.text}" in joint "${name}" (expected OFFSET, CHANNELS, JOINT, End Site or "}")`, t.line);
-      }
-    }
-    if (!sawOffset) throw new MotionFormatError('bvh', `joint "${name}" has no OFFSET`, openLine);
-    if (!sawChannels) throw new MotionFormatError('bvh', `joint "${name}" has no CHANNELS line`, openLine);
-  };
-
+function parseHierarchy(lines: string[]): BvhHierarchy & { motionLine: number } {
+  const { toks, motionLine } = tokenizeHierarchy(lines);
   if (toks.length === 0 || toks[0].text !== 'HIERARCHY') {
     throw new MotionFormatError('bvh', `expected "HIERARCHY" at the start, found "${toks[0]?.text ?? (motionLine >= 0 ? 'MOTION' : '')}"`, toks[0]?.line ?? 1);
   }
-  pos = 1;
-  const root = next('"ROOT"');
+  const cursor = new HierarchyCursor(toks, motionLine >= 0 ? motionLine + 1 : lines.length);
+  cursor.pos = 1;
+  const root = cursor.next('"ROOT"');
   if (root.text !== 'ROOT') throw new MotionFormatError('bvh', `expected "ROOT", found "${root.text}"`, root.line);
-  parseJoint(readName(root.line), -1, 0, root.line);
-  if (pos < toks.length) {
-    const t = toks[pos];
+  const hierarchy: BvhHierarchy = { nodes: [], channelCount: 0 };
+  parseJoint(cursor, hierarchy, cursor.name(root.line), -1, 0, root.line);
+  if (cursor.pos < toks.length) {
+    const t = toks[cursor.pos];
     const what = t.text === 'ROOT' ? 'a second ROOT (only one skeleton per file is supported)' : `"${t.text}"`;
     throw new MotionFormatError('bvh', `expected "MOTION" after the hierarchy, found ${what}`, t.line);
   }
-  if (motionLine < 0) throw new MotionFormatError('bvh', 'expected a "MOTION" section after the hierarchy (file truncated?)', lastLine);
-  return { nodes, channelCount, motionLine };
+  if (motionLine < 0) throw new MotionFormatError('bvh', 'expected a "MOTION" section after the hierarchy (file truncated?)', lines.length);
+  return { ...hierarchy, motionLine };
+}
+
+/** Reads a joint's "{ … }" block, its children and End Site included, appending nodes depth first. */
+function parseJoint(
+  cursor: HierarchyCursor, hierarchy: BvhHierarchy, name: string, parent: number, depth: number, openLine: number,
+): void {
+  if (depth > MAX_DEPTH) throw new MotionFormatError('bvh', `hierarchy nested deeper than ${MAX_DEPTH} joints`, openLine);
+  const { nodes } = hierarchy;
+  const index = nodes.length;
+  const node: BvhNode = { name, parent, offset: [0, 0, 0], channels: [], firstChannel: hierarchy.channelCount, endSite: false };
+  nodes.push(node);
+  cursor.expect('{');
+  let sawOffset = false;
+  let sawChannels = false;
+  for (;;) {
+    const t = cursor.next(`"}" closing joint "${name}" (opened at line ${openLine})`);
+    if (t.text === '}') break;
+    if (t.text === 'OFFSET') {
+      node.offset = cursor.offset();
+      sawOffset = true;
+    } else if (t.text === 'CHANNELS') {
+      if (sawChannels) throw new MotionFormatError('bvh', `joint "${name}" has two CHANNELS lines`, t.line);
+      node.channels = readChannels(cursor, name);
+      hierarchy.channelCount += node.channels.length;
+      sawChannels = true;
+    } else if (t.text === 'JOINT') {
+      if (!sawOffset) throw new MotionFormatError('bvh', `joint "${name}" has no OFFSET before its children`, t.line);
+      parseJoint(cursor, hierarchy, cursor.name(t.line), index, depth + 1, t.line);
+    } else if (t.text === 'End') {
+      const site = cursor.next('"Site"');
+      if (site.text !== 'Site') throw new MotionFormatError('bvh', `expected "End Site", found "End ${site.text}"`, site.line);
+      cursor.expect('{');
+      cursor.expect('OFFSET');
+      const offset = cursor.offset();
+      cursor.expect('}');
+      nodes.push({ name: `${name}_end`, parent: index, offset, channels: [], firstChannel: hierarchy.channelCount, endSite: true });
+    } else {
+      throw new MotionFormatError('bvh', `unexpected "${t.text}" in joint "${name}" (expected OFFSET, CHANNELS, JOINT, End Site or "}")`, t.line);
+    }
+  }
+  if (!sawOffset) throw new MotionFormatError('bvh', `joint "${name}" has no OFFSET`, openLine);
+  if (!sawChannels) throw new MotionFormatError('bvh', `joint "${name}" has no CHANNELS line`, openLine);
+}
+
+/** The rest of a "CHANNELS n name…" line, after the keyword: exactly n channel names. */
+function readChannels(cursor: HierarchyCursor, jointName: string): Channel[] {
+  const countTok = cursor.next('a channel count');
+  const count = parseNumber(countTok.text, 'bvh', countTok.line, 'a channel count');
+  if (!Number.isInteger(count) || count < 0 || count > 6) {
+    throw new MotionFormatError('bvh', `expected a channel count from 0 to 6, found ${countTok.text}`, countTok.line);
+  }
+  const channels: Channel[] = [];
+  for (let c = 0; c < count; c++) {
+    const ch = cursor.next(`${count} channel names`);
+    if (!CHANNELS.has(ch.text)) {
+      throw new MotionFormatError('bvh', `joint "${jointName}" declares ${count} channels but "${ch.text}" is not a channel name (Xposition … Zrotation)`, ch.line);
+    }
+    channels.push(ch.text as Channel);
+  }
+  const after = cursor.peek();
+  if (after && after.line === countTok.line && CHANNELS.has(after.text)) {
+    throw new MotionFormatError('bvh', `joint "${jointName}" declares ${count} channels but lists more`, countTok.line);
+  }
+  return channels;
 }
 
 /** Rest-pose joint positions (all rotations zero), in file units. */
@@ -210,62 +241,24 @@ export function parseBVH(text: string, options: BVHOptions = {}): Motion {
   checkText(text, 'bvh');
   const lines = splitLines(text);
   const { nodes, channelCount, motionLine } = parseHierarchy(lines);
-
-  // Header of the MOTION section (skip blank lines between the entries).
-  let i = motionLine + 1;
-  const skipBlank = () => {
-    while (i < lines.length && lines[i].trim() === '') i++;
-  };
-  skipBlank();
-  const framesTok = headerValue(lines[i], i + 1, ['Frames']);
-  const frames = parseNumber(framesTok, 'bvh', i + 1, 'a frame count');
-  if (!Number.isInteger(frames) || frames < 1) throw new MotionFormatError('bvh', `expected a positive whole frame count, found ${framesTok}`, i + 1);
-  if (frames > MAX_FRAMES) throw new MotionFormatError('bvh', `declares ${frames} frames; at most ${MAX_FRAMES} are supported`, i + 1);
-  if (frames * channelCount > MAX_VALUES) {
-    throw new MotionFormatError('bvh', `declares ${frames} frames × ${channelCount} channels = ${frames * channelCount} values; at most ${MAX_VALUES} are supported`, i + 1);
-  }
-  const framesLine = i + 1;
-  i++;
-  skipBlank();
-  const frameTime = parseNumber(headerValue(lines[i], i + 1, ['Frame', 'Time']), 'bvh', i + 1, 'a frame time in seconds');
-  if (!(frameTime > 0 && frameTime < 10)) throw new MotionFormatError('bvh', `expected a positive frame time in seconds, found ${frameTime}`, i + 1);
-  i++;
-  let fps = 1 / frameTime;
-  if (Math.abs(fps - Math.round(fps)) < 1e-3 * fps) fps = Math.round(fps);
+  const { frames, fps, framesLine, firstFrameLine } = readMotionHeader(lines, motionLine, channelCount);
 
   let unitScale = options.unitScale;
   if (unitScale === undefined) unitScale = detectBVHUnitScale(nodes);
   if (!(unitScale > 0 && Number.isFinite(unitScale))) throw new Error(`parseBVH: unitScale must be a positive number, got ${unitScale}`);
 
-  // Kept joints and their parents (nearest kept ancestor).
-  const keptIndex = new Int32Array(nodes.length).fill(-1);
-  const joints: string[] = [];
-  const parents: number[] = [];
-  const keptNodes: number[] = [];
-  const nearestKept = new Int32Array(nodes.length).fill(-1);
-  nodes.forEach((n, k) => {
-    const zero = n.offset[0] === 0 && n.offset[1] === 0 && n.offset[2] === 0;
-    const hasPosition = n.channels.some((c) => c.endsWith('position'));
-    const keep = n.parent < 0 || !zero || hasPosition;
-    if (keep) {
-      keptIndex[k] = joints.length;
-      joints.push(n.name);
-      parents.push(n.parent < 0 ? -1 : nearestKept[n.parent]);
-      keptNodes.push(k);
-    }
-    nearestKept[k] = keep ? keptIndex[k] : nearestKept[n.parent];
-  });
+  const { joints, parents, keptNodes } = keptJoints(nodes);
   const J = joints.length;
 
   // Allocate for the frame lines actually present, so a bogus "Frames:" cannot reserve memory.
   let frameLines = 0;
-  for (let k = i; k < lines.length; k++) if (lines[k].trim() !== '') frameLines++;
+  for (let k = firstFrameLine; k < lines.length; k++) if (lines[k].trim() !== '') frameLines++;
   const positions = new Float32Array(Math.min(frames, frameLines) * J * 3);
   const globals: Quat[] = new Array(nodes.length);
   const world: Vec3[] = new Array(nodes.length);
   const values = new Float64Array(channelCount);
   let frame = 0;
-  for (; i < lines.length; i++) {
+  for (let i = firstFrameLine; i < lines.length; i++) {
     const parts = tokens(lines[i]);
     if (parts.length === 0) continue;
     if (frame >= frames) {
@@ -275,38 +268,7 @@ export function parseBVH(text: string, options: BVHOptions = {}): Motion {
       throw new MotionFormatError('bvh', `expected ${channelCount} numbers per frame, found ${parts.length}`, i + 1);
     }
     for (let c = 0; c < channelCount; c++) values[c] = parseNumber(parts[c], 'bvh', i + 1);
-
-    for (let k = 0; k < nodes.length; k++) {
-      const n = nodes[k];
-      let local: Vec3 = n.parent < 0 ? [n.offset[0], n.offset[1], n.offset[2]] : n.offset;
-      let rot = quatIdentity();
-      let hasPosition = false;
-      const posChannels: Vec3 = [0, 0, 0];
-      for (let c = 0; c < n.channels.length; c++) {
-        const ch = n.channels[c];
-        const v = values[n.firstChannel + c];
-        const axis = ch.charCodeAt(0) - 88; // 'X' → 0, 'Y' → 1, 'Z' → 2
-        if (ch.endsWith('rotation')) {
-          rot = quatMultiply(rot, quatAboutAxis(AXIS_NAMES[axis], v * DEG));
-        } else {
-          posChannels[axis] = v;
-          hasPosition = true;
-        }
-      }
-      if (hasPosition) {
-        local = n.parent < 0 ? [local[0] + posChannels[0], local[1] + posChannels[1], local[2] + posChannels[2]] : posChannels;
-      }
-      if (n.parent < 0) {
-        globals[k] = rot;
-        world[k] = local;
-      } else {
-        const pg = globals[n.parent];
-        const o = quatRotate(pg, local);
-        const pw = world[n.parent];
-        world[k] = [pw[0] + o[0], pw[1] + o[1], pw[2] + o[2]];
-        globals[k] = quatMultiply(pg, rot);
-      }
-    }
+    poseNodes(nodes, values, globals, world);
     const base = frame * J * 3;
     for (let j = 0; j < J; j++) {
       const w = world[keptNodes[j]];
@@ -325,6 +287,90 @@ export function parseBVH(text: string, options: BVHOptions = {}): Motion {
   return { fps, frames, joints, parents, positions };
 }
 
+/**
+ * The "Frames:" and "Frame Time:" lines after MOTION (blank lines between them are skipped): the frame
+ * count, fps, the 1-based line of "Frames:" and the 0-based index of the line after "Frame Time:".
+ */
+function readMotionHeader(lines: string[], motionLine: number, channelCount: number): { frames: number; fps: number; framesLine: number; firstFrameLine: number } {
+  let i = motionLine + 1;
+  const skipBlank = () => {
+    while (i < lines.length && lines[i].trim() === '') i++;
+  };
+  skipBlank();
+  const framesTok = headerValue(lines[i], i + 1, ['Frames']);
+  const frames = parseNumber(framesTok, 'bvh', i + 1, 'a frame count');
+  if (!Number.isInteger(frames) || frames < 1) throw new MotionFormatError('bvh', `expected a positive whole frame count, found ${framesTok}`, i + 1);
+  if (frames > MAX_FRAMES) throw new MotionFormatError('bvh', `declares ${frames} frames; at most ${MAX_FRAMES} are supported`, i + 1);
+  if (frames * channelCount > MAX_VALUES) {
+    throw new MotionFormatError('bvh', `declares ${frames} frames × ${channelCount} channels = ${frames * channelCount} values; at most ${MAX_VALUES} are supported`, i + 1);
+  }
+  const framesLine = i + 1;
+  i++;
+  skipBlank();
+  const frameTime = parseNumber(headerValue(lines[i], i + 1, ['Frame', 'Time']), 'bvh', i + 1, 'a frame time in seconds');
+  if (!(frameTime > 0 && frameTime < 10)) throw new MotionFormatError('bvh', `expected a positive frame time in seconds, found ${frameTime}`, i + 1);
+  let fps = 1 / frameTime;
+  if (Math.abs(fps - Math.round(fps)) < 1e-3 * fps) fps = Math.round(fps);
+  return { frames, fps, framesLine, firstFrameLine: i + 1 };
+}
+
+/** The Motion's joints: nodes other than zero-offset ones without position channels; parent = nearest kept ancestor. */
+function keptJoints(nodes: BvhNode[]): { joints: string[]; parents: number[]; keptNodes: number[] } {
+  const keptIndex = new Int32Array(nodes.length).fill(-1);
+  const joints: string[] = [];
+  const parents: number[] = [];
+  const keptNodes: number[] = [];
+  const nearestKept = new Int32Array(nodes.length).fill(-1);
+  nodes.forEach((n, k) => {
+    const zero = n.offset[0] === 0 && n.offset[1] === 0 && n.offset[2] === 0;
+    const hasPosition = n.channels.some((c) => c.endsWith('position'));
+    const keep = n.parent < 0 || !zero || hasPosition;
+    if (keep) {
+      keptIndex[k] = joints.length;
+      joints.push(n.name);
+      parents.push(n.parent < 0 ? -1 : nearestKept[n.parent]);
+      keptNodes.push(k);
+    }
+    nearestKept[k] = keep ? keptIndex[k] : nearestKept[n.parent];
+  });
+  return { joints, parents, keptNodes };
+}
+
+/** One frame's channel values → every node's global rotation and world position (file units). */
+function poseNodes(nodes: BvhNode[], values: Float64Array, globals: Quat[], world: Vec3[]): void {
+  for (let k = 0; k < nodes.length; k++) {
+    const n = nodes[k];
+    let local: Vec3 = n.parent < 0 ? [n.offset[0], n.offset[1], n.offset[2]] : n.offset;
+    let rot = quatIdentity();
+    let hasPosition = false;
+    const posChannels: Vec3 = [0, 0, 0];
+    for (let c = 0; c < n.channels.length; c++) {
+      const ch = n.channels[c];
+      const v = values[n.firstChannel + c];
+      const axis = ch.charCodeAt(0) - 88; // 'X' → 0, 'Y' → 1, 'Z' → 2
+      if (ch.endsWith('rotation')) {
+        rot = quatMultiply(rot, quatAboutAxis(AXIS_NAMES[axis], v * DEG));
+      } else {
+        posChannels[axis] = v;
+        hasPosition = true;
+      }
+    }
+    if (hasPosition) {
+      local = n.parent < 0 ? [local[0] + posChannels[0], local[1] + posChannels[1], local[2] + posChannels[2]] : posChannels;
+    }
+    if (n.parent < 0) {
+      globals[k] = rot;
+      world[k] = local;
+    } else {
+      const pg = globals[n.parent];
+      const o = quatRotate(pg, local);
+      const pw = world[n.parent];
+      world[k] = [pw[0] + o[0], pw[1] + o[1], pw[2] + o[2]];
+      globals[k] = quatMultiply(pg, rot);
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Export
 
@@ -339,28 +385,57 @@ function fmt(v: number): string {
 
 type ExportNode = { kind: 'joint'; joint: number } | { kind: 'helper'; joint: number; child: number };
 
+/** A validated Motion as the exporter reads it, with each joint's children in index order. */
+interface ExportClip {
+  frames: number;
+  joints: string[];
+  parents: number[];
+  positions: Float32Array;
+  children: number[][];
+}
+
 /** Positions-only Motion → BVH text (centimetres, y up, ZYX Euler channels in degrees). */
 export function exportBVH(motion: Motion): string {
   const m = validateMotion(motion);
-  const { frames: F, joints, parents, positions: P } = m;
-  const J = joints.length;
-  const at = (f: number, j: number): Vec3 => {
-    const b = (f * J + j) * 3;
-    return [P[b], P[b + 1], P[b + 2]];
-  };
-  const boneVector = (f: number, j: number): Vec3 => {
-    const a = at(f, parents[j]);
-    const b = at(f, j);
-    return [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-  };
-  const children: number[][] = joints.map(() => []);
-  for (let j = 1; j < J; j++) children[parents[j]].push(j);
+  const children: number[][] = m.joints.map(() => []);
+  for (let j = 1; j < m.joints.length; j++) children[m.parents[j]].push(j);
+  const clip: ExportClip = { frames: m.frames, joints: m.joints, parents: m.parents, positions: m.positions, children };
 
-  // Rest pose: bone directions from the tallest frame (keeps unit detection on re-import reliable
-  // even if the clip starts crouched), lengths averaged over all frames.
+  const rest = restBones(clip);
+  const framePair = rotationPairs(clip, rest);
+  const out: string[] = ['HIERARCHY'];
+  const order = writeHierarchy(clip, rest, out);
+  out.push('MOTION', `Frames: ${clip.frames}`, `Frame Time: ${(1 / m.fps).toPrecision(10)}`);
+
+  const jointGlobal: Quat[] = new Array(clip.joints.length);
+  const helperGlobal: Quat[] = new Array(clip.joints.length); // indexed by child joint
+  for (let f = 0; f < clip.frames; f++) {
+    solveGlobalRotations(clip, rest, framePair, f, jointGlobal, helperGlobal);
+    out.push(frameLine(clip, f, order, jointGlobal, helperGlobal));
+  }
+  return out.join('\n') + '\n';
+}
+
+function jointAt(clip: ExportClip, f: number, j: number): Vec3 {
+  const P = clip.positions;
+  const b = (f * clip.joints.length + j) * 3;
+  return [P[b], P[b + 1], P[b + 2]];
+}
+
+/** Joint j's position minus its parent's in frame f. */
+function boneVector(clip: ExportClip, f: number, j: number): Vec3 {
+  const a = jointAt(clip, f, clip.parents[j]);
+  const b = jointAt(clip, f, j);
+  return [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+}
+
+/** The frame with the largest y extent (the first of equals). */
+function tallestFrame(clip: ExportClip): number {
+  const P = clip.positions;
+  const J = clip.joints.length;
   let restFrame = 0;
   let tallest = -Infinity;
-  for (let f = 0; f < F; f++) {
+  for (let f = 0; f < clip.frames; f++) {
     let lo = Infinity;
     let hi = -Infinity;
     for (let j = 0; j < J; j++) {
@@ -373,21 +448,36 @@ export function exportBVH(motion: Motion): string {
       restFrame = f;
     }
   }
-  const rest: Vec3[] = joints.map(() => [0, 0, 0]);
-  for (let j = 1; j < J; j++) {
+  return restFrame;
+}
+
+/**
+ * Rest bone of each joint (metres; zero for the root): direction from the tallest frame (keeps unit
+ * detection on re-import reliable even if the clip starts crouched), length averaged over all frames.
+ */
+function restBones(clip: ExportClip): Vec3[] {
+  const F = clip.frames;
+  const restFrame = tallestFrame(clip);
+  const rest: Vec3[] = clip.joints.map(() => [0, 0, 0]);
+  for (let j = 1; j < clip.joints.length; j++) {
     let mean = 0;
-    for (let f = 0; f < F; f++) mean += length(boneVector(f, j));
+    for (let f = 0; f < F; f++) mean += length(boneVector(clip, f, j));
     mean /= F;
-    let dir = normalize(boneVector(restFrame, j));
-    for (let f = 0; length(dir) === 0 && f < F; f++) dir = normalize(boneVector(f, j));
+    let dir = normalize(boneVector(clip, restFrame, j));
+    for (let f = 0; length(dir) === 0 && f < F; f++) dir = normalize(boneVector(clip, f, j));
     if (length(dir) === 0) dir = [0, 1, 0];
     const len = mean > TINY_BONE ? mean : TINY_BONE;
     rest[j] = [dir[0] * len, dir[1] * len, dir[2] * len];
   }
+  return rest;
+}
 
-  // For joints with several children, the pair of children whose rest bones are least parallel
-  // defines the joint's own rotation.
-  const framePair: Array<[number, number] | undefined> = children.map((kids) => {
+/**
+ * For joints with several children, the pair of children whose rest bones are least parallel
+ * defines the joint's own rotation; undefined where no pair is far enough from parallel.
+ */
+function rotationPairs(clip: ExportClip, rest: Vec3[]): Array<[number, number] | undefined> {
+  return clip.children.map((kids) => {
     let best: [number, number] | undefined;
     let bestSin = 1e-3;
     for (let a = 0; a < kids.length; a++) {
@@ -401,10 +491,12 @@ export function exportBVH(motion: Motion): string {
     }
     return best;
   });
+}
 
-  // Hierarchy, depth first; children in index order.
+/** Appends the HIERARCHY lines to `out`, depth first, children in index order; returns the BVH nodes in channel order. */
+function writeHierarchy(clip: ExportClip, rest: Vec3[], out: string[]): ExportNode[] {
+  const { joints, parents, children } = clip;
   const order: ExportNode[] = [];
-  const out: string[] = ['HIERARCHY'];
   const writeJoint = (j: number, offset: Vec3, indent: string): void => {
     const isRoot = parents[j] < 0;
     out.push(`${indent}${isRoot ? 'ROOT' : 'JOINT'} ${joints[j]}`, `${indent}{`);
@@ -429,52 +521,59 @@ export function exportBVH(motion: Motion): string {
     out.push(`${indent}}`);
   };
   writeJoint(0, [0, 0, 0], '');
-  out.push('MOTION', `Frames: ${F}`, `Frame Time: ${(1 / m.fps).toPrecision(10)}`);
+  return order;
+}
 
-  const jointGlobal: Quat[] = new Array(J);
-  const helperGlobal: Quat[] = new Array(J); // indexed by child joint
+/** Global rotation of the BVH node directly above joint j: identity, j's helper joint, or j's parent. */
+function parentNodeGlobal(clip: ExportClip, j: number, jointGlobal: Quat[], helperGlobal: Quat[]): Quat {
+  const p = clip.parents[j];
+  return p < 0 ? quatIdentity() : clip.children[p].length > 1 ? helperGlobal[j] : jointGlobal[p];
+}
+
+/**
+ * Frame f's global rotations, parents first. A joint's rotation aims its child bone(s); it starts from
+ * the rotation of the BVH node above it, so local rotations stay small and twist-free.
+ */
+function solveGlobalRotations(
+  clip: ExportClip, rest: Vec3[], framePair: Array<[number, number] | undefined>, f: number, jointGlobal: Quat[], helperGlobal: Quat[],
+): void {
+  for (let j = 0; j < clip.joints.length; j++) {
+    const base = parentNodeGlobal(clip, j, jointGlobal, helperGlobal);
+    const kids = clip.children[j];
+    const current = kids.map((c) => boneVector(clip, f, c));
+    let g = base;
+    if (kids.length === 1) {
+      g = quatMultiply(swingRotation(quatRotate(base, rest[kids[0]]), current[0]), base);
+    } else if (kids.length > 1) {
+      const pair = framePair[j];
+      if (pair) {
+        const [a, b] = pair;
+        g = rotationFromTwoVectors(rest[a], rest[b], boneVector(clip, f, a), boneVector(clip, f, b)) ?? base;
+      }
+      kids.forEach((c, k) => {
+        helperGlobal[c] = quatMultiply(swingRotation(quatRotate(g, rest[c]), current[k]), g);
+      });
+    }
+    jointGlobal[j] = g;
+  }
+}
+
+/** Frame f's motion line: root position (cm), then each node's local rotation as Z Y X degrees. */
+function frameLine(clip: ExportClip, f: number, order: ExportNode[], jointGlobal: Quat[], helperGlobal: Quat[]): string {
   const line: string[] = [];
   const euler = (q: Quat) => {
     const [z, y, x] = quatToEulerZYX(q);
     line.push(fmt(z / DEG), fmt(y / DEG), fmt(x / DEG));
   };
-  for (let f = 0; f < F; f++) {
-    // Global rotations, parents first. A joint's rotation aims its child bone(s); it starts from
-    // the rotation of the BVH node above it, so local rotations stay small and twist-free.
-    for (let j = 0; j < J; j++) {
-      const p = parents[j];
-      const base: Quat = p < 0 ? quatIdentity() : children[p].length > 1 ? helperGlobal[j] : jointGlobal[p];
-      const kids = children[j];
-      const current = kids.map((c) => boneVector(f, c));
-      let g = base;
-      if (kids.length === 1) {
-        g = quatMultiply(swingRotation(quatRotate(base, rest[kids[0]]), current[0]), base);
-      } else if (kids.length > 1) {
-        const pair = framePair[j];
-        if (pair) {
-          const [a, b] = pair;
-          g = rotationFromTwoVectors(rest[a], rest[b], boneVector(f, a), boneVector(f, b)) ?? base;
-        }
-        kids.forEach((c, k) => {
-          helperGlobal[c] = quatMultiply(swingRotation(quatRotate(g, rest[c]), current[k]), g);
-        });
-      }
-      jointGlobal[j] = g;
+  const root = jointAt(clip, f, 0);
+  line.push(fmt(root[0] * CM_PER_M), fmt(root[1] * CM_PER_M), fmt(root[2] * CM_PER_M));
+  for (const node of order) {
+    if (node.kind === 'helper') {
+      euler(quatMultiply(quatConjugate(jointGlobal[node.joint]), helperGlobal[node.child]));
+    } else {
+      const j = node.joint;
+      euler(quatMultiply(quatConjugate(parentNodeGlobal(clip, j, jointGlobal, helperGlobal)), jointGlobal[j]));
     }
-    line.length = 0;
-    const root = at(f, 0);
-    line.push(fmt(root[0] * CM_PER_M), fmt(root[1] * CM_PER_M), fmt(root[2] * CM_PER_M));
-    for (const node of order) {
-      if (node.kind === 'helper') {
-        euler(quatMultiply(quatConjugate(jointGlobal[node.joint]), helperGlobal[node.child]));
-      } else {
-        const j = node.joint;
-        const p = parents[j];
-        const parentGlobal = p < 0 ? quatIdentity() : children[p].length > 1 ? helperGlobal[j] : jointGlobal[p];
-        euler(quatMultiply(quatConjugate(parentGlobal), jointGlobal[j]));
-      }
-    }
-    out.push(line.join(' '));
   }
-  return out.join('\n') + '\n';
+  return line.join(' ');
 }
