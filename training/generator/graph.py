@@ -13,8 +13,6 @@ from ..onnx.sessions import cpu_session
 
 INPUTS, OUTPUTS = ["x", "h", "c"], ["weights", "mu", "sigma", "h_out", "c_out"]
 PARITY_TOLERANCE = 1e-4
-
-
 GATE_ORDER = [0, 1, 3, 2]  # the graph's gate blocks (i, f, o, g) from PyTorch's (i, f, g, o): one Sigmoid covers i, f, o
 
 
