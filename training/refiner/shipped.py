@@ -37,7 +37,8 @@ class ShippedRefiner:
         h = np.zeros((1, b, self.hidden), np.float32)
         c = h.copy()
         out = np.zeros_like(x)
-        for k in range(t):
-            out[:, k], h, c = self.session.run(None, {"x": x[:, k], "ends": q[:, k], "ends_prev": q_prev, "h": h, "c": c})
+        for k in range(t):  # one frame per call: the graph takes (B, frames, .) chunks
+            y, h, c = self.session.run(None, {"x": x[:, k:k + 1], "ends": q[:, k:k + 1], "ends_prev": q_prev, "h": h, "c": c})
+            out[:, k] = y[:, 0]
             q_prev = q[:, k]
         return out * self.std + self.mean
