@@ -15,21 +15,34 @@ const SECONDS = Number(process.env.BENCH_SECONDS ?? 5);
 const WARMUP_SECONDS = Number(process.env.BENCH_WARMUP ?? 4);
 const VIEWPORT = { width: 1280, height: 720 };
 
-/** Display frame timing in the page: rAF intervals over `seconds`. */
-async function measureFrames(page, seconds) {
-  const t = await page.evaluate(
-    (ms) =>
+/**
+ * Display frame timing in the page: rAF intervals over `seconds`. With `clock`, also the playback
+ * clock's rate against the page's clock: playback seconds advanced per second (unwrapped at the loop
+ * point, times the speed's inverse; 1 = real time), sampled at every display frame.
+ */
+async function measureFrames(page, seconds, { clock = false } = {}) {
+  const { stamps: t, playback } = await page.evaluate(
+    ({ ms, clock }) =>
       new Promise((resolve) => {
         const stamps = [];
         const start = performance.now();
+        let advanced = 0, last = null, first = null, end = null;
         const step = (now) => {
           stamps.push(now);
+          if (clock) {
+            const s = window.playground.state();
+            const duration = s.frames > 1 ? (s.frames - 1) / s.fps : 0;
+            if (last) advanced += (s.time >= last.time ? s.time - last.time : s.time + duration - last.time) / s.speed;
+            last = s;
+            first ??= now;
+            end = now;
+          }
           if (now - start < ms) requestAnimationFrame(step);
-          else resolve(stamps);
+          else resolve({ stamps, playback: clock ? advanced / ((end - first) / 1000) : undefined });
         };
         requestAnimationFrame(step);
       }),
-    seconds * 1000,
+    { ms: seconds * 1000, clock },
   );
   const dts = [];
   for (let i = 1; i < t.length; i++) dts.push(t[i] - t[i - 1]);
@@ -45,6 +58,7 @@ async function measureFrames(page, seconds) {
     p99_frame_ms: +pct(99).toFixed(2),
     max_frame_ms: +sorted[sorted.length - 1].toFixed(2),
     long_frames: dts.filter((d) => d > 25).length, // > 1.5 refresh intervals at 60 Hz
+    ...(clock ? { playback_rate: +playback.toFixed(3), target_playback_rate: 1 } : {}),
   };
 }
 
@@ -62,7 +76,7 @@ async function playbackBenchmark(ctx, query) {
       { amc, asf },
     );
     await page.waitForTimeout(WARMUP_SECONDS * 1000);
-    const frames = await measureFrames(page, SECONDS);
+    const frames = await measureFrames(page, SECONDS, { clock: true });
     const state = await page.evaluate(() => window.playground.state());
     const stats = await page.evaluate(() => window.playground.stats());
     if (!state.playing) throw new Error('clip stopped playing during the benchmark');
@@ -145,11 +159,13 @@ async function liveModeBenchmark(ctx, button, statusId) {
     const frames = await measureFrames(page, SECONDS);
     const f1 = await streamFrame();
     const stats = await page.evaluate(() => window.playground.stats());
+    const modelFps = await page.evaluate(() => window.playground.current().fps);
     return {
       viewport: `${VIEWPORT.width}x${VIEWPORT.height}`,
       ...frames,
       target_fps: 60,
       stream_frames_per_s: +((f1 - f0) / SECONDS).toFixed(1),
+      target_stream_frames_per_s: modelFps, // the stream keeps up with real time
       ...displayFields(stats, problems),
     };
   } finally {
@@ -293,6 +309,59 @@ async function liveControlBenchmark(ctx) {
   }
 }
 
+/**
+ * Steer mode's keys against the page's clock: ← held for about a second turns the target heading, ↑
+ * held for about half a second raises the target speed. The rates use the key events' own times in the
+ * page and the readout after the release (it refreshes every 100 ms).
+ */
+async function steerKeysBenchmark(ctx) {
+  const { context, page, problems } = await openPlayground(ctx.browser, ctx.url, VIEWPORT);
+  const readout = () =>
+    page.evaluate(
+      () =>
+        new Promise((resolve) => {
+          const el = document.getElementById('steer-readout');
+          const observer = new MutationObserver(() => {
+            observer.disconnect();
+            resolve({ heading: Number(el.dataset.targetHeading), speed: Number(el.dataset.targetSpeed) });
+          });
+          observer.observe(el, { attributes: true });
+        }),
+    );
+  /** Holds `key` for about `ms`; returns the seconds between its keydown and keyup in the page. */
+  const hold = async (key, ms) => {
+    await page.evaluate(() => {
+      window.keyTimes = {};
+      document.addEventListener('keydown', (e) => (window.keyTimes.down ??= e.timeStamp), { once: true });
+      document.addEventListener('keyup', (e) => (window.keyTimes.up = e.timeStamp), { once: true });
+    });
+    await page.keyboard.down(key);
+    await page.waitForTimeout(ms);
+    await page.keyboard.up(key);
+    const { down, up } = await page.evaluate(() => window.keyTimes);
+    return (up - down) / 1000;
+  };
+  try {
+    await page.click('#mode-steer');
+    await page.waitForFunction(() => Number(document.getElementById('steer-status').dataset.frame) > 15, null, { timeout: 120_000 });
+    const a = await readout();
+    const turnSeconds = await hold('ArrowLeft', 1000);
+    const b = await readout();
+    const speedSeconds = await hold('ArrowUp', 500);
+    const c = await readout();
+    const turn = Math.atan2(Math.sin(b.heading - a.heading), Math.cos(b.heading - a.heading));
+    return {
+      turn_deg_per_s: +((turn * 180) / Math.PI / turnSeconds).toFixed(1),
+      target_turn_deg_per_s: 90,
+      speed_change_m_per_s2: +((c.speed - b.speed) / speedSeconds).toFixed(2),
+      target_speed_change_m_per_s2: 1,
+      page_errors: problems.length,
+    };
+  } finally {
+    await context.close();
+  }
+}
+
 const OPTIMIZER_BENCHMARKS = [
   {
     name: 'path-follow',
@@ -345,6 +414,12 @@ export const BENCHMARKS = [
     description: 'Steer mode: live control streaming (no input: straight ahead at 1.2 m/s), default quality — target 60 fps',
     kind: 'live',
     run: (ctx) => liveModeBenchmark(ctx, '#mode-steer', 'steer-status'),
+  },
+  {
+    name: 'steer-keys',
+    description: 'Steer mode: ← held ~1 s and ↑ held ~0.5 s — targets: the heading turns 90°/s, the speed changes 1 m/s per second',
+    kind: 'keys',
+    run: steerKeysBenchmark,
   },
 ];
 
@@ -412,13 +487,19 @@ async function main() {
     if (b.kind === 'live') {
       console.log(
         `  ${b.name}: ${r.mean_fps} fps mean (target 60), p95 frame ${r.p95_frame_ms} ms, ${r.long_frames}/${r.frames} frames > 25 ms,` +
-          ` stream ${r.stream_frames_per_s} frames/s — ${r.quality} quality at pixel ratio ${r.pixel_ratio}\n    ${b.description}`,
+          ` stream ${r.stream_frames_per_s} frames/s (target ${r.target_stream_frames_per_s}) — ${r.quality} quality at pixel ratio ${r.pixel_ratio}\n    ${b.description}`,
+      );
+      continue;
+    }
+    if (b.kind === 'keys') {
+      console.log(
+        `  ${b.name}: turn ${r.turn_deg_per_s}°/s (target 90), speed ${r.speed_change_m_per_s2} m/s per second (target 1)\n    ${b.description}`,
       );
       continue;
     }
     console.log(
-      `  ${b.name}: ${r.mean_fps} fps mean, p95 frame ${r.p95_frame_ms} ms, ${r.long_frames}/${r.frames} frames > 25 ms` +
-        ` — ${r.quality} quality at pixel ratio ${r.pixel_ratio}, ${r.viewport}\n    ${b.description}`,
+      `  ${b.name}: ${r.mean_fps} fps mean, p95 frame ${r.p95_frame_ms} ms, ${r.long_frames}/${r.frames} frames > 25 ms,` +
+        ` playback ${r.playback_rate}× real time (target 1) — ${r.quality} quality at pixel ratio ${r.pixel_ratio}, ${r.viewport}\n    ${b.description}`,
     );
   }
   const renderer = results.find((x) => x.result.renderer)?.result.renderer;

@@ -5,18 +5,25 @@ import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
 import { describe, test } from 'node:test';
-import { openPlayground, ROOT, startServer, usePlayground } from './harness.mjs';
+import { openPlayground, ROOT, startServer, usePlayground, waitUntil } from './harness.mjs';
 
 const INFO = JSON.parse(readFileSync(path.join(ROOT, 'public', 'models', 'aclstm.json'), 'utf8'));
 const REFERENCE = JSON.parse(readFileSync(path.join(ROOT, 'tests', 'fixtures', 'aclstm_reference.json'), 'utf8'));
 const { joints: JOINTS, parents: PARENTS, offsets: OFFSETS } = INFO.skeleton;
 const J = JOINTS.length;
 const BONE = JOINTS.map((_, j) => Math.hypot(OFFSETS[3 * j], OFFSETS[3 * j + 1], OFFSETS[3 * j + 2]));
+/**
+ * The freeze line of the pose-change plot: 20 % of the real dance's median for the style
+ * (FREEZE_FRACTION in web/ui/poseChangePlot.ts). docs/models/aclstm.md: acLSTM from the first salsa seed
+ * motion ("salsa 10 @5.0s", the Dance mode's default) has its first frozen second at 34 s.
+ */
+const SALSA_FREEZE = 0.2 * INFO.real_pose_change.salsa;
 
 /** In-page: generate, then summarise (the positions stay in the page; only derived numbers come back). */
 function summarise(page, options) {
   return page.evaluate(
     async ({ options, parents, bone }) => {
+      const before = window.playground.current();
       const m = await window.playground.generate(options);
       const J = m.joints.length;
       const P = m.positions;
@@ -51,7 +58,7 @@ function summarise(page, options) {
         meanJointSpeed: (relMotion / ((m.frames - 1) * J)) * m.fps,
         rootY: [Math.min(...rootY), Math.max(...rootY)],
         contacts: m.contacts ? m.contacts.length : null,
-        shown: window.playground.current() !== null,
+        shownUnchanged: window.playground.current() === before,
       };
     },
     { options, parents: PARENTS, bone: BONE },
@@ -101,7 +108,7 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
       assert.ok(m.meanJointSpeed > 0.03, `the pose changes (mean joint speed relative to the root ${m.meanJointSpeed.toFixed(3)} m/s)`);
       assert.ok(m.rootY[0] > 0.2 && m.rootY[1] < 1.6, `root height within 0.2–1.6 m (${m.rootY.map((v) => v.toFixed(2)).join('–')})`);
       assert.equal(m.contacts, 240 * 2, 'foot contacts, detected from the positions');
-      assert.equal(m.shown, false, 'generate does not show the motion');
+      assert.equal(m.shownUnchanged, true, 'generate does not show the motion');
     });
   }
 
@@ -199,9 +206,15 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
   });
 
   test('Dance mode: streams, plots the pose change, switches style and model, exports BVH', async () => {
-    const clipFrames = await suite.page.evaluate(() => window.playground.current()?.frames);
+    // A clip to come back to.
+    const clipFrames = await suite.page.evaluate(async () => {
+      const m = await window.playground.generate({ model: 'aclstm', style: 'martial', frames: 45, seed: 0 });
+      window.playground.show(m, 'clip');
+      return window.playground.current().frames;
+    });
+    assert.equal(clipFrames, 45);
     await suite.page.click('#mode-dance');
-    await suite.page.waitForFunction(() => Number(document.getElementById('dance-status').dataset.frame) > 10, null, { timeout: 60_000 });
+    await waitUntil(suite.page, () => Number(document.getElementById('dance-status').dataset.frame) > 10, null, { timeout: 60_000, message: 'the dance starts' });
     const ui = await suite.page.evaluate(() => ({
       dance: document.body.classList.contains('dance-mode'),
       pressed: document.getElementById('mode-dance').getAttribute('aria-pressed'),
@@ -215,9 +228,9 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
     assert.deepEqual(ui.seeds, INFO.seeds.filter((s) => s.style === INFO.styles[0]).map((s) => s.name));
     assert.ok(ui.plotVisible);
 
-    // Frames advance in real time and the plot gains a point per second.
+    // Frames advance and the plot gains a point per second of them.
     const f1 = await status(suite.page);
-    await suite.page.waitForFunction(() => Number(document.getElementById('dance-plot').dataset.seconds) >= 3, null, { timeout: 30_000 });
+    await waitUntil(suite.page, () => Number(document.getElementById('dance-plot').dataset.seconds) >= 3, null, { timeout: 30_000, message: 'the plot shows 3 seconds' });
     const f2 = await status(suite.page);
     assert.ok(f2 > f1 + INFO.fps, `the dance advances (frame ${f1} → ${f2})`);
     const live = await suite.page.evaluate(() => {
@@ -228,8 +241,7 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
     assert.equal(live.joints, 57);
     assert.equal(live.fps, INFO.fps);
     assert.equal(live.playing, true);
-    assert.ok(live.frames <= 1200 + 180, 'only a bounded window is kept');
-    assert.ok(Number.isFinite(live.last) && live.last >= 0, `the plot shows a pose change (${live.last} m/s)`);
+    assert.ok(live.last > SALSA_FREEZE, `the plot shows the dance moving: ${live.last} m/s, above the freeze line ${SALSA_FREEZE.toFixed(3)} m/s`);
     assert.equal(live.loading, true, 'the loading indicator is hidden once the model is loaded');
 
     // Export BVH saves the dance: 57 joints at the skeleton's bone lengths.
@@ -259,10 +271,11 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
     // Another style restarts the dance from its first seed motion; the plot starts again.
     const style = INFO.styles[1];
     await suite.page.selectOption('#dance-style', style);
-    await suite.page.waitForFunction(
+    await waitUntil(
+      suite.page,
       (s) => document.getElementById('clip-meta').textContent.includes(s) && Number(document.getElementById('dance-status').dataset.frame) < 200,
       style,
-      { timeout: 30_000 },
+      { timeout: 30_000, message: `the dance restarts as ${style}` },
     );
     const switched = await suite.page.evaluate(() => ({
       seeds: [...document.getElementById('dance-seed').options].map((o) => o.textContent),
@@ -271,37 +284,38 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
     assert.deepEqual(switched.seeds, INFO.seeds.filter((s) => s.style === style).map((s) => s.name));
     assert.match(switched.meta, new RegExp(`acLSTM · ${style}`));
     assert.ok((await plotSeconds(suite.page)) <= 3, 'the plot restarted');
-    await suite.page.waitForFunction(() => Number(document.getElementById('dance-plot').dataset.seconds) >= 1, null, { timeout: 30_000 });
+    await waitUntil(suite.page, () => Number(document.getElementById('dance-plot').dataset.seconds) >= 1, null, { timeout: 30_000, message: 'the new plot gains a second' });
 
     // The vanilla baseline runs in the same mode.
     await suite.page.selectOption('#dance-model', 'aclstm-vanilla');
-    await suite.page.waitForFunction(() => document.getElementById('clip-meta').textContent.includes('vanilla'), null, { timeout: 60_000 });
+    await waitUntil(suite.page, () => document.getElementById('clip-meta').textContent.includes('vanilla'), null, { timeout: 60_000, message: 'the baseline is shown' });
     // The switch shows at once; the baseline's stream starts once its model has loaded (no fixed deadline).
     const g1 = await status(suite.page);
-    await suite.page.waitForFunction(
-      (from) => Number(document.getElementById('dance-status').dataset.frame) > from + 30,
-      g1,
-      { timeout: 60_000 },
-    );
+    await waitUntil(suite.page, (from) => Number(document.getElementById('dance-status').dataset.frame) > from + 30, g1, {
+      timeout: 60_000,
+      message: `the baseline's dance advances 30 frames from frame ${g1}`,
+    });
     assert.match(await suite.page.locator('#clip-meta').textContent(), /vanilla/, 'the baseline dances too');
 
     await suite.page.click('#mode-clip');
     const back = await suite.page.evaluate(() => ({ frames: window.playground.current()?.frames, dance: document.body.classList.contains('dance-mode') }));
     assert.equal(back.dance, false);
     assert.equal(back.frames, clipFrames, 'the clip shown before is back');
-    assert.deepEqual(suite.problems, [], 'no console errors');
   });
 
   test('Dance mode in a fresh page: frames grow, the plot fills, no console errors', async () => {
     const fresh = await openPlayground(suite.browser, suite.url);
     try {
       await fresh.page.click('#mode-dance');
-      await fresh.page.waitForFunction(() => Number(document.getElementById('dance-plot').dataset.seconds) >= 2, null, { timeout: 60_000 });
+      await waitUntil(fresh.page, () => Number(document.getElementById('dance-plot').dataset.seconds) >= 2, null, { timeout: 60_000, message: 'the plot shows 2 seconds' });
       const a = await status(fresh.page);
-      await fresh.page.waitForTimeout(2000);
-      const b = await status(fresh.page);
-      assert.ok(b > a + 1.5 * INFO.fps, `frames grow at the model's rate (${a} → ${b} in 2 s at ${INFO.fps} fps)`);
-      assert.ok((await plotSeconds(fresh.page)) >= 3);
+      // Frames keep coming (their rate against the wall clock is `npm run bench`'s dance-mode) and the
+      // plot gains the seconds they complete.
+      await waitUntil(fresh.page, ([a, fps]) => Number(document.getElementById('dance-status').dataset.frame) > a + 2 * fps, [a, INFO.fps], {
+        timeout: 60_000,
+        message: `the dance advances 2 s of frames from frame ${a}`,
+      });
+      await waitUntil(fresh.page, () => Number(document.getElementById('dance-plot').dataset.seconds) >= 3, null, { timeout: 30_000, message: 'the plot shows 3 seconds' });
       assert.deepEqual(fresh.problems, []);
     } finally {
       await fresh.context.close();

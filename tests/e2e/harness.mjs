@@ -1,10 +1,11 @@
 // Shared setup for the end-to-end tests and the benchmark: a Vite dev server started in-process,
 // headless Chromium (playwright-core, the system browser) and corpus files read from ../shared/mocap.
+import assert from 'node:assert/strict';
 import { existsSync, readFileSync } from 'node:fs';
 import net from 'node:net';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { after, before } from 'node:test';
+import { after, afterEach, before } from 'node:test';
 import { gunzipSync } from 'node:zlib';
 import { chromium } from 'playwright-core';
 import { createServer } from 'vite';
@@ -103,9 +104,28 @@ export function nextFrames(page, n = 2) {
 }
 
 /**
+ * Waits until `fn` (run in the page with `arg`) returns a truthy value, like `page.waitForFunction`, and
+ * returns that value. If it does not within `timeout` ms it fails as an assertion with `message` (what
+ * did not happen), so a test that waits on the page's state fails for that reason, not with a bare
+ * timeout. The timeout only bounds a hang; nothing is asserted about how long the wait took.
+ */
+export async function waitUntil(page, fn, arg, { timeout = 30_000, message = 'the page never reached the state waited for' } = {}) {
+  try {
+    const handle = await page.waitForFunction(fn, arg, { timeout });
+    const value = await handle.jsonValue();
+    await handle.dispose();
+    return value;
+  } catch (e) {
+    if (e?.name !== 'TimeoutError') throw e;
+    throw new assert.AssertionError({ message: `${message} (waited ${Math.round(timeout / 1000)} s)` });
+  }
+}
+
+/**
  * For a `describe` block: starts the dev server, Chromium and one playground page before its tests and
  * closes them after. Returns an object whose `server`, `url`, `browser`, `page`, `context` and
- * `problems` are filled in once the tests run.
+ * `problems` are filled in once the tests run. After each test, the console and page errors collected
+ * during it must be none (and are cleared), so every test checks its own.
  */
 export function usePlayground(options) {
   const suite = {};
@@ -113,6 +133,9 @@ export function usePlayground(options) {
     Object.assign(suite, await startServer());
     suite.browser = await launchBrowser();
     Object.assign(suite, await openPlayground(suite.browser, suite.url, options));
+  });
+  afterEach(() => {
+    assert.deepEqual(suite.problems?.splice(0) ?? [], [], 'no console or page errors during the test');
   });
   after(async () => {
     await suite.browser?.close();

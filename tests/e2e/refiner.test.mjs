@@ -5,18 +5,23 @@ import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
 import { describe, test } from 'node:test';
-import { openPlayground, ROOT, usePlayground } from './harness.mjs';
+import { openPlayground, ROOT, usePlayground, waitUntil } from './harness.mjs';
 
 const GENERATOR = JSON.parse(readFileSync(path.join(ROOT, 'public', 'models', 'generator.json'), 'utf8'));
 const J = GENERATOR.skeleton.joints.length;
 const REFERENCE = JSON.parse(readFileSync(path.join(ROOT, 'tests', 'fixtures', 'refiner_reference.json'), 'utf8'));
 
-/** In-page: generate and return a JSON-friendly copy, with its foot skating (the app's web/motion/footSkating.ts). */
+/**
+ * In-page: generate and return a JSON-friendly copy, with its foot skating (the app's
+ * web/motion/footSkating.ts) and whether current() is what it was before (`shownUnchanged`).
+ */
 function generate(page, options) {
   return page.evaluate(async (o) => {
+    const before = window.playground.current();
     const m = await window.playground.generate(o);
     const { footSkating } = await import('/motion/footSkating.ts');
     return {
+      shownUnchanged: window.playground.current() === before,
       skating: footSkating(m),
       fps: m.fps,
       frames: m.frames,
@@ -62,7 +67,7 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
     assert.ok(Math.hypot(raw.positions[0] - m.positions[0], raw.positions[2] - m.positions[2]) < 0.05);
     const other = await generate(suite.page, { model: 'generator', frames: 300, seed: 5, refine: true });
     assert.notDeepEqual(other.positions, m.positions, 'another seed gives another refined motion');
-    assert.equal(await suite.page.evaluate(() => window.playground.current()), null, 'generate does not show the motion');
+    assert.ok([m, again, raw, other].every((g) => g.shownUnchanged), 'generate does not show the motion');
   });
 
   test('refined + foot lock skates far less than the raw motion (same seeds)', async () => {
@@ -112,6 +117,8 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
   test('bad refine values reject with clear messages and leave the scene as it was', async () => {
     const r = await suite.page.evaluate(async () => {
       const pg = window.playground;
+      pg.show(await pg.generate({ model: 'generator', frames: 40, seed: 2 }), 'before');
+      const before = pg.current();
       const messages = [];
       for (const refine of ['yes', 1, null]) {
         try {
@@ -122,12 +129,13 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
         }
       }
       const one = await pg.generate({ model: 'generator', frames: 1, seed: 1, refine: true });
-      return { messages, current: pg.current(), one: { frames: one.frames, contacts: one.contacts.length, finite: Array.from(one.positions).every(Number.isFinite) } };
+      return { messages, unchanged: pg.current() === before, frames: pg.state().frames, one: { frames: one.frames, contacts: one.contacts.length, finite: Array.from(one.positions).every(Number.isFinite) } };
     });
     assert.match(r.messages[0], /^generate: refine must be true or false, got yes/);
     assert.match(r.messages[1], /refine must be true or false, got 1/);
     assert.match(r.messages[2], /refine must be true or false, got null/);
-    assert.equal(r.current, null);
+    assert.equal(r.unchanged, true, 'current() is unchanged');
+    assert.equal(r.frames, 40);
     assert.deepEqual(r.one, { frames: 1, contacts: 2, finite: true });
   });
 
@@ -180,9 +188,17 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
         };
       });
     const waitFrame = (n, text = '') =>
-      suite.page.waitForFunction(([n, text]) => Number(document.getElementById('walk-status').dataset.frame) > n && document.getElementById('walk-status').textContent.includes(text), [n, text], { timeout: 90_000 });
+      waitUntil(
+        suite.page,
+        ([n, text]) => Number(document.getElementById('walk-status').dataset.frame) > n && document.getElementById('walk-status').textContent.includes(text),
+        [n, text],
+        { timeout: 90_000, message: `the walk passes frame ${n}${text ? ` (${text})` : ''}` },
+      );
 
+    // The walk starts raw, one figure.
     await suite.page.click('#mode-walk');
+    await suite.page.uncheck('#walk-side-by-side');
+    await suite.page.uncheck('#walk-refine');
     await waitFrame(60);
     let s = await status();
     assert.equal(s.card, 'block', 'the skating readout shows in Random walk mode');
@@ -194,7 +210,7 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
 
     // Refine: the stream restarts refined; one figure, the refined readout.
     await suite.page.check('#walk-refine');
-    await suite.page.waitForFunction(() => /refined/.test(document.getElementById('walk-status').textContent), null, { timeout: 60_000 });
+    await waitUntil(suite.page, () => /refined/.test(document.getElementById('walk-status').textContent), null, { timeout: 60_000, message: 'the walk restarts refined' });
     await waitFrame(90, 'refined');
     s = await status();
     assert.equal(s.skating.shown, 'refined');
@@ -210,16 +226,37 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
     assert.deepEqual(shown, { joints: J, contacts: true, finite: true });
 
     // Side by side: no restart (the refined stream carries the raw frames), both figures labelled, both numbers.
+    // The lowest stream frame shown from here on is watched: a restart would start again from 0.
     const before = s.frame;
+    await suite.page.evaluate(() => {
+      const el = document.getElementById('walk-status');
+      window.lowestWalkFrame = Number(el.dataset.frame);
+      new MutationObserver(() => (window.lowestWalkFrame = Math.min(window.lowestWalkFrame, Number(el.dataset.frame)))).observe(el, { attributes: true, attributeFilter: ['data-frame'] });
+    });
     await suite.page.check('#walk-side-by-side');
-    await suite.page.waitForFunction(() => /side by side/.test(document.getElementById('walk-status').textContent) && document.querySelectorAll('.figure-label:not([hidden])').length === 2, null, { timeout: 20_000 });
-    await suite.page.waitForTimeout(3000);
+    await waitUntil(
+      suite.page,
+      () => /side by side/.test(document.getElementById('walk-status').textContent) && document.querySelectorAll('.figure-label:not([hidden])').length === 2,
+      null,
+      { timeout: 20_000, message: 'both figures are labelled' },
+    );
+    // A second of the walk side by side, with both numbers in the readout.
+    await waitUntil(
+      suite.page,
+      (f) => Number(document.getElementById('walk-status').dataset.frame) > f + 30 && document.getElementById('walk-skating').dataset.shown === 'both',
+      before,
+      { timeout: 60_000, message: `the walk goes on side by side from frame ${before}` },
+    );
     s = await status();
-    assert.ok(s.frame > before, `the walk went on (frame ${before} → ${s.frame})`);
+    const lowest = await suite.page.evaluate(() => window.lowestWalkFrame);
+    assert.ok(lowest >= before, `the walk went on without restarting (frame ${before} → ${s.frame}, lowest ${lowest})`);
     assert.equal(s.skating.shown, 'both');
     assert.ok(s.rawLine && s.refinedLine);
     const raw = Number(s.skating.raw), refined = Number(s.skating.refined);
-    assert.ok(raw > 0.3 && refined >= 0 && refined < raw, `readout: raw ${raw} vs refined ${refined} m/s`);
+    console.log(`# Random walk side by side, skating readout at frame ${s.frame}: raw ${raw} refined ${refined} m/s`);
+    // The raw generator skates (docs/models/refiner.md: about 1.2 m/s); refined + foot lock at most half of
+    // that, as generate({ refine: true }) does per seed above.
+    assert.ok(raw > 0.3 && refined < 0.5 * raw, `readout: raw ${raw} vs refined ${refined} m/s`);
     assert.deepEqual(s.labels.map((l) => l.text).sort(), ['raw', 'refined + foot lock']);
     const [a, b] = s.labels.map((l) => l.box.x + l.box.width / 2);
     assert.ok(Math.abs(a - b) > 80, `the two figures are drawn apart (labels at ${a.toFixed(0)} and ${b.toFixed(0)} px)`);
@@ -228,20 +265,25 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
 
     // Side by side off: one figure again, same stream.
     await suite.page.uncheck('#walk-side-by-side');
-    await suite.page.waitForFunction(() => document.querySelectorAll('.figure-label').length === 0, null, { timeout: 10_000 });
+    await waitUntil(suite.page, () => document.querySelectorAll('.figure-label').length === 0, null, { timeout: 10_000, message: 'the labels go' });
     s = await status();
     assert.equal(s.refine, true);
     assert.equal(s.skating.shown, 'refined');
 
     // Refine off (turns side by side off too): back to the raw generator.
     await suite.page.check('#walk-side-by-side');
-    await suite.page.waitForFunction(() => document.querySelectorAll('.figure-label').length === 2, null, { timeout: 10_000 });
+    await waitUntil(suite.page, () => document.querySelectorAll('.figure-label').length === 2, null, { timeout: 10_000, message: 'both figures are labelled again' });
     await suite.page.uncheck('#walk-refine');
     assert.equal(await suite.page.evaluate(() => document.querySelectorAll('.figure-label').length), 0, 'the raw figure goes at once');
-    await suite.page.waitForFunction(() => {
-      const s = document.getElementById('walk-status');
-      return /τ/.test(s.textContent) && !/refined/.test(s.textContent) && Number(s.dataset.frame) > 30;
-    }, null, { timeout: 60_000 });
+    await waitUntil(
+      suite.page,
+      () => {
+        const s = document.getElementById('walk-status');
+        return /τ/.test(s.textContent) && !/refined/.test(s.textContent) && Number(s.dataset.frame) > 30;
+      },
+      null,
+      { timeout: 60_000, message: 'the walk restarts raw' },
+    );
     s = await status();
     assert.equal(s.sideBySide, false);
     assert.equal(s.labels.length, 0);
@@ -249,6 +291,5 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
 
     await suite.page.click('#mode-clip');
     assert.equal(await suite.page.evaluate(() => getComputedStyle(document.getElementById('walk-skating')).display), 'none');
-    assert.deepEqual(suite.problems, [], 'no console errors');
   });
 });
