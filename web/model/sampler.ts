@@ -1,8 +1,17 @@
 // Drawing the generator's next frame from its Gaussian mixture output, deterministically from a seed.
-// Mirrors training/generate.py (sample_mixture and the contact snapping in ShippedGenerator.sample).
+// Mirrors training/generator/sampling.py (draw_mixture and snap_contacts); tests/unit/mixtureParity.test.ts
+// checks the two against a fixture written by python -m training.fixtures.mixture.
+
+/** Where the sampler's random numbers come from: the seeded Rng, or given values (the parity test). */
+export interface RandomSource {
+  /** Uniform in [0, 1). */
+  uniform(): number;
+  /** Standard normal N(0, 1). */
+  normal(): number;
+}
 
 /** Seeded PRNG: mulberry32 for uniforms, Box–Muller for standard normals. Same seed → same sequence. */
-export class Rng {
+export class Rng implements RandomSource {
   private state: number;
   private spareNormal: number | undefined;
 
@@ -67,9 +76,10 @@ export function chooseComponent(weights: ArrayLike<number>, temperature: number,
 
 /**
  * One draw per batch row: component k with probability ∝ w_k^(1/τ), then mu_k + sigma_k·τ·N(0, 1) per
- * dimension. τ ≤ 0 takes the heaviest component's mean and uses no random numbers.
+ * dimension; a row takes one uniform, then D normals. τ ≤ 0 takes the heaviest component's mean and uses no
+ * random numbers.
  */
-export function sampleMixture(m: MixtureBatch, temperature: number, rng: Rng, out = new Float32Array(m.batch * m.dim)): Float32Array {
+export function sampleMixture(m: MixtureBatch, temperature: number, rng: RandomSource, out = new Float32Array(m.batch * m.dim)): Float32Array {
   const { batch, mixtures: M, dim: D } = m;
   if (m.weights.length !== batch * M || m.mu.length !== batch * M * D || m.sigma.length !== batch * M * D) {
     throw new Error(`sampleMixture: output sizes (${m.weights.length}, ${m.mu.length}, ${m.sigma.length}) do not fit batch ${batch}, ${M} mixtures, dim ${D}`);
