@@ -3,7 +3,7 @@
 // the shared corpus at ../shared/mocap (or MOCAP_DIR).
 import assert from 'node:assert/strict';
 import { gzipSync } from 'node:zlib';
-import { readFileSync, writeFileSync } from 'node:fs';
+import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
 import { after, afterEach, before, describe, test } from 'node:test';
 import { corpusText, launchBrowser, nextFrames, openPlayground, ROOT, startServer, waitUntil } from './harness.mjs';
@@ -447,7 +447,10 @@ describe('motion playground page', { timeout: 150_000 }, () => {
     );
     await nextFrames(shot, 12);
     const png = await shot.screenshot({ type: 'png' });
-    writeFileSync(path.join(ROOT, 'docs', 'screenshot.png'), png);
+    // A test run leaves the tracked docs alone: the still goes to test-results/ unless asked for the docs.
+    const out = process.env.UPDATE_DOCS_SCREENSHOT ? path.join(ROOT, 'docs', 'screenshot.png') : path.join(ROOT, 'test-results', 'screenshot.png');
+    mkdirSync(path.dirname(out), { recursive: true });
+    writeFileSync(out, png);
     // Decode the PNG in the page and measure it: many colours, real contrast, and the figure's and
     // footprints' blue and orange present.
     const stats = await shot.evaluate(async (b64) => {
