@@ -66,7 +66,7 @@ def test_shipped_generator_round_trips_through_a_checkpoint(tmp_path):
     info = json.loads((MODELS_DIR / "generator.json").read_text())
     state = checkpoint_from_shipped(MODELS_DIR / info["file"], info)
     torch.save(state, tmp_path / "best.pt")
-    model, meta, loaded = load_generator(tmp_path / "best.pt")  # as export_generator loads it
+    model, meta, loaded = load_generator(tmp_path / "best.pt")  # as python -m training.generator.export loads it
     assert compare_with_onnx(model, MODELS_DIR / info["file"], batches=(1, 7)) < 1e-5
     assert loaded["epoch"] == info["training"]["epochs"] and loaded["valid_nll"] == info["training"]["valid_nll_per_frame"]
     assert (meta["dim"], meta["hidden"], meta["mixtures"], meta["fps"]) == (

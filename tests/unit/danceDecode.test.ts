@@ -1,4 +1,4 @@
-// The dance feature decoder against the Python one (training/aclstm_data.py decode) via the fixture the
+// The dance feature decoder against the Python one (training/data/dance.py decode) via the fixture the
 // export writes (tests/fixtures/aclstm_reference.json), and the dance model JSON checks.
 import { describe, expect, it } from 'vitest';
 import { decodeDance } from '../../web/runtime/danceDecode';

@@ -1,5 +1,5 @@
 // The foot lock (web/motion/footLock.ts) against training/footlock.py on generator motion
-// (tests/fixtures/footlock_reference.json, written by python -m training.fixtures_footlock), and what it
+// (tests/fixtures/footlock_reference.json, written by python -m training.fixtures.footlock), and what it
 // must do on its own: planted toes stay put and on the ground, bones keep their lengths, no popping.
 import { describe, expect, it } from 'vitest';
 import { FOOT_LOCK_DEFAULTS, FootLock, footLock, twoBoneIK } from '../../web/motion/footLock';

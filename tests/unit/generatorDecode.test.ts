@@ -1,4 +1,4 @@
-// The TypeScript feature decoder against the Python one (training/features.py), via the fixture the
+// The TypeScript feature decoder against the Python one (training/data/features.py), via the fixture the
 // Python export writes (tests/fixtures/generator_reference.json), plus the generator JSON checks.
 import { describe, expect, it } from 'vitest';
 import { decodeFeatures } from '../../web/model/featureDecode';

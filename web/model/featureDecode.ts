@@ -1,5 +1,5 @@
 // Generator feature rows (physical units) → root trajectory, local rotations and joint positions.
-// A port of training/features.py FeatureCodec.decode followed by forward kinematics; keep the two in step.
+// A port of training/data/features.py FeatureCodec.decode followed by forward kinematics; keep the two in step.
 import { forwardKinematics } from '../motion/skeleton';
 import { quatMultiply, quatNormalize, type Quat } from '../motion/math';
 import type { Skeleton } from '../motion/types';

@@ -1,5 +1,5 @@
 // The locomotion generator's description file (public/models/generator.json, written by
-// training/export_generator.py): skeleton, ONNX step signature, feature layout, normalisation and
+// python -m training.generator.export): skeleton, ONNX step signature, feature layout, normalisation and
 // seed states. `parseGeneratorInfo` checks everything the runtime relies on, so a mismatched or
 // truncated file fails at load time with a message saying which field is wrong.
 

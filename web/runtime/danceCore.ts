@@ -1,6 +1,6 @@
 // The dance models' step loop (acLSTM and its vanilla baseline), independent of where it runs: an
 // onnxruntime session, the feature decoder and the skeleton fit. dance.worker.ts wraps it in messages;
-// unit tests drive it directly with onnxruntime-web's Node build. The loop is training/dance.py's:
+// unit tests drive it directly with onnxruntime-web's Node build. The loop is training/aclstm/shipped.py's:
 // h = c = 0, the seed motion's frames are fed one by one (normalised), then each output y is one new
 // frame and is fed back as the next input. No randomness: the same style and seed give the same dance.
 import type { InferenceSession, TensorConstructor } from 'onnxruntime-web';

@@ -1,5 +1,5 @@
 // Dance feature rows (physical units) → world positions of the 57 skeleton points. A port of
-// training/aclstm_data.py `decode`; keep the two in step.
+// training/data/dance.py `decode`; keep the two in step.
 //   x(t) = [r_x(t) − r_x(t−1), r_y(t), r_z(t) − r_z(t−1), p_j(t) − r(t) for points j = 1…]
 // The root's x and z integrate the steps (from where the previous frame ended), its height is absolute,
 // and every other point is the root plus its offset (world axes).

@@ -1,5 +1,5 @@
 // The dance models' description files (public/models/aclstm.json and aclstm-vanilla.json, written by
-// training/export_aclstm.py): skeleton, ONNX step signature, feature layout, normalisation, the seed
+// python -m training.aclstm.export): skeleton, ONNX step signature, feature layout, normalisation, the seed
 // motions per style and the real pose change per style. `parseDanceInfo` checks everything the runtime
 // relies on and names the first bad field.
 import { modelInfoFormat } from '../model/modelInfo';

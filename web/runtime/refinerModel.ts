@@ -1,4 +1,4 @@
-// The refiner's description file (public/models/refiner.json, written by training/export_refiner.py): the
+// The refiner's description file (public/models/refiner.json, written by python -m training.refiner.export): the
 // ONNX step signature, the end effectors it reads, the normalisation (the generator's) and the foot-lock
 // settings. `parseRefinerInfo` checks everything the runtime relies on and names the first bad field;
 // `checkRefinerPairing` checks that it fits the loaded generator.
