@@ -89,3 +89,65 @@ def test_the_check_finds_violations(tmp_path):
         "training/sub/lib.py imports the command module training.sub.tool",
         "training/sub/tool.py is a command but defines helper; move it to a library module",
     ]
+
+
+# What each part of training/ may import of the others (docs/architecture.md): the pipeline runs one way,
+# corpus readers → datasets → networks → one folder per model; shared modules sit beside them.
+SHARED = {"paths", "runs", "metrics", "footlock", "onnx"}
+MAY_IMPORT = {
+    "paths": set(),
+    "runs": {"paths"},
+    "mocap": {"paths"},
+    "metrics": {"mocap"},
+    "footlock": {"mocap"},
+    "onnx": {"paths"},
+    "data": {"mocap", "paths", "metrics"},
+    "models": {"mocap", "data"},
+    "generator": {"mocap", "data", "models"} | SHARED,
+    "aclstm": {"mocap", "data", "models"} | SHARED,
+    "refiner": {"mocap", "data", "models", "generator"} | SHARED,
+    "fixtures": {"mocap", "data", "models", "generator", "refiner", "aclstm"} | SHARED,
+}
+
+
+def layering_violations(root: Path) -> list[str]:
+    problems = []
+    for path in sorted((root / "training").rglob("*.py")):
+        name = module_name(path, root)
+        parts = name.split(".")
+        if len(parts) < 2:
+            continue  # training/__init__.py
+        part = parts[1]
+        allowed = MAY_IMPORT.get(part)
+        if allowed is None:
+            problems.append(f"{path.relative_to(root)}: training/{part} is not in the layering table")
+            continue
+        folders = set()
+        for target in imported_modules(ast.parse(path.read_text()), name, path.name == "__init__.py"):
+            t = target.split(".")
+            # Outside training/, the part itself, or a name of `from .. import x` (x is checked as training.x).
+            if t[0] == "training" and len(t) > 1 and t[1] != part and t[1] in MAY_IMPORT:
+                folders.add(t[1])
+        problems += [f"{path.relative_to(root)} (training/{part}) imports training/{f}" for f in sorted(folders - allowed)]
+    return problems
+
+
+def test_training_folders_import_down_the_pipeline_only():
+    assert layering_violations(REPO) == []
+
+
+def test_the_layering_check_finds_violations(tmp_path):
+    pkg = tmp_path / "training"
+    for sub in ("mocap", "models", "extra"):
+        (pkg / sub).mkdir(parents=True)
+        (pkg / sub / "__init__.py").write_text("")
+    (pkg / "__init__.py").write_text("")
+    (pkg / "mocap" / "bvh.py").write_text("from ..models.generator import MixtureLSTM\nfrom .. import metrics\n")
+    (pkg / "models" / "net.py").write_text("from ..mocap.skeleton import Skeleton\n")
+    (pkg / "extra" / "x.py").write_text("")
+    assert layering_violations(tmp_path) == [
+        "training/extra/__init__.py: training/extra is not in the layering table",
+        "training/extra/x.py: training/extra is not in the layering table",
+        "training/mocap/bvh.py (training/mocap) imports training/metrics",
+        "training/mocap/bvh.py (training/mocap) imports training/models",
+    ]
