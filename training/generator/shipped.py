@@ -13,6 +13,7 @@ from ..data.locomotion import LocomotionClip
 from ..mocap.rotations import quat_to_matrix
 from ..mocap.skeleton import canonical_skeleton
 from ..onnx.sessions import cpu_session
+from .sampling import sample_mixture, snap_contacts
 
 
 @dataclass
@@ -49,13 +50,10 @@ class ShippedGenerator:
         h = np.stack([np.array(s["h"], np.float32).reshape(2, self.hidden) for s in chosen], axis=1)
         c = np.stack([np.array(s["c"], np.float32).reshape(2, self.hidden) for s in chosen], axis=1)
         out = np.zeros((b, frames, len(self.mean)), np.float32)
-        contact_lo, contact_hi = (0 - self.mean[-2:]) / self.std[-2:], (1 - self.mean[-2:]) / self.std[-2:]
         for t in tqdm(range(frames), desc="sampling", unit="frame", disable=not progress):
             w, mu, sigma, h, c = self.session.run(None, {"x": x, "h": h, "c": c})
-            x = sample_mixture(w, mu, sigma, temperature, rng)
             # Contacts are bits: feed back a clean 0 or 1, as in the training data.
-            on = x[:, -2:] * self.std[-2:] + self.mean[-2:] > 0.5
-            x[:, -2:] = np.where(on, contact_hi, contact_lo)
+            x = snap_contacts(sample_mixture(w, mu, sigma, temperature, rng), self.mean, self.std)
             out[:, t] = x * self.std + self.mean
         return out
 
@@ -73,15 +71,3 @@ class ShippedGenerator:
                 out.append(DecodedMotion(features, self.codec.positions(features), c.contacts[1:]))
         return out
 
-
-def sample_mixture(w: np.ndarray, mu: np.ndarray, sigma: np.ndarray, temperature: float, rng: np.random.Generator) -> np.ndarray:
-    """One draw per row from diagonal Gaussian mixtures; temperature sharpens the weights and scales sigma."""
-    if temperature <= 0:
-        k = w.argmax(axis=1)
-        return mu[np.arange(len(w)), k]
-    logits = np.log(np.maximum(w, 1e-12)) / temperature
-    p = np.exp(logits - logits.max(axis=1, keepdims=True))
-    p /= p.sum(axis=1, keepdims=True)
-    k = np.array([rng.choice(len(row), p=row) for row in p])
-    rows = np.arange(len(w))
-    return (mu[rows, k] + sigma[rows, k] * temperature * rng.standard_normal(mu.shape[-1])).astype(np.float32)

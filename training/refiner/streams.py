@@ -16,7 +16,7 @@ TEMPERATURE = 0.5
 
 
 def sample_torch(logits, mu, log_sigma, temperature: float, gen: torch.Generator) -> torch.Tensor:
-    """generator/shipped.sample_mixture in torch: weights sharpened by 1/temperature, sigmas scaled by temperature."""
+    """generator/sampling.sample_mixture in torch: weights sharpened by 1/temperature, sigmas scaled by temperature."""
     p = torch.softmax(torch.log_softmax(logits, -1) / temperature, -1)
     k = torch.multinomial(p, 1, generator=gen)[:, 0]
     rows = torch.arange(len(k))
