@@ -220,7 +220,9 @@ def results_lines(r: dict) -> list[str]:
     sk = {k: V[k]["foot_skating"] for k in VARIANTS}
     acc_raw, acc_ref = ts["raw"]["balanced_accuracy_mean"], ts["refined"]["balanced_accuracy_mean"]
     ok1 = sk["refined + foot lock"] <= real["foot_skating"]
-    ok2 = acc_ref < acc_raw
+    # Lower by more than the classifier seeds' spread: a difference inside it is not a measured improvement.
+    within_spread = abs(acc_ref - acc_raw) <= 2 * max(ts['raw']['balanced_accuracy_sd'], ts['refined']['balanced_accuracy_sd'], 0.005)
+    ok2 = acc_ref < acc_raw and not within_spread
     lines += [
         "",
         "## Acceptance", "",
@@ -228,23 +230,35 @@ def results_lines(r: dict) -> list[str]:
         f"held-out clips, measured the same way: **{'met' if ok1 else 'NOT met'}**.",
         f"- Two-sample accuracy: refined {100 * acc_ref:.1f}% against raw {100 * acc_raw:.1f}% "
         f"(mean of {r['two_sample']['classifier_seeds']} classifiers each): **{'met' if ok2 else 'NOT met'}**"
-        + ("" if abs(acc_ref - acc_raw) > 2 * max(ts['raw']['balanced_accuracy_sd'], ts['refined']['balanced_accuracy_sd'], 0.005)
-           else " (the difference is within the spread between classifier seeds)") + ".",
+        + (" (the difference is within the spread between classifier seeds)" if within_spread else "") + ".",
         "",
         "## Reading the numbers", "",
         "- The foot lock does nearly all of the skating removal: on its own it takes the raw generator from "
         f"{sk['raw']:.3f} to {sk['raw + foot lock']:.3f} m/s; the refiner alone halves skating "
         f"({sk['raw']:.3f} → {sk['refined']:.3f} m/s, planted toes visibly calmer) and leaves less for the lock to pull back.",
         "- Every generated variant stays easy to tell from real motion: the window classifier is right "
-        f"{100 * min(ts[v]['balanced_accuracy_mean'] for v in VARIANTS):.0f}-100% of the time and even single frames give "
-        "it away about 95% of the time. The refiner lowers both accuracies a little, more than the spread between "
-        "classifier seeds, but it does not make the motion indistinguishable. The foot lock raises them slightly "
-        "(perfectly still toes and IK-bent legs are themselves unlike real motion).",
+        f"{100 * min(ts[v]['balanced_accuracy_mean'] for v in VARIANTS):.0f}-100% of the time and single frames give "
+        f"it away {100 * min(ts[v]['frame_balanced_accuracy_mean'] for v in VARIANTS):.0f}-"
+        f"{100 * max(ts[v]['frame_balanced_accuracy_mean'] for v in VARIANTS):.0f}% of the time. Against raw, the refiner "
+        f"{accuracy_change(ts['raw'], ts['refined'])}; it does not make the motion indistinguishable. The foot lock, on "
+        f"the refined motion, {accuracy_change(ts['refined'], ts['refined + foot lock'])} (perfectly still toes and "
+        "IK-bent legs are themselves unlike real motion).",
         f"- Refined hands move faster than raw ones (W1 to real {V['raw']['speed_wasserstein']['hands']:.2f} → "
         f"{V['refined']['speed_wasserstein']['hands']:.2f} m/s): D sees the wrists and R trades them off against the feet.",
         "",
     ]
     return lines
+
+
+def accuracy_change(before: dict, after: dict) -> str:
+    """How the two-sample accuracies move from `before` to `after`, judged against the classifier seeds' spread."""
+    def one(key: str, what: str) -> str:
+        a, b = before[f"{key}_mean"], after[f"{key}_mean"]
+        spread = 2 * max(before[f"{key}_sd"], after[f"{key}_sd"], 0.005)
+        if abs(b - a) <= spread:
+            return f"does not move the {what} accuracy beyond the classifier seeds' spread ({100 * a:.1f}% → {100 * b:.1f}%)"
+        return f"{'lowers' if b < a else 'raises'} the {what} accuracy ({100 * a:.1f}% → {100 * b:.1f}%)"
+    return f"{one('balanced_accuracy', 'window')} and {one('frame_balanced_accuracy', 'single-frame')}"
 
 
 def method_lines(r: dict) -> list[str]:
