@@ -210,7 +210,7 @@ def write_markdown(report: dict) -> None:
         "## Reading the numbers", "",
         f"- Foot skating is {g['foot_skating_mean'] / r['foot_skating']:.1f}× that of real motion measured the same way: "
         "each frame is an independent draw from the mixture, so planted feet jitter. The refiner and the contact "
-        "clean-up remove exactly this: refined + foot lock skates 0.06 m/s ([refiner.md](refiner.md)).",
+        "clean-up remove exactly this ([refiner.md](refiner.md) measures refined + foot-locked skating the same way).",
         f"- Generated root speed averages {g['root_speed']['mean']:.2f} m/s against {r['root_speed']['mean']:.2f} m/s for the "
         f"held-out clips, and turning is milder ({g['turning_rate_abs']['mean']:.2f} vs {r['turning_rate_abs']['mean']:.2f} rad/s): "
         "free-running samples settle into a steady, moderate walk. Faster walking, running and sharp turns are in "
