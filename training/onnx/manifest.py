@@ -4,9 +4,9 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from ..paths import REPO_ROOT
+from ..paths import MODELS_DIR
 
-MANIFEST = REPO_ROOT / "public" / "models" / "index.json"
+MANIFEST = MODELS_DIR / "index.json"
 
 
 def register_model(entry: dict, manifest: Path = MANIFEST) -> None:
