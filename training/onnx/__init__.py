@@ -1,1 +1,2 @@
-"""Writing ONNX files: the graph builder and the manifest of shipped models."""
+"""Shared ONNX helpers: the graph builder (graph.py), the manifest of shipped models (manifest.py) and CPU
+onnxruntime sessions (sessions.py)."""
