@@ -213,16 +213,14 @@ function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorCall | D
   if (typeof o.frames !== 'number' || !Number.isInteger(o.frames) || o.frames < 1 || o.frames > GENERATE_MAX_FRAMES) {
     throw new RangeError(`frames must be an integer from 1 to ${GENERATE_MAX_FRAMES}, got ${String(o.frames)}`);
   }
-  if (typeof o.seed !== 'number' || !Number.isInteger(o.seed) || o.seed < 0 || o.seed > 0xffffffff) {
-    throw new RangeError(`seed must be an integer from 0 to 4294967295, got ${String(o.seed)}`);
-  }
+  const seed = checkSeed(o.seed);
   if (dance) {
     const styles = entry.styles ?? [];
     if (o.style === undefined) throw new TypeError(`style is required for model "${entry.id}" (styles: ${styles.join(', ')})`);
     if (typeof o.style !== 'string' || !styles.includes(o.style)) {
       throw new RangeError(`unknown style ${typeof o.style === 'string' ? `"${o.style}"` : String(o.style)} for model "${entry.id}" (styles: ${styles.join(', ')})`);
     }
-    return { kind: 'aclstm', model: entry.id, frames: o.frames, seed: o.seed, style: o.style };
+    return { kind: 'aclstm', model: entry.id, frames: o.frames, seed, style: o.style };
   }
   const temperature = o.temperature ?? GENERATE_DEFAULT_TEMPERATURE;
   if (typeof temperature !== 'number' || !Number.isFinite(temperature) || temperature < 0 || temperature > 2) {
@@ -231,7 +229,7 @@ function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorCall | D
   if (o.refine !== undefined && typeof o.refine !== 'boolean') throw new TypeError(`refine must be true or false, got ${String(o.refine)}`);
   const refine = o.refine === true;
   if (refine && !models.some((m) => m.kind === 'refiner')) throw new Error('refine is not available: no refiner model is listed in models/index.json');
-  return { kind: 'lstm-gmm', model: entry.id, frames: o.frames, seed: o.seed, temperature, refine };
+  return { kind: 'lstm-gmm', model: entry.id, frames: o.frames, seed, temperature, refine };
 }
 
 /** Throws unless `options` is a plain object whose keys are all in `known`. */

@@ -11,6 +11,7 @@
 import { integrateRoot, type RootStart } from '../model/featureDecode';
 import type { GeneratorInfo, GeneratorSeed, StepOutputs } from '../model/generatorInfo';
 import { chooseComponent, denormalise, snapContacts } from '../model/sampler';
+import { repeatState, stateRow } from '../model/lstmState';
 
 /** The paper's input-noise prior: d ~ N(0, 0.05²) on the normalised network input (eq. 16). */
 export const INPUT_NOISE_SIGMA = 0.05;
@@ -89,20 +90,6 @@ export interface RolloutOptions {
    * noise term's spread across particles (σ ≈ 20 over 12 frames) swamp the control terms.
    */
   noiseScale?: number;
-}
-
-/** Copies one batch row of the L×B×H state layout. */
-function stateRow(src: Float32Array, L: number, B: number, H: number, b: number): Float32Array {
-  const out = new Float32Array(L * H);
-  for (let l = 0; l < L; l++) out.set(src.subarray((l * B + b) * H, (l * B + b + 1) * H), l * H);
-  return out;
-}
-
-/** One stream's L×H state repeated for B batch rows (the inverse of stateRow). */
-function repeatState(src: Float32Array, L: number, B: number, H: number): Float32Array {
-  const out = new Float32Array(L * B * H);
-  for (let l = 0; l < L; l++) for (let b = 0; b < B; b++) out.set(src.subarray(l * H, (l + 1) * H), (l * B + b) * H);
-  return out;
 }
 
 /**

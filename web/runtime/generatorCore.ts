@@ -3,6 +3,7 @@
 // onnxruntime-web's Node build.
 import type { InferenceSession, TensorConstructor } from 'onnxruntime-web';
 import { decodeFeatures, type RootStart } from '../model/featureDecode';
+import { setStateRow } from '../model/lstmState';
 import type { GeneratorInfo, StepInputs, StepOutputs } from '../model/generatorInfo';
 import type { BenchmarkResult, GeneratedChunk, GenerateParams, InitResult, ParityResult, StreamInfo, StreamParams } from './protocol';
 import type { RefinerCore, RefinerStream } from './refinerCore';
@@ -217,10 +218,8 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
     seedIndices.forEach((s, b) => {
       const seed = this.info.seeds[s];
       x.set(seed.x, b * D);
-      for (let l = 0; l < L; l++) {
-        h.set(seed.h.slice(l * H, (l + 1) * H), (l * B + b) * H);
-        c.set(seed.c.slice(l * H, (l + 1) * H), (l * B + b) * H);
-      }
+      setStateRow(h, L, B, H, b, seed.h);
+      setStateRow(c, L, B, H, b, seed.c);
     });
     return { x, h, c };
   }

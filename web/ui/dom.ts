@@ -1,5 +1,5 @@
 // Small helpers the page's ui files share: looking up index.html's elements, making elements, slider
-// fills, reading seed fields, and the text of a caught error for the page's messages.
+// fills, reading seed fields, the text of a caught error for the page's messages, and offering a text as a download.
 
 /** The element with this id in index.html (a missing one is a bug in the page, so it throws). */
 export function $<T extends HTMLElement = HTMLElement>(id: string): T {
@@ -32,4 +32,17 @@ export function readSeed(input: HTMLInputElement): number {
 export function errorMessage(e: unknown): string {
   if (e instanceof Error) return e.message || e.name;
   return String(e);
+}
+
+/** Offers a text as a file download. */
+export function downloadText(fileName: string, text: string, mime = 'text/plain'): void {
+  const url = URL.createObjectURL(new Blob([text], { type: mime }));
+  const a = document.createElement('a');
+  a.href = url;
+  a.download = fileName;
+  a.style.display = 'none';
+  document.body.append(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(url), 10_000);
 }

@@ -10,8 +10,8 @@ import type { FollowedPath, GeneratorClient } from '../../runtime/generatorClien
 import { GroundLine, TARGET_COLOR } from '../../viewer/groundPath';
 import { $, element, errorMessage, readSeed, setSliderFill } from '../dom';
 import type { ModeHost } from './host';
+import type { Gait } from '../../optimizer/pathFollower';
 
-type Gait = 'walk' | 'run';
 type Point = [number, number];
 
 const DEFAULT_FIT = 0.1;

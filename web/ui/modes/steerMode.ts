@@ -11,8 +11,8 @@ import { GroundArrow, TARGET_COLOR } from '../../viewer/groundPath';
 import { $, setSliderFill } from '../dom';
 import type { ModeHost } from './host';
 import { LiveMode, type LiveStream } from './liveMode';
+import type { Gait } from '../../optimizer/pathFollower';
 
-type Gait = 'walk' | 'run';
 
 /** Frames per optimised batch, and frames kept ready beyond the playhead (0.4 s at 30 fps). */
 const BATCH = 6;
