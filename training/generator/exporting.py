@@ -18,6 +18,7 @@ from ..onnx.manifest import register_model
 from ..onnx.sessions import cpu_session
 from ..paths import MODELS_DIR, REPO_ROOT
 from .graph import INPUTS, OUTPUTS, check_parity, export_onnx
+from .shipped import seed_batch
 from .training import load_generator
 
 FIXTURE = REPO_ROOT / "tests" / "fixtures" / "generator_reference.json"
@@ -83,11 +84,7 @@ def write_reference_fixture(onnx_path: Path, info: dict, codec: FeatureCodec) ->
     """Numbers the browser tests compare against: one ONNX step at batch 2 (onnxruntime-web parity) and
     the decoding of a few real feature frames into joint positions (TypeScript decoder parity)."""
     session = cpu_session(onnx_path)
-    hidden = info["onnx"]["hidden"]
-    s0, s1 = info["seeds"][0], info["seeds"][-1]
-    x = np.array([s0["x"], s1["x"]], np.float32)
-    h = np.stack([np.array(s["h"], np.float32).reshape(2, hidden) for s in (s0, s1)], axis=1)
-    c = np.stack([np.array(s["c"], np.float32).reshape(2, hidden) for s in (s0, s1)], axis=1)
+    x, h, c = seed_batch(info, [0, len(info["seeds"]) - 1])  # the first and the last seed state
     outs = session.run(OUTPUTS, {"x": x, "h": h, "c": c})
     mean, std = np.array(info["normalisation"]["mean"]), np.array(info["normalisation"]["std"])
     frames = np.array([s["x"] for s in info["seeds"]]) * std + mean  # physical units, one real frame per seed

@@ -29,6 +29,17 @@ class DecodedMotion:
         return np.cumsum(self.features[:, 2])
 
 
+def seed_batch(info: dict, indices: list[int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The step inputs (x, h, c) of a batch that starts from generator.json's seed states `indices` (`info` is
+    generator.json): x (batch, dim), h and c (layers, batch, hidden), float32."""
+    layers, hidden = info["onnx"]["layers"], info["onnx"]["hidden"]
+    chosen = [info["seeds"][i] for i in indices]
+    x = np.array([s["x"] for s in chosen], np.float32)
+    h = np.stack([np.array(s["h"], np.float32).reshape(layers, hidden) for s in chosen], axis=1)
+    c = np.stack([np.array(s["c"], np.float32).reshape(layers, hidden) for s in chosen], axis=1)
+    return x, h, c
+
+
 class ShippedGenerator:
     def __init__(self, models_dir: Path):
         self.info = json.loads((models_dir / "generator.json").read_text())
@@ -40,15 +51,16 @@ class ShippedGenerator:
         refs = quat_to_matrix(np.array(self.info["features"]["references"]))
         self.codec = FeatureCodec(self.skel, refs)
 
+    def seed_batch(self, indices: list[int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The step inputs (x, h, c) of a batch that starts from the seed states `indices` (seed_batch)."""
+        return seed_batch(self.info, indices)
+
     def sample(self, seeds: list[int], frames: int, temperature: float = 1.0, rng: np.random.Generator | None = None,
                progress: bool = False) -> np.ndarray:
         """Features (len(seeds), frames, dim) in physical units, one stream per seed, batched in one session call per step."""
         rng = rng or np.random.default_rng(0)
         b = len(seeds)
-        chosen = [self.info["seeds"][s] for s in seeds]
-        x = np.array([s["x"] for s in chosen], np.float32)
-        h = np.stack([np.array(s["h"], np.float32).reshape(2, self.hidden) for s in chosen], axis=1)
-        c = np.stack([np.array(s["c"], np.float32).reshape(2, self.hidden) for s in chosen], axis=1)
+        x, h, c = self.seed_batch(seeds)
         out = np.zeros((b, frames, len(self.mean)), np.float32)
         for t in tqdm(range(frames), desc="sampling", unit="frame", disable=not progress):
             w, mu, sigma, h, c = self.session.run(None, {"x": x, "h": h, "c": c})
