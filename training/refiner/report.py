@@ -221,7 +221,7 @@ def results_lines(r: dict) -> list[str]:
     acc_raw, acc_ref = ts["raw"]["balanced_accuracy_mean"], ts["refined"]["balanced_accuracy_mean"]
     ok1 = sk["refined + foot lock"] <= real["foot_skating"]
     # Lower by more than the classifier seeds' spread: a difference inside it is not a measured improvement.
-    within_spread = abs(acc_ref - acc_raw) <= 2 * max(ts['raw']['balanced_accuracy_sd'], ts['refined']['balanced_accuracy_sd'], 0.005)
+    within_spread = abs(acc_ref - acc_raw) <= seed_spread(ts['raw']['balanced_accuracy_sd'], ts['refined']['balanced_accuracy_sd'])
     ok2 = acc_ref < acc_raw and not within_spread
     lines += [
         "",
@@ -250,11 +250,17 @@ def results_lines(r: dict) -> list[str]:
     return lines
 
 
+def seed_spread(sd_a: float, sd_b: float) -> float:
+    """How far two two-sample accuracies (each a mean over classifier seeds, with standard deviation sd_a, sd_b)
+    may lie apart and still count as the same: twice the larger standard deviation, and at least 0.01."""
+    return 2 * max(sd_a, sd_b, 0.005)
+
+
 def accuracy_change(before: dict, after: dict) -> str:
     """How the two-sample accuracies move from `before` to `after`, judged against the classifier seeds' spread."""
     def one(key: str, what: str) -> str:
         a, b = before[f"{key}_mean"], after[f"{key}_mean"]
-        spread = 2 * max(before[f"{key}_sd"], after[f"{key}_sd"], 0.005)
+        spread = seed_spread(before[f"{key}_sd"], after[f"{key}_sd"])
         if abs(b - a) <= spread:
             return f"does not move the {what} accuracy beyond the classifier seeds' spread ({100 * a:.1f}% → {100 * b:.1f}%)"
         return f"{'lowers' if b < a else 'raises'} the {what} accuracy ({100 * a:.1f}% → {100 * b:.1f}%)"
