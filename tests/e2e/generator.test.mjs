@@ -3,8 +3,8 @@
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
-import { after, afterEach, before, describe, test } from 'node:test';
-import { launchBrowser, openPlayground, ROOT, startServer, waitUntil } from './harness.mjs';
+import { before, describe, test } from 'node:test';
+import { openPlayground, ROOT, usePlayground, waitUntil } from './harness.mjs';
 
 const CANONICAL = JSON.parse(readFileSync(path.join(ROOT, 'public', 'models', 'generator.json'), 'utf8')).skeleton.joints;
 const REFERENCE = JSON.parse(readFileSync(path.join(ROOT, 'tests', 'fixtures', 'generator_reference.json'), 'utf8'));
@@ -31,23 +31,10 @@ async function generate(page, options) {
 }
 
 describe('generator in the page', { timeout: 240_000 }, () => {
-  let server, url, browser, page, problems, context;
-
-  before(async () => {
-    ({ server, url } = await startServer());
-    browser = await launchBrowser();
-    ({ context, page, problems } = await openPlayground(browser, url));
-  });
-
-  // Every test checks the console and page errors of its own steps.
-  afterEach(() => {
-    assert.deepEqual(problems?.splice(0) ?? [], [], 'no console or page errors during the test');
-  });
-
-  after(async () => {
-    await browser?.close();
-    await server?.close();
-  });
+  // The shared page; every test checks the console and page errors of its own steps (usePlayground).
+  const suite = usePlayground();
+  let url, browser, page;
+  before(() => ({ url, browser, page } = suite));
 
   test('generate: shape, canonical skeleton, contacts, plausible and moving', async () => {
     const m = await generate(page, { model: 'generator', frames: 300, seed: 7 });

@@ -5,8 +5,8 @@ import assert from 'node:assert/strict';
 import { gzipSync } from 'node:zlib';
 import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
-import { after, afterEach, before, describe, test } from 'node:test';
-import { corpusText, launchBrowser, nextFrames, openPlayground, ROOT, startServer, waitUntil } from './harness.mjs';
+import { before, describe, test } from 'node:test';
+import { corpusText, nextFrames, openPlayground, ROOT, startServer, usePlayground, waitUntil } from './harness.mjs';
 
 const BVH_CLIP = 'cmu/bvh/07_04.bvh.gz';
 const AMC_CLIP = 'cmu/amc/16_11.amc.gz';
@@ -27,26 +27,16 @@ function maxAbsDiff(a, b) {
 }
 
 describe('motion playground page', { timeout: 150_000 }, () => {
-  let server, url, browser, page, problems;
+  // The shared page; every test checks the console and page errors of its own steps (usePlayground).
+  const suite = usePlayground();
+  let url, browser, page;
   const text = {};
 
-  before(async () => {
+  before(() => {
+    ({ url, browser, page } = suite);
     text.bvh = corpusText(BVH_CLIP);
     text.amc = corpusText(AMC_CLIP);
     text.asf = corpusText(ASF_FILE);
-    ({ server, url } = await startServer());
-    browser = await launchBrowser();
-    ({ page, problems } = await openPlayground(browser, url));
-  });
-
-  // Every test checks the console and page errors of its own steps.
-  afterEach(() => {
-    assert.deepEqual(problems?.splice(0) ?? [], [], 'no console or page errors during the test');
-  });
-
-  after(async () => {
-    await browser?.close();
-    await server?.close();
   });
 
   /** Imports through the API in the page and shows the result; returns its summary. */
