@@ -213,8 +213,10 @@ def write_markdown(report: dict) -> None:
         "clean-up remove exactly this ([refiner.md](refiner.md) measures refined + foot-locked skating the same way).",
         f"- Generated root speed averages {g['root_speed']['mean']:.2f} m/s against {r['root_speed']['mean']:.2f} m/s for the "
         f"held-out clips, and turning is milder ({g['turning_rate_abs']['mean']:.2f} vs {r['turning_rate_abs']['mean']:.2f} rad/s): "
-        "free-running samples settle into a steady, moderate walk. Faster walking, running and sharp turns are in "
-        "the model but need steering (path and speed control) to come out.",
+        + (f"free-running samples mostly settle into a steady, moderate walk ({', '.join(run['seed'] for run in standing)} "
+           f"{'stands' if len(standing) == 1 else 'stand'} in place instead: see the stability section). " if standing else
+           "free-running samples settle into a steady, moderate walk. ")
+        + "Faster walking, running and sharp turns are in the model but need steering (path and speed control) to come out.",
         "- NPSS is on a scale set by the real data: two halves of the held-out set differ by the first column's value.",
         "",
     ]
