@@ -15,7 +15,7 @@ from ..models.refiner import Refiner
 from ..onnx.graph import OPSET
 from ..onnx.manifest import register_model
 from ..onnx.sessions import cpu_session
-from ..paths import MODELS_DIR, REPO_ROOT
+from ..paths import DEFAULT_CACHE, MODELS_DIR, REPO_ROOT
 from .graph import INPUTS, OUTPUTS, PARITY_TOLERANCE, export_onnx, parity_error, refiner_from_onnx, step_parity, stream_inputs
 from .training import load_refiner
 
@@ -120,7 +120,7 @@ def export_refiner(checkpoint: Path, out: Path) -> Path:
     export_onnx(model, onnx_path)
 
     # Parity on generator-like frames: the validation streams cached by refiner training when present, else noise.
-    cached = sorted((REPO_ROOT / "cache").glob("refiner_generated_*_s101.npz"))
+    cached = sorted(DEFAULT_CACHE.glob("refiner_generated_*_s101.npz"))
     frames = np.load(cached[0])["x"][:8, :21] if cached else \
         np.random.default_rng(0).normal(scale=0.5, size=(8, 21, model.dim)).astype(np.float32)
     worst = parity_error(model, onnx_path, frames)
