@@ -5,6 +5,20 @@ import { MotionFormatError, type MotionFormat } from './types';
 export const MAX_FRAMES = 1_000_000;
 export const MAX_VALUES = 100_000_000;
 
+/** Longest stretch of the input an error message quotes. */
+export const MAX_QUOTE = 40;
+
+/**
+ * A piece of the input as an error message quotes it: in double quotes, at most `max` characters (then "…"),
+ * with line breaks and other invisible characters (U+2028, controls) shown as escapes, so the message says
+ * what is really there.
+ */
+export function quoteInput(value: string, max = MAX_QUOTE): string {
+  const cut = value.length > max ? value.slice(0, max) : value;
+  const shown = cut.replace(/[\u0000-\u001f\u007f-\u009f\u2028\u2029\ufeff]/g, (c) => `\\u${c.charCodeAt(0).toString(16).padStart(4, '0')}`);
+  return `"${shown}${value.length > max ? '…' : ''}"`;
+}
+
 const NUMBER = /^[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?$/;
 
 /** Rejects empty and binary input before any parsing. */
@@ -39,7 +53,7 @@ export function tokens(line: string): string[] {
 export function parseNumber(token: string, format: MotionFormat, line: number, what = 'a number'): number {
   const v = NUMBER.test(token) ? Number(token) : NaN;
   if (!Number.isFinite(v)) {
-    throw new MotionFormatError(format, `expected ${what}, found "${token.length > 40 ? token.slice(0, 40) + '…' : token}"`, line);
+    throw new MotionFormatError(format, `expected ${what}, found ${quoteInput(token)}`, line);
   }
   return v;
 }

@@ -25,12 +25,20 @@ export interface Skeleton {
 
 export type MotionFormat = 'bvh' | 'amc' | 'asf';
 
-/** Raised for malformed input: says which file kind, where (1-based line if known) and what was expected. */
+/** The longest message a MotionFormatError carries; a longer one is cut (it would quote the file at length). */
+export const MAX_ERROR_MESSAGE = 300;
+
+/**
+ * Raised for malformed input: says which file kind, where (1-based line if known) and what was expected.
+ * The message is at most MAX_ERROR_MESSAGE characters, whatever the parser put in it; quote input with
+ * quoteInput (text.ts) so the useful part survives.
+ */
 export class MotionFormatError extends Error {
   readonly format: MotionFormat;
   readonly line?: number;
   constructor(format: MotionFormat, message: string, line?: number) {
-    super(`${format.toUpperCase()}${line !== undefined ? ` line ${line}` : ''}: ${message}`);
+    const full = `${format.toUpperCase()}${line !== undefined ? ` line ${line}` : ''}: ${message}`;
+    super(full.length > MAX_ERROR_MESSAGE ? `${full.slice(0, MAX_ERROR_MESSAGE - 1)}…` : full);
     this.name = 'MotionFormatError';
     this.format = format;
     this.line = line;
