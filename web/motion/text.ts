@@ -72,3 +72,13 @@ export function parseNumber(token: string, format: MotionFormat, line: number, w
   }
   return v;
 }
+
+/**
+ * parseNumber, then at most `max` in magnitude: a finite value beyond it is absurd for `what` (name the
+ * unit in `what`, e.g. "an angle in degrees") and rejected with the limit.
+ */
+export function parseBounded(token: string, format: MotionFormat, line: number, what: string, max: number): number {
+  const v = parseNumber(token, format, line, what);
+  if (Math.abs(v) > max) throw new MotionFormatError(format, `expected ${what} of at most ${max} in magnitude, found ${quoteInput(token)}`, line);
+  return v;
+}
