@@ -2,6 +2,7 @@ import { describe, expect, it } from 'vitest';
 import { parseAMC, parseASF } from '../../web/motion/asfamc';
 import { readCorpus } from './corpus';
 import { boneLengthDrift, distance, jointIndex, maxHeight, position } from './motionStats';
+import { LINE_ENDINGS } from './fuzz';
 
 const CMU_UNIT = 0.0254 / 0.45;
 
@@ -154,5 +155,40 @@ ${hierarchy}
   end`, '    root b').replace('length 1.0', 'length 0.45').replace('angle deg', 'angle rad');
     const m = parseAMC(`1\nroot 0 0 0 0 0 0\nb ${Math.PI / 2}\n`, text);
     expect(inch(Array.from(m.positions.slice(3, 6)))).toEqual([0, 1, 0]);
+  });
+});
+
+describe('ASF/AMC line breaks and truncation', () => {
+  const asfText = readCorpus('cmu/asf/16.asf');
+  const FIVE_FRAMES = 3 + 30 * 5; // 3 header lines, then a frame number and 29 bone lines per frame
+  const amcText = readCorpus('cmu/amc/16_11.amc.gz').split('\n').slice(0, FIVE_FRAMES).join('\n') + '\n';
+  const skeleton = parseASF(asfText);
+  const reference = parseAMC(amcText, skeleton);
+
+  it('reads CRLF, CR, U+2028 and U+2029 line breaks exactly as LF', () => {
+    expect(reference.frames).toBe(5);
+    for (const [name, lineBreak] of Object.entries(LINE_ENDINGS)) {
+      const m = parseAMC(amcText.replace(/\n/g, lineBreak), asfText.replace(/\n/g, lineBreak));
+      expect(Array.from(m.positions), name).toEqual(Array.from(reference.positions));
+    }
+  });
+
+  it('rejects every cut inside the last frame but one inside its last number (undetectable: docs/api.md)', () => {
+    const lastFrame = amcText.lastIndexOf('\n5\n') + 1;
+    const end = amcText.length;
+    expect(amcText.slice(end - 15)).toBe('\nltoes 3.01279\n');
+    const accepted: number[] = [];
+    for (let cut = lastFrame; cut < end; cut++) {
+      try {
+        const m = parseAMC(amcText.slice(0, cut), skeleton);
+        expect(m.frames).toBe(cut === lastFrame ? 4 : 5);
+        accepted.push(cut);
+      } catch (e) {
+        expect((e as Error).message).toMatch(/^AMC line \d+: /);
+      }
+    }
+    // The clip cut where frame 5 starts reads as four frames; cut after "3", "3.", "3.0", … "3.01279" of
+    // "ltoes 3.01279", the last value reads as the shorter number.
+    expect(accepted).toEqual([lastFrame, end - 7, end - 6, end - 5, end - 4, end - 3, end - 2, end - 1]);
   });
 });

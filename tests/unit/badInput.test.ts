@@ -6,6 +6,8 @@ import { parseAMC, parseASF } from '../../web/motion/asfamc';
 import { importMotion } from '../../web/motion/io';
 import { MotionFormatError } from '../../web/motion/types';
 import { readCorpus } from './corpus';
+import { MAX_JOINTS } from '../../web/motion/validate';
+import { generatedASF, hierarchyParents, parentLinks, seededRandom } from './fuzz';
 
 /** Runs fn, expects a MotionFormatError of that format (and line), returns its message. */
 function formatError(fn: () => unknown, format: 'bvh' | 'amc' | 'asf', line?: number): string {
@@ -141,7 +143,71 @@ describe('bad ASF input', () => {
     expect(formatError(() => parseASF(ASF.replace('length 7.03469', '')), 'asf')).toMatch(/bone starting at line \d+ has no length/);
     expect(formatError(() => parseASF(ASF.replace('lhipjoint lfemur', 'lhipjoint lfemur lwing')), 'asf', 315)).toBe('ASF line 315: :hierarchy names unknown bone "lwing"');
     expect(formatError(() => parseASF(ASF.replace('dof rx ry rz', 'dof rx rq rz')), 'asf')).toMatch(/unknown dof "rq"/);
-    expect(formatError(() => parseASF(ASF.replace('length 7.03469', 'length seven')), 'asf')).toMatch(/expected a bone length, found "seven"/);
+    expect(formatError(() => parseASF(ASF.replace('length 7.03469', 'length seven')), 'asf')).toMatch(/expected a bone length in length units, found "seven"/);
+  });
+
+  it('quotes at most a few dozen characters of a long name or token', () => {
+    const long = 'x'.repeat(5_000_000);
+    const quoted = `"${'x'.repeat(40)}…"`;
+    expect(formatError(() => parseASF(ASF.replace('lhipjoint lfemur', `lhipjoint lfemur ${long}`)), 'asf', 315)).toBe(`ASF line 315: :hierarchy names unknown bone ${quoted}`);
+    expect(formatError(() => parseASF(ASF.replace('dof rx ry rz', `dof rx ${long}`)), 'asf', 31)).toBe(`ASF line 31: unknown dof ${quoted} (expected rx ry rz tx ty tz l)`);
+    expect(formatError(() => parseASF(ASF.replace('axis 0 0 20  XYZ', `axis 0 0 20 ${long}`)), 'asf', 30)).toBe(`ASF line 30: expected an axis order like XYZ, found ${quoted}`);
+    expect(formatError(() => parseASF(ASF.replace('name lfemur', `name ${long}`).replace('name ltibia', `name ${long}`)), 'asf')).toMatch(/^ASF line \d+: duplicate bone name "x{40}…"$/);
+  });
+
+  // Generated skeletons: line 10 is the first bone's "begin" and each bone takes 7 lines (see generatedASF).
+  const boneBeginLine = (bone: number) => 10 + 7 * (bone - 1);
+  const chainLinks = (bones: number) => parentLinks(hierarchyParents(seededRandom(1), 'chain', bones + 1));
+
+  it('rejects more bones than a skeleton may have while reading them, however they are linked', () => {
+    const tooMany = boneBeginLine(MAX_JOINTS);
+    const message = `ASF line ${tooMany}: more than ${MAX_JOINTS - 1} bones (a skeleton has at most ${MAX_JOINTS} joints: the root and ${MAX_JOINTS - 1} bones)`;
+    expect(formatError(() => parseASF(generatedASF(10_000, chainLinks(10_000))), 'asf', tooMany)).toBe(message);
+    expect(formatError(() => parseASF(generatedASF(20_000, [...chainLinks(20_000), [20_000, 1]])), 'asf', tooMany)).toBe(message);
+    expect(formatError(() => parseASF(generatedASF(50_000, parentLinks(hierarchyParents(seededRandom(1), 'wide', 50_001)))), 'asf', tooMany)).toBe(message);
+  });
+
+  it('reads a skeleton at the joint limit: a chain 1023 bones deep', () => {
+    const skeleton = parseASF(generatedASF(MAX_JOINTS - 1, chainLinks(MAX_JOINTS - 1)));
+    expect(skeleton.joints).toHaveLength(MAX_JOINTS);
+    expect(skeleton.parents.every((p, j) => p === j - 1)).toBe(true);
+    let amc = '1\nroot 0 0 0 0 0 0\n';
+    for (let b = 1; b < MAX_JOINTS; b++) amc += `b${b} 0 0 0\n`;
+    const m = parseAMC(amc, skeleton);
+    expect(m.positions[(MAX_JOINTS - 1) * 3 + 1]).toBeCloseTo((MAX_JOINTS - 1) * 0.0254, 5);
+  });
+
+  it('names a bone listed under two parents, and a cycle cut off from the root', () => {
+    // Three bones: :hierarchy is on line 31, "begin" 32, the parent lines from 33.
+    expect(formatError(() => parseASF(generatedASF(3, [[0, 1], [0, 2], [1, 2], [2, 3]])), 'asf', 34)).toBe('ASF line 34: :hierarchy lists bone "b2" under both "root" (line 33) and "b1"');
+    expect(formatError(() => parseASF(generatedASF(3, [[0, 1], [2, 3], [3, 2]])), 'asf', 35)).toBe('ASF line 35: :hierarchy links bone "b2" below itself (a cycle cut off from the root)');
+    expect(formatError(() => parseASF(generatedASF(100, [...chainLinks(100), [100, 1]])), 'asf', 812)).toBe('ASF line 812: :hierarchy lists bone "b1" under both "root" (line 712) and "b100"');
+    expect(formatError(() => parseASF(generatedASF(2, [[0, 1]])), 'asf')).toBe('ASF: bone "b2" is not connected to the root in :hierarchy');
+  });
+
+  it('reads :hierarchy lines of 200,000 names without overflowing the stack', () => {
+    const names = Array.from({ length: 200_000 }, (_, i) => `n${i}`).join(' ');
+    expect(formatError(() => parseASF(ASF.replace('root lhipjoint rhipjoint lowerback', `root lhipjoint rhipjoint lowerback\nroot ${names}`)), 'asf', 315)).toBe('ASF line 315: :hierarchy names unknown bone "n0"');
+  });
+
+  it('rejects repeated dofs and root order entries', () => {
+    expect(formatError(() => parseASF(ASF.replace('dof rx ry rz', 'dof rx ry rx')), 'asf', 31)).toBe('ASF line 31: dof "rx" is listed twice');
+    expect(formatError(() => parseASF(ASF.replace('order TX TY TZ RX RY RZ', 'order TX TY TZ RX RY TX')), 'asf', 13)).toBe('ASF line 13: root order lists "TX" twice');
+  });
+
+  it('rejects absurd but finite units, lengths, angles and positions, naming the limit', () => {
+    expect(formatError(() => parseASF(ASF.replace('length 0.45', 'length 1e-300')), 'asf', 7)).toBe('ASF line 7: expected a length unit L from 0.0001 to 10000 (one unit is 1/L inch), found "1e-300"');
+    expect(formatError(() => parseASF(ASF.replace('length 0.45', 'length 1e300')), 'asf', 7)).toMatch(/expected a length unit L from 0.0001 to 10000/);
+    expect(formatError(() => parseASF(ASF.replace('length 7.03469', 'length 1e300')), 'asf', 29)).toBe('ASF line 29: expected a bone length in length units of at most 10000 in magnitude, found "1e300"');
+    expect(formatError(() => parseASF(ASF.replace('axis 0 0 20  XYZ', 'axis 0 0 1e300 XYZ')), 'asf', 30)).toBe('ASF line 30: expected an axis angle in degrees of at most 1000000 in magnitude, found "1e300"');
+    expect(formatError(() => parseASF(ASF.replace('position 0 0 0', 'position 0 1e300 0')), 'asf', 15)).toBe('ASF line 15: expected a root position in length units of at most 1000000 in magnitude, found "1e300"');
+    expect(formatError(() => parseASF(ASF.replace('orientation 0 0 0', 'orientation 0 0 -1e300').replace('angle deg', 'angle rad')), 'asf', 16)).toBe('ASF line 16: expected a root orientation angle in radians of at most 1000000 in magnitude, found "-1e300"');
+  });
+
+  it('normalises a huge but finite direction instead of overflowing it to zero', () => {
+    const femur = parseASF(ASF.replace('direction 0.34202 -0.939693 0', 'direction 1.5e308 -1.5e308 0')).bones.find((b) => b.name === 'lfemur')!;
+    expect(femur.direction[0]).toBeCloseTo(Math.SQRT1_2, 12);
+    expect(femur.direction[1]).toBeCloseTo(-Math.SQRT1_2, 12);
   });
 });
 
@@ -161,6 +227,19 @@ describe('bad AMC input', () => {
     expect(formatError(() => parseAMC(amcWithLine(10, () => 'tail 1 2 3'), ASF), 'amc', 10)).toBe('AMC line 10: unknown bone "tail" (not in the ASF skeleton)');
   });
 
+  it('quotes at most a few dozen characters of a long bone name or line', () => {
+    expect(formatError(() => parseAMC(amcWithLine(10, () => `${'y'.repeat(5_000_000)} 1 2 3`), ASF), 'amc', 10)).toBe(`AMC line 10: unknown bone "${'y'.repeat(40)}…" (not in the ASF skeleton)`);
+    expect(formatError(() => parseAMC('x'.repeat(20_000_000), ASF), 'amc', 1)).toBe(`AMC line 1: expected a frame number before "${'x'.repeat(40)}…"`);
+    expect(formatError(() => parseAMC(amcWithLine(30, () => `lfemur ${'9'.repeat(1000)}`), ASF), 'amc', 30)).toBe('AMC line 30: expected 3 numbers for "lfemur", found 1');
+  });
+
+  it('rejects absurd but finite angles, translations and frame numbers, naming the limit', () => {
+    expect(formatError(() => parseAMC(amcWithLine(30, () => 'lfemur 1e300 0 0'), ASF), 'amc', 30)).toBe('AMC line 30: expected an angle in degrees of at most 1000000 in magnitude, found "1e300"');
+    expect(formatError(() => parseAMC(amcWithLine(3, () => ':RADIANS').replace('lfemur -18.0782', 'lfemur -2e6'), ASF), 'amc', 30)).toBe('AMC line 30: expected an angle in radians of at most 1000000 in magnitude, found "-2e6"');
+    expect(formatError(() => parseAMC(amcWithLine(5, () => 'root 1e300 17.5143 -32.75 -1.4536 -6.19748 1.72036'), ASF), 'amc', 5)).toBe('AMC line 5: expected a root translation in length units of at most 1000000 in magnitude, found "1e300"');
+    expect(formatError(() => parseAMC(amcWithLine(4, () => '9007199254740993'), ASF), 'amc', 4)).toBe('AMC line 4: expected a frame number of at most 9007199254740991, found "9007199254740993"');
+  });
+
   it('rejects lines with the wrong number of values', () => {
     // Line 30 is "lfemur -18.0782 -1.58962 -24.8838" (dof rx ry rz).
     expect(AMC_LINES[29]).toMatch(/^lfemur /);
@@ -169,8 +248,8 @@ describe('bad AMC input', () => {
   });
 
   it('rejects NaN and non-numeric values', () => {
-    expect(formatError(() => parseAMC(amcWithLine(30, () => 'lfemur NaN 0 0'), ASF), 'amc', 30)).toBe('AMC line 30: expected a number, found "NaN"');
-    expect(formatError(() => parseAMC(amcWithLine(30, () => 'lfemur 1 two 3'), ASF), 'amc', 30)).toBe('AMC line 30: expected a number, found "two"');
+    expect(formatError(() => parseAMC(amcWithLine(30, () => 'lfemur NaN 0 0'), ASF), 'amc', 30)).toBe('AMC line 30: expected an angle in degrees, found "NaN"');
+    expect(formatError(() => parseAMC(amcWithLine(30, () => 'lfemur 1 two 3'), ASF), 'amc', 30)).toBe('AMC line 30: expected an angle in degrees, found "two"');
   });
 
   it('rejects a truncated file (last frame incomplete)', () => {

@@ -136,3 +136,39 @@ export function checkFuzzCase(label: string, parse: () => Motion, inputLength: n
   expect(message.length, `${label}: message of ${message.length} characters: ${message.slice(0, 200)}`).toBeLessThanOrEqual(MAX_ERROR_MESSAGE);
   return 'rejected';
 }
+
+/**
+ * ASF text with bones b1 … b<n−1> (one inch long, pointing up, dofs rx ry rz) and a :hierarchy of the given
+ * parent → child links (joint indices: 0 is the root, j is bone b<j>), one line per parent in first-seen order.
+ */
+export function generatedASF(bones: number, links: ReadonlyArray<readonly [number, number]>): string {
+  const name = (j: number) => (j === 0 ? 'root' : `b${j}`);
+  const boneData: string[] = [];
+  for (let j = 1; j <= bones; j++) boneData.push(`begin\nname b${j}\ndirection 0 1 0\nlength 1\naxis 0 0 0 XYZ\ndof rx ry rz\nend`);
+  const children = new Map<number, number[]>();
+  for (const [parent, child] of links) {
+    const list = children.get(parent);
+    if (list) list.push(child);
+    else children.set(parent, [child]);
+  }
+  const hierarchy = [...children].map(([parent, list]) => `${name(parent)} ${list.map(name).join(' ')}`);
+  return `:units\nlength 1\nangle deg\n:root\norder TX TY TZ RX RY RZ\naxis XYZ\nposition 0 0 0\norientation 0 0 0\n:bonedata\n${boneData.join('\n')}\n:hierarchy\nbegin\n${hierarchy.join('\n')}\nend\n`;
+}
+
+/** The parent → child links of a parents array (as from hierarchyParents). */
+export function parentLinks(parents: readonly number[]): Array<[number, number]> {
+  const links: Array<[number, number]> = [];
+  for (let j = 1; j < parents.length; j++) links.push([parents[j], j]);
+  return links;
+}
+
+/** AMC text for generatedASF's skeleton with `bones` bones: `frames` frames of small rotations. */
+export function generatedAMC(random: Random, bones: number, frames: number): string {
+  const angle = () => (random.next() * 60 - 30).toFixed(3);
+  const lines = [':FULLY-SPECIFIED', ':DEGREES'];
+  for (let f = 1; f <= frames; f++) {
+    lines.push(String(f), `root ${angle()} ${angle()} ${angle()} ${angle()} ${angle()} ${angle()}`);
+    for (let j = 1; j <= bones; j++) lines.push(`b${j} ${angle()} ${angle()} ${angle()}`);
+  }
+  return lines.join('\n') + '\n';
+}

@@ -11,9 +11,23 @@
 // root position = (TX, TY, TZ) + `position`. Joint "lfemur" of the Motion is the END of the femur
 // (the knee); joint "root" is the root position. Translation and length dofs (tx, ty, tz, l) on
 // bones are read but ignored.
+//
+// Limits: at most MAX_JOINTS joints (the root and MAX_JOINTS − 1 bones), checked while reading
+// :bonedata; finite values beyond the bounds below are rejected as absurd, so positions stay finite.
 import { MotionFormatError, type Motion } from './types';
 import { DEG, eulerToQuat, quatConjugate, quatIdentity, quatMultiply, quatRotate, type Quat, type Vec3 } from './math';
-import { MAX_FRAMES, MAX_VALUES, checkText, parseNumber, splitLines, tokens } from './text';
+import { MAX_FRAMES, MAX_VALUES, checkText, parseBounded, parseNumber, parseWork, quoteInput, splitLines, tokens } from './text';
+import { MAX_JOINTS } from './validate';
+
+/** `:units length L` (one length unit is 1/L inch) must lie in [MIN_LENGTH_UNIT, MAX_LENGTH_UNIT]. */
+export const MIN_LENGTH_UNIT = 1e-4;
+export const MAX_LENGTH_UNIT = 1e4;
+/** Largest bone length, in length units. */
+export const MAX_BONE_LENGTH = 1e4;
+/** Largest root position or AMC translation (root TX TY TZ, bone tx ty tz l), in length units. */
+export const MAX_TRANSLATION = 1e6;
+/** Largest angle (axis, orientation, AMC rotation), in the file's angle unit (degrees or radians). */
+export const MAX_ANGLE = 1e6;
 
 export interface AsfBone {
   name: string;
@@ -54,17 +68,32 @@ const ROOT_ORDER_NAMES = new Set(['TX', 'TY', 'TZ', 'RX', 'RY', 'RZ']);
 function axisOrder(token: string | undefined, line: number): string {
   const order = (token ?? '').toUpperCase();
   if (!/^[XYZ]{3}$/.test(order) || new Set(order).size !== 3) {
-    throw new MotionFormatError('asf', `expected an axis order like XYZ, found "${token ?? ''}"`, line);
+    throw new MotionFormatError('asf', `expected an axis order like XYZ, found ${quoteInput(token ?? '')}`, line);
   }
   return order;
 }
 
-function vec3(parts: string[], from: number, line: number, what: string): Vec3 {
+/** Three numbers from parts[from], each at most `max` in magnitude. */
+function vec3(parts: string[], from: number, line: number, what: string, max = Infinity): Vec3 {
   if (parts.length < from + 3) throw new MotionFormatError('asf', `expected 3 numbers for ${what}, found ${Math.max(0, parts.length - from)}`, line);
-  return [parseNumber(parts[from], 'asf', line, what), parseNumber(parts[from + 1], 'asf', line, what), parseNumber(parts[from + 2], 'asf', line, what)];
+  return [parseBounded(parts[from], 'asf', line, what, max), parseBounded(parts[from + 1], 'asf', line, what, max), parseBounded(parts[from + 2], 'asf', line, what, max)];
 }
 
+/** The direction of d as a unit vector (scaled first, so huge components do not overflow); zero stays zero. */
+function unitDirection(d: Vec3): Vec3 {
+  const largest = Math.max(Math.abs(d[0]), Math.abs(d[1]), Math.abs(d[2]));
+  if (largest === 0) return [0, 0, 0];
+  const x = d[0] / largest, y = d[1] / largest, z = d[2] / largest;
+  const n = Math.hypot(x, y, z);
+  return [x / n, y / n, z / n];
+}
+
+const ANGLE_UNIT_NAMES = { deg: 'degrees', rad: 'radians' } as const;
+
+/** :hierarchy lines: parent name → children, with the line that first names the parent. */
 type BoneChildren = Map<string, { names: string[]; line: number }>;
+/** :hierarchy links: bone name → its parent's name, with the line that lists it. */
+type BoneParents = Map<string, { parent: string; line: number }>;
 
 /** What parseASF has read so far: the skeleton, the open section and the bone or block being read. */
 interface AsfReader {
@@ -74,15 +103,16 @@ interface AsfReader {
   sawHierarchy: boolean;
   /** The :bonedata entry between "begin" and "end", with the line of its "begin". */
   bone: (Partial<AsfBone> & { line: number }) | undefined;
+  boneNames: Set<string>;
   inHierarchyBlock: boolean;
-  /** :hierarchy lines: parent name → children, with the line that first names the parent. */
   children: BoneChildren;
+  parentOf: BoneParents;
 }
 
 export function parseASF(text: string): AsfSkeleton {
   checkText(text, 'asf');
   const reader = readASFSections(splitLines(text));
-  orderJoints(reader.skeleton, reader.children);
+  orderJoints(reader.skeleton, reader.children, reader.parentOf);
   return reader.skeleton;
 }
 
@@ -102,8 +132,10 @@ function readASFSections(lines: string[]): AsfReader {
     sawBonedata: false,
     sawHierarchy: false,
     bone: undefined,
+    boneNames: new Set(),
     inHierarchyBlock: false,
     children: new Map(),
+    parentOf: new Map(),
   };
   for (let i = 0; i < lines.length; i++) {
     const lineNo = i + 1;
@@ -141,30 +173,47 @@ function openSection(reader: AsfReader, key: string, parts: string[], lineNo: nu
 function readUnitsLine(skeleton: AsfSkeleton, k: string, parts: string[], lineNo: number): void {
   if (k === 'length') {
     const l = parseNumber(parts[1] ?? '', 'asf', lineNo, 'a length unit');
-    if (!(l > 0)) throw new MotionFormatError('asf', `expected a positive length unit, found ${parts[1]}`, lineNo);
+    if (!(l >= MIN_LENGTH_UNIT && l <= MAX_LENGTH_UNIT)) {
+      throw new MotionFormatError('asf', `expected a length unit L from ${MIN_LENGTH_UNIT} to ${MAX_LENGTH_UNIT} (one unit is 1/L inch), found ${quoteInput(parts[1])}`, lineNo);
+    }
     skeleton.lengthScale = 0.0254 / l;
   } else if (k === 'angle') {
     const unit = (parts[1] ?? '').toLowerCase();
     if (unit.startsWith('deg')) skeleton.angleUnit = 'deg';
     else if (unit.startsWith('rad')) skeleton.angleUnit = 'rad';
-    else throw new MotionFormatError('asf', `expected angle unit "deg" or "rad", found "${parts[1] ?? ''}"`, lineNo);
+    else throw new MotionFormatError('asf', `expected angle unit "deg" or "rad", found ${quoteInput(parts[1] ?? '')}`, lineNo);
   }
+}
+
+/** Each entry of `names` once: the first repeated one, or undefined. */
+function firstRepeat(names: string[]): string | undefined {
+  const seen = new Set<string>();
+  for (const name of names) {
+    if (seen.has(name)) return name;
+    seen.add(name);
+  }
+  return undefined;
 }
 
 function readRootLine(skeleton: AsfSkeleton, k: string, parts: string[], lineNo: number): void {
   if (k === 'order') {
     const order = parts.slice(1).map((p) => p.toUpperCase());
-    for (const o of order) if (!ROOT_ORDER_NAMES.has(o)) throw new MotionFormatError('asf', `unknown root order entry "${o}" (expected TX TY TZ RX RY RZ)`, lineNo);
+    for (const o of order) if (!ROOT_ORDER_NAMES.has(o)) throw new MotionFormatError('asf', `unknown root order entry ${quoteInput(o)} (expected TX TY TZ RX RY RZ)`, lineNo);
+    const repeated = firstRepeat(order);
+    if (repeated) throw new MotionFormatError('asf', `root order lists "${repeated}" twice`, lineNo);
     skeleton.root.order = order;
   } else if (k === 'axis') skeleton.root.axisOrder = axisOrder(parts[1], lineNo);
-  else if (k === 'position') skeleton.root.position = vec3(parts, 1, lineNo, 'the root position');
-  else if (k === 'orientation') skeleton.root.orientation = vec3(parts, 1, lineNo, 'the root orientation');
+  else if (k === 'position') skeleton.root.position = vec3(parts, 1, lineNo, 'a root position in length units', MAX_TRANSLATION);
+  else if (k === 'orientation') skeleton.root.orientation = vec3(parts, 1, lineNo, `a root orientation angle in ${ANGLE_UNIT_NAMES[skeleton.angleUnit]}`, MAX_ANGLE);
 }
 
 /** One :bonedata line: "begin" … "end" around name, direction, length, axis and dof lines. */
 function readBonedataLine(reader: AsfReader, k: string, key: string, parts: string[], lineNo: number): void {
   if (k === 'begin') {
     if (reader.bone) throw new MotionFormatError('asf', `bone starting at line ${reader.bone.line} has no "end"`, lineNo);
+    if (reader.skeleton.bones.length >= MAX_JOINTS - 1) {
+      throw new MotionFormatError('asf', `more than ${MAX_JOINTS - 1} bones (a skeleton has at most ${MAX_JOINTS} joints: the root and ${MAX_JOINTS - 1} bones)`, lineNo);
+    }
     reader.bone = { line: lineNo };
     return;
   }
@@ -174,22 +223,24 @@ function readBonedataLine(reader: AsfReader, k: string, key: string, parts: stri
   }
   const bone = reader.bone;
   if (!bone) {
-    throw new MotionFormatError('asf', `expected "begin" in :bonedata, found "${key}"`, lineNo);
+    throw new MotionFormatError('asf', `expected "begin" in :bonedata, found ${quoteInput(key)}`, lineNo);
   } else if (k === 'name') {
     if (!parts[1]) throw new MotionFormatError('asf', 'expected a bone name', lineNo);
     bone.name = parts[1];
   } else if (k === 'direction') {
     bone.direction = vec3(parts, 1, lineNo, 'the bone direction');
   } else if (k === 'length') {
-    const len = parseNumber(parts[1] ?? '', 'asf', lineNo, 'a bone length');
-    if (len < 0) throw new MotionFormatError('asf', `expected a non-negative bone length, found ${len}`, lineNo);
+    const len = parseBounded(parts[1] ?? '', 'asf', lineNo, 'a bone length in length units', MAX_BONE_LENGTH);
+    if (len < 0) throw new MotionFormatError('asf', `expected a non-negative bone length, found ${quoteInput(parts[1])}`, lineNo);
     bone.length = len;
   } else if (k === 'axis') {
-    bone.axis = vec3(parts, 1, lineNo, 'the bone axis');
+    bone.axis = vec3(parts, 1, lineNo, `an axis angle in ${ANGLE_UNIT_NAMES[reader.skeleton.angleUnit]}`, MAX_ANGLE);
     bone.axisOrder = axisOrder(parts[4], lineNo);
   } else if (k === 'dof') {
     const dof = parts.slice(1).map((d) => d.toLowerCase());
-    for (const d of dof) if (!DOF_NAMES.has(d)) throw new MotionFormatError('asf', `unknown dof "${d}" (expected rx ry rz tx ty tz l)`, lineNo);
+    for (const d of dof) if (!DOF_NAMES.has(d)) throw new MotionFormatError('asf', `unknown dof ${quoteInput(d)} (expected rx ry rz tx ty tz l)`, lineNo);
+    const repeated = firstRepeat(dof);
+    if (repeated) throw new MotionFormatError('asf', `dof "${repeated}" is listed twice`, lineNo);
     bone.dof = dof;
   }
   // id, limits (and their continuation lines), bodymass, cofmass: not needed.
@@ -202,14 +253,12 @@ function finishBone(reader: AsfReader, endLine: number): void {
   for (const field of ['name', 'direction', 'length'] as const) {
     if (bone[field] === undefined) throw new MotionFormatError('asf', `bone starting at line ${bone.line} has no ${field}`, endLine);
   }
-  const bones = reader.skeleton.bones;
   const name = bone.name!;
-  if (name === 'root' || bones.some((b) => b.name === name)) throw new MotionFormatError('asf', `duplicate bone name "${name}"`, bone.line);
-  const d = bone.direction!;
-  const n = Math.hypot(d[0], d[1], d[2]);
-  bones.push({
+  if (name === 'root' || reader.boneNames.has(name)) throw new MotionFormatError('asf', `duplicate bone name ${quoteInput(name)}`, bone.line);
+  reader.boneNames.add(name);
+  reader.skeleton.bones.push({
     name,
-    direction: n > 0 ? [d[0] / n, d[1] / n, d[2] / n] : [0, 0, 0],
+    direction: unitDirection(bone.direction!),
     length: bone.length!,
     axis: bone.axis ?? [0, 0, 0],
     axisOrder: bone.axisOrder ?? 'XYZ',
@@ -218,36 +267,59 @@ function finishBone(reader: AsfReader, endLine: number): void {
   reader.bone = undefined;
 }
 
-/** One :hierarchy line: "begin", "end", or "parent child1 child2 …" inside the block. */
+/**
+ * One :hierarchy line: "begin", "end", or "parent child1 child2 …" inside the block. A bone is listed
+ * under one parent only, so the links form a tree from the root (and perhaps cycles cut off from it).
+ */
 function readHierarchyLine(reader: AsfReader, k: string, key: string, parts: string[], lineNo: number): void {
   if (k === 'begin') reader.inHierarchyBlock = true;
   else if (k === 'end') reader.inHierarchyBlock = false;
   else {
-    if (!reader.inHierarchyBlock) throw new MotionFormatError('asf', `expected "begin" in :hierarchy, found "${key}"`, lineNo);
-    const entry = reader.children.get(key);
-    if (entry) entry.names.push(...parts.slice(1));
-    else reader.children.set(key, { names: parts.slice(1), line: lineNo });
+    if (!reader.inHierarchyBlock) throw new MotionFormatError('asf', `expected "begin" in :hierarchy, found ${quoteInput(key)}`, lineNo);
+    let entry = reader.children.get(key);
+    if (!entry) reader.children.set(key, (entry = { names: [], line: lineNo }));
+    for (let c = 1; c < parts.length; c++) {
+      const child = parts[c];
+      const listed = reader.parentOf.get(child);
+      if (listed) {
+        throw new MotionFormatError('asf', `:hierarchy lists bone ${quoteInput(child)} under both ${quoteInput(listed.parent)} (line ${listed.line}) and ${quoteInput(key)}`, lineNo);
+      }
+      reader.parentOf.set(child, { parent: key, line: lineNo });
+      entry.names.push(child);
+    }
   }
 }
 
 /** Fills skeleton.joints and .parents depth first from the root, children in the order listed. */
-function orderJoints(skeleton: AsfSkeleton, children: BoneChildren): void {
+function orderJoints(skeleton: AsfSkeleton, children: BoneChildren, parentOf: BoneParents): void {
   const known = new Set(skeleton.bones.map((b) => b.name));
   for (const [parent, { names, line }] of children) {
-    if (parent !== 'root' && !known.has(parent)) throw new MotionFormatError('asf', `:hierarchy names unknown bone "${parent}"`, line);
-    for (const c of names) if (!known.has(c)) throw new MotionFormatError('asf', `:hierarchy names unknown bone "${c}"`, line);
+    if (parent !== 'root' && !known.has(parent)) throw new MotionFormatError('asf', `:hierarchy names unknown bone ${quoteInput(parent)}`, line);
+    for (const c of names) if (!known.has(c)) throw new MotionFormatError('asf', `:hierarchy names unknown bone ${quoteInput(c)}`, parentOf.get(c)!.line);
   }
-  const visit = (name: string, parent: number) => {
-    if (skeleton.joints.includes(name)) throw new MotionFormatError('asf', `:hierarchy lists bone "${name}" twice or in a cycle`, children.get(name)?.line);
+  // Every bone has at most one parent and the root none, so this walk meets each joint once.
+  const stack: Array<{ name: string; parent: number }> = [{ name: 'root', parent: -1 }];
+  while (stack.length > 0) {
+    const { name, parent } = stack.pop()!;
     const index = skeleton.joints.length;
     skeleton.joints.push(name);
     skeleton.parents.push(parent);
-    for (const c of children.get(name)?.names ?? []) visit(c, index);
-  };
-  visit('root', -1);
-  for (const b of skeleton.bones) {
-    if (!skeleton.joints.includes(b.name)) throw new MotionFormatError('asf', `bone "${b.name}" is not connected to the root in :hierarchy`);
+    parseWork.steps++;
+    const names = children.get(name)?.names ?? [];
+    for (let c = names.length - 1; c >= 0; c--) stack.push({ name: names[c], parent: index });
   }
+  if (skeleton.joints.length === skeleton.bones.length + 1) return;
+  const placed = new Set(skeleton.joints);
+  const cutOff = skeleton.bones.find((b) => !placed.has(b.name))!.name;
+  // Up from a bone the walk missed: the links end at a bone without a parent, or go round a cycle.
+  const above = new Set<string>();
+  let name = cutOff;
+  while (parentOf.has(name) && !above.has(name)) {
+    above.add(name);
+    name = parentOf.get(name)!.parent;
+  }
+  if (above.has(name)) throw new MotionFormatError('asf', `:hierarchy links bone ${quoteInput(name)} below itself (a cycle cut off from the root)`, parentOf.get(name)!.line);
+  throw new MotionFormatError('asf', `bone ${quoteInput(cutOff)} is not connected to the root in :hierarchy`);
 }
 
 export interface AMCOptions {
@@ -263,6 +335,8 @@ interface JointKinematics {
   /** Axis letters of the rotation dofs in value order, and where each value sits in the bone's line. */
   rotAxes: string;
   rotSlots: number[];
+  /** What each value of the bone's line is, for the bound it must keep: a rotation (angle) or not. */
+  valueIsAngle: boolean[];
   valueCount: number;
   firstValue: number; // index of the first value in a frame vector
 }
@@ -304,6 +378,7 @@ function jointKinematics(skeleton: AsfSkeleton): { kin: JointKinematics[]; value
       offset: bone ? [bone.direction[0] * bone.length * skeleton.lengthScale, bone.direction[1] * bone.length * skeleton.lengthScale, bone.direction[2] * bone.length * skeleton.lengthScale] : [0, 0, 0],
       rotAxes,
       rotSlots,
+      valueIsAngle: dof.map((d) => d[0] === 'r'),
       valueCount: dof.length,
       firstValue: valuesPerFrame,
     };
@@ -334,7 +409,7 @@ function readAMCFrames(
     for (let j = 0; j < J; j++) {
       if (!seen[j] && kin[j].valueCount > 0) {
         const hint = atEnd ? ' (file truncated?)' : '';
-        throw new MotionFormatError('amc', `frame ${expectedNumber - 1} has no values for "${skeleton.joints[j]}"${hint}`, currentLine);
+        throw new MotionFormatError('amc', `frame ${expectedNumber - 1} has no values for ${quoteInput(skeleton.joints[j])}${hint}`, currentLine);
       }
     }
     frameValues.push(current);
@@ -353,6 +428,7 @@ function readAMCFrames(
     const parts = tokens(trimmed);
     if (parts.length === 1 && /^\d+$/.test(parts[0])) {
       const n = Number(parts[0]);
+      if (n > Number.MAX_SAFE_INTEGER) throw new MotionFormatError('amc', `expected a frame number of at most ${Number.MAX_SAFE_INTEGER}, found ${quoteInput(parts[0])}`, lineNo);
       if (expectedNumber >= 0 && n !== expectedNumber) {
         throw new MotionFormatError('amc', `expected frame number ${expectedNumber}, found ${n}`, lineNo);
       }
@@ -365,11 +441,11 @@ function readAMCFrames(
       currentLine = lineNo;
       continue;
     }
-    if (!current) throw new MotionFormatError('amc', `expected a frame number before "${parts[0]}"`, lineNo);
+    if (!current) throw new MotionFormatError('amc', `expected a frame number before ${quoteInput(parts[0])}`, lineNo);
     const j = jointIndex.get(parts[0]);
-    if (j === undefined) throw new MotionFormatError('amc', `unknown bone "${parts[0]}" (not in the ASF skeleton)`, lineNo);
-    if (seen[j]) throw new MotionFormatError('amc', `bone "${parts[0]}" appears twice in frame ${expectedNumber - 1}`, lineNo);
-    readBoneValues(kin[j], parts, current, lineNo);
+    if (j === undefined) throw new MotionFormatError('amc', `unknown bone ${quoteInput(parts[0])} (not in the ASF skeleton)`, lineNo);
+    if (seen[j]) throw new MotionFormatError('amc', `bone ${quoteInput(parts[0])} appears twice in frame ${expectedNumber - 1}`, lineNo);
+    readBoneValues(kin[j], parts, current, lineNo, angleUnit);
     seen[j] = 1;
   }
   closeFrame(true);
@@ -377,12 +453,19 @@ function readAMCFrames(
   return { frameValues, angleUnit };
 }
 
-/** A "bone v1 v2 …" line: its values into the bone's slots of the frame vector. */
-function readBoneValues(k: JointKinematics, parts: string[], frame: Float64Array, lineNo: number): void {
+const AMC_ANGLE = { deg: 'an angle in degrees', rad: 'an angle in radians' } as const;
+
+/** A "bone v1 v2 …" line: its values into the bone's slots of the frame vector, each within its bound. */
+function readBoneValues(k: JointKinematics, parts: string[], frame: Float64Array, lineNo: number, angleUnit: 'deg' | 'rad'): void {
   if (parts.length - 1 !== k.valueCount) {
-    throw new MotionFormatError('amc', `expected ${k.valueCount} numbers for "${parts[0]}", found ${parts.length - 1}`, lineNo);
+    throw new MotionFormatError('amc', `expected ${k.valueCount} numbers for ${quoteInput(parts[0])}, found ${parts.length - 1}`, lineNo);
   }
-  for (let v = 0; v < k.valueCount; v++) frame[k.firstValue + v] = parseNumber(parts[v + 1], 'amc', lineNo);
+  const translation = k.bone ? 'a bone translation or length in length units' : 'a root translation in length units';
+  for (let v = 0; v < k.valueCount; v++) {
+    frame[k.firstValue + v] = k.valueIsAngle[v]
+      ? parseBounded(parts[v + 1], 'amc', lineNo, AMC_ANGLE[angleUnit], MAX_ANGLE)
+      : parseBounded(parts[v + 1], 'amc', lineNo, translation, MAX_TRANSLATION);
+  }
 }
 
 /** Axis rotations C (and C⁻¹), in the ASF's own angle unit. */
@@ -412,6 +495,7 @@ function amcPositions(skeleton: AsfSkeleton, kin: JointKinematics[], frameValues
   const parents = skeleton.parents;
   for (let f = 0; f < frames; f++) {
     const values = frameValues[f];
+    parseWork.steps += J;
     for (let j = 0; j < J; j++) {
       const k = kin[j];
       const angles = k.rotSlots.map((slot) => values[k.firstValue + slot] * motionAngle);
