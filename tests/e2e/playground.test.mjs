@@ -245,6 +245,33 @@ describe('motion playground page', { timeout: 150_000 }, () => {
     assert.ok(same, 'download equals exportBVH(current())');
   });
 
+  test('importMotion parses in the import worker: the motion comes back whole, a parser error keeps its name', async () => {
+    const r = await page.evaluate(async ({ bvh, SUMMARY }) => {
+      const posted = [];
+      const native = Worker.prototype.postMessage;
+      Worker.prototype.postMessage = function (message, transfer) {
+        posted.push(message?.type);
+        return native.call(this, message, transfer);
+      };
+      try {
+        const m = await window.playground.importMotion(bvh, 'bvh');
+        const error = await window.playground.importMotion(bvh.replace(/Frame Time:.*/, 'Frame Time: fast'), 'bvh').catch((e) => e);
+        return {
+          posted,
+          motion: eval(SUMMARY)(m),
+          typed: m.positions instanceof Float32Array && m.contacts instanceof Uint8Array,
+          error: { name: error.name, message: error.message, cause: error.cause?.name },
+        };
+      } finally {
+        Worker.prototype.postMessage = native;
+      }
+    }, { bvh: text.bvh, SUMMARY });
+    assert.deepEqual(r.posted, ['text', 'text']);
+    assert.deepEqual([r.motion.frames, r.motion.joints[0], r.motion.n, r.typed], [450, 'Hips', 450 * r.motion.joints.length * 3, true]);
+    assert.deepEqual([r.error.name, r.error.cause], ['MotionFormatError', 'MotionFormatError']);
+    assert.match(r.error.message, /^importMotion: BVH line 187: .*"fast"/);
+  });
+
   describe('bad input is refused with a clear message and the scene stays', () => {
     const lines = () => text.bvh.split('\n');
     const cases = [
@@ -399,6 +426,53 @@ describe('motion playground page', { timeout: 150_000 }, () => {
       await drop([{ name: '16_12.amc', text: amc12 }]);
       await waitFrames(441);
       assert.equal((await page.locator('#clip-name').textContent()), '16_12.amc');
+    });
+
+    test('a large drop is read and parsed in a worker and shows its progress; a broken one gives the parser\'s message', async () => {
+      // 07_04 with its MOTION section repeated to about 3 MB (over the 1 MB that shows progress), plain and gzipped.
+      const lines = text.bvh.split('\n');
+      const motion = lines.findIndex((l) => l.trim() === 'MOTION');
+      const frameLines = lines.slice(motion + 3).filter((l) => l.trim());
+      const copies = 10, frames = frameLines.length * copies;
+      const big = [...lines.slice(0, motion), 'MOTION', `Frames: ${frames}`, lines[motion + 2], ''].join('\n') + (frameLines.join('\n') + '\n').repeat(copies);
+      assert.ok(big.length > 3e6, `${big.length} bytes`);
+      await page.evaluate(() => {
+        // What the page posts to workers, and the import indicator's stages and visibility as they change.
+        window.posted = [];
+        window.nativePostMessage = Worker.prototype.postMessage;
+        Worker.prototype.postMessage = function (message, transfer) {
+          window.posted.push({ type: message?.type, files: Array.isArray(message?.files) ? message.files.map((f) => f.name) : undefined });
+          return window.nativePostMessage.call(this, message, transfer);
+        };
+        const status = document.getElementById('import-status');
+        window.importSeen = [];
+        window.importWatch = new MutationObserver(() => window.importSeen.push(status.hidden ? 'hidden' : status.dataset.stage));
+        window.importWatch.observe(status, { attributes: true, attributeFilter: ['hidden', 'data-stage'] });
+      });
+      const seen = async () => (await page.evaluate(() => window.importSeen.splice(0))).filter((s, i, all) => s !== all[i - 1]);
+      try {
+        await drop([{ name: 'long.bvh', text: big }]);
+        await waitFrames(frames);
+        assert.deepEqual(await page.evaluate(() => window.posted.filter((p) => p.type === 'files')), [{ type: 'files', files: ['long.bvh'] }]);
+        assert.deepEqual(await seen(), ['read', 'parse', 'hidden']);
+        assert.equal(await page.locator('#clip-name').textContent(), 'long.bvh');
+
+        await drop([{ name: 'long.bvh.gz', base64: gzipSync(Buffer.from(big)).toString('base64') }]);
+        await waitFrames(frames);
+        assert.deepEqual(await seen(), ['read', 'decompress', 'parse', 'hidden']);
+
+        const shown = await currentSummary();
+        await drop([{ name: 'cut.bvh', text: big.slice(0, 2_000_000) + 'junk\n' }]);
+        await waitUntil(page, () => /^Could not import cut\.bvh: BVH line \d+: /.test(window.playground.lastError() ?? ''), null, { message: 'the broken large drop is reported' });
+        assert.deepEqual(await seen(), ['read', 'parse', 'hidden']);
+        assert.deepEqual(await currentSummary(), shown, 'the scene stays');
+        assert.equal(await page.locator('#import-status').isHidden(), true);
+      } finally {
+        await page.evaluate(() => {
+          Worker.prototype.postMessage = window.nativePostMessage;
+          window.importWatch.disconnect();
+        });
+      }
     });
 
     test('a broken drop shows a message and keeps the scene', async () => {

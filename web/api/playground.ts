@@ -4,7 +4,7 @@
 
 import { exportBVH as exportBVHText } from '../motion/bvh';
 import { detectContacts } from '../motion/contacts';
-import { importMotion as importMotionText, validateMotion } from '../motion/io';
+import { validateMotion } from '../motion/io';
 import type { Motion } from '../motion/types';
 import type { PlaybackState } from '../viewer/playback';
 import type { RenderStats } from '../viewer/viewer';
@@ -322,15 +322,11 @@ export function createPlayground(app: App): Playground {
     models: () => models.map((m) => ({ ...m, ...(m.styles ? { styles: [...m.styles] } : {}) })),
 
     importMotion(text, format, asfText) {
-      return new Promise<Motion>((resolve) => {
-        resolve(
-          guarded('importMotion', () => {
-            if (typeof text !== 'string') throw new TypeError(`text must be a string, got ${text === null ? 'null' : typeof text}`);
-            if (format !== 'bvh' && format !== 'amc') throw new TypeError(`format must be "bvh" or "amc", got ${JSON.stringify(format)}`);
-            if (format === 'amc' && typeof asfText !== 'string') throw new TypeError('an AMC motion needs its skeleton: pass the ASF file text as asfText');
-            return importMotionText(text, format, asfText);
-          }),
-        );
+      return guardedAsync('importMotion', async () => {
+        if (typeof text !== 'string') throw new TypeError(`text must be a string, got ${text === null ? 'null' : typeof text}`);
+        if (format !== 'bvh' && format !== 'amc') throw new TypeError(`format must be "bvh" or "amc", got ${JSON.stringify(format)}`);
+        if (format === 'amc' && typeof asfText !== 'string') throw new TypeError('an AMC motion needs its skeleton: pass the ASF file text as asfText');
+        return app.importer.importText(text, format, format === 'amc' ? asfText : undefined); // parsed in the import worker
       });
     },
 

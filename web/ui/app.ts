@@ -3,12 +3,13 @@
 
 import { detectContacts } from '../motion/contacts';
 import { exportBVH } from '../motion/bvh';
-import { importMotion } from '../motion/io';
 import type { Motion } from '../motion/types';
 import { Viewer } from '../viewer/viewer';
-import { baseName, readTextFile, type TextFile } from './files';
 import { DanceClient, type DanceInitResult } from '../runtime/danceClient';
 import { GeneratorClient, type InitResult } from '../runtime/generatorClient';
+import { ImportClient } from '../runtime/importClient';
+import { baseName, type FileImportOutcome } from '../runtime/motionFiles';
+import { ImportIndicator } from './files';
 import { $, downloadText, errorMessage } from './dom';
 import { BusyIndicator, ModelHost, pageThreads } from './modelHost';
 import { DanceMode } from './modes/danceMode';
@@ -31,8 +32,10 @@ export class App implements ModeHost {
   /** The generator model, loaded on first use (playground.generate, Random walk). */
   readonly generator = new ModelHost<GeneratorClient, InitResult>(() => new GeneratorClient({ threads: pageThreads() }), this.busy);
   private readonly danceHosts = new Map<string, ModelHost<DanceClient, DanceInitResult>>();
+  /** Parses imports off the page thread (dropped and picked files, playground.importMotion). */
+  readonly importer = new ImportClient();
+  private readonly importIndicator = new ImportIndicator();
   private name = '';
-  private lastAsf: TextFile | null = null;
   private lastErrorMessage: string | null = null;
   private readonly exportBtn = $<HTMLButtonElement>('export-btn');
   readonly walk: RandomWalk;
@@ -218,49 +221,25 @@ export class App implements ModeHost {
     }
   }
 
-  /** Imports dropped or picked files: one .bvh, or an .amc with its .asf (dropped together or the .asf first). */
+  /**
+   * Imports dropped or picked files in the import worker: one .bvh, or an .amc with its .asf (dropped
+   * together or the .asf first). Large ones show their progress; a failure leaves the scene as it was.
+   */
   async handleFiles(files: File[]): Promise<void> {
-    let read: TextFile[];
+    const bytes = files.reduce((sum, f) => sum + f.size, 0);
+    let outcome: FileImportOutcome;
     try {
-      read = await Promise.all(files.map((f) => readTextFile(f)));
+      outcome = await this.importIndicator.track(bytes, (onProgress) => this.importer.importFiles(files, onProgress));
     } catch (e) {
       this.reportError(errorMessage(e));
       return;
     }
-    const unknown = read.filter((f) => f.kind === null);
-    const asfs = read.filter((f) => f.kind === 'asf');
-    const motions = read.filter((f) => f.kind === 'bvh' || f.kind === 'amc');
-    if (unknown.length && !motions.length && !asfs.length) {
-      this.reportError(`Unsupported file ${unknown.map((f) => `"${f.name}"`).join(', ')}: drop a .bvh, or an .asf with an .amc (gzipped .gz files are fine).`);
+    if (outcome.kind === 'skeleton') {
+      this.note(`Skeleton ${outcome.name} loaded: now drop an .amc motion for it.`);
       return;
     }
-    if (!motions.length) {
-      this.lastAsf = asfs[asfs.length - 1];
-      this.note(`Skeleton ${this.lastAsf.name} loaded: now drop an .amc motion for it.`);
-      return;
-    }
-    const file = motions[0];
-    let asf: TextFile | null = null;
-    if (file.kind === 'amc') {
-      // Prefer the subject's skeleton by CMU naming (16_11.amc ↔ 16.asf), else the last one dropped.
-      const subject = baseName(file.name).split('_')[0];
-      asf = asfs.find((a) => baseName(a.name) === subject) ?? asfs[asfs.length - 1] ?? this.lastAsf;
-      if (!asf) {
-        this.reportError(`${file.name} needs its skeleton: drop the subject's .asf file together with the .amc (or before it).`);
-        return;
-      }
-    }
-    if (asfs.length) this.lastAsf = asf && asfs.includes(asf) ? asf : asfs[asfs.length - 1];
-    let motion: Motion;
-    try {
-      motion = importMotion(file.text, file.kind as 'bvh' | 'amc', asf?.text);
-    } catch (e) {
-      this.reportError(`Could not import ${file.name}${asf ? ` (skeleton ${asf.name})` : ''}: ${errorMessage(e)}`);
-      return;
-    }
-    this.show(motion, file.name);
-    const ignored = [...motions.slice(1), ...unknown].map((f) => f.name);
-    if (ignored.length) this.note(`Showing ${file.name}; ignored ${ignored.join(', ')}.`);
+    this.show(outcome.motion, outcome.name);
+    if (outcome.ignored.length) this.note(`Showing ${outcome.name}; ignored ${outcome.ignored.join(', ')}.`);
   }
 
   private installDropZone(): void {

@@ -1,58 +1,40 @@
-// Reading dropped or picked files: gzip by magic number or .gz suffix, kind by extension or content.
+// The page's part of importing dropped or picked files (read and parsed in the import worker:
+// runtime/importClient.ts, runtime/motionFiles.ts): the progress shown while a large import runs.
+import type { ImportProgress, ProgressListener } from '../runtime/motionFiles';
+import { $ } from './dom';
 
-export type FileKind = 'bvh' | 'amc' | 'asf';
+/** Imports of at least this many bytes (the files together, as given) show their progress. */
+export const LARGE_IMPORT_BYTES = 1_000_000;
 
-export interface TextFile {
-  /** File name without a trailing .gz. */
-  name: string;
-  kind: FileKind | null;
-  text: string;
-}
+const STAGE_NAMES: Record<ImportProgress['stage'], string> = { read: 'Reading', decompress: 'Decompressing', parse: 'Parsing' };
 
-/** Largest file read (after decompression); bigger ones are refused before parsing. */
-export const MAX_FILE_BYTES = 256 * 1024 * 1024;
+/**
+ * The "Reading 07_04.bvh… 40 %" indicator beside the model status: shown while at least one large import
+ * runs; `data-stage` is the latest stage reported ("read", "decompress", "parse").
+ */
+export class ImportIndicator {
+  private readonly element = $('import-status');
+  private readonly label = $('import-stage');
+  private readonly bar = $<HTMLProgressElement>('import-progress');
+  private running = 0;
 
-function isGzip(bytes: Uint8Array): boolean {
-  return bytes.length >= 2 && bytes[0] === 0x1f && bytes[1] === 0x8b;
-}
-
-async function gunzip(bytes: Uint8Array, name: string): Promise<Uint8Array> {
-  if (typeof DecompressionStream === 'undefined') throw new Error(`${name}: this browser cannot decompress gzip files`);
-  try {
-    const stream = new Blob([bytes as BlobPart]).stream().pipeThrough(new DecompressionStream('gzip'));
-    return new Uint8Array(await new Response(stream).arrayBuffer());
-  } catch {
-    throw new Error(`${name}: not a valid gzip file (decompression failed)`);
+  /** Runs an import of `bytes` bytes, showing the progress it reports when it is large. */
+  async track<T>(bytes: number, run: (onProgress?: ProgressListener) => Promise<T>): Promise<T> {
+    if (bytes < LARGE_IMPORT_BYTES) return run();
+    this.running++;
+    this.show({ stage: 'read', file: '', fraction: 0 });
+    this.element.hidden = false;
+    try {
+      return await run((progress) => this.show(progress));
+    } finally {
+      if (--this.running === 0) this.element.hidden = true;
+    }
   }
-}
 
-export function kindFromName(name: string): FileKind | null {
-  const m = /\.(bvh|amc|asf)$/i.exec(name.replace(/\.gz$/i, ''));
-  return m ? (m[1].toLowerCase() as FileKind) : null;
-}
-
-/** Guesses the kind from the first non-comment line when the name does not tell. */
-export function kindFromText(text: string): FileKind | null {
-  const head = text.slice(0, 4096).split(/\r\n|\n|\r/).map((l) => l.trim()).filter((l) => l && !l.startsWith('#'));
-  const first = head[0] ?? '';
-  if (/^HIERARCHY\b/i.test(first)) return 'bvh';
-  if (head.some((l) => /^:(FULLY-SPECIFIED|DEGREES|RADIANS)\b/i.test(l)) && !head.some((l) => /^:(root|bonedata)\b/i.test(l))) return 'amc';
-  if (head.some((l) => /^:(version|root|bonedata|units)\b/i.test(l))) return 'asf';
-  return null;
-}
-
-export async function readTextFile(file: File): Promise<TextFile> {
-  if (file.size > MAX_FILE_BYTES) throw new Error(`${file.name}: file too large (${(file.size / 1e6).toFixed(0)} MB)`);
-  let bytes: Uint8Array = new Uint8Array(await file.arrayBuffer());
-  const gz = isGzip(bytes) || /\.gz$/i.test(file.name);
-  if (gz) bytes = await gunzip(bytes, file.name);
-  if (bytes.length > MAX_FILE_BYTES) throw new Error(`${file.name}: file too large once decompressed`);
-  const text = new TextDecoder('utf-8').decode(bytes);
-  const name = file.name.replace(/\.gz$/i, '');
-  return { name, kind: kindFromName(name) ?? kindFromText(text), text };
-}
-
-/** Base name without directory or extension ("16_11.amc" → "16_11"). */
-export function baseName(name: string): string {
-  return name.replace(/^.*[\\/]/, '').replace(/\.gz$/i, '').replace(/\.[^.]*$/, '');
+  private show({ stage, file, fraction }: ImportProgress): void {
+    this.element.dataset.stage = stage;
+    this.label.textContent = `${STAGE_NAMES[stage]}${file ? ` ${file}` : ''}…${fraction === undefined ? '' : ` ${Math.round(fraction * 100)} %`}`;
+    if (fraction === undefined) this.bar.removeAttribute('value'); // indeterminate: parsing reports no share
+    else this.bar.value = fraction;
+  }
 }
