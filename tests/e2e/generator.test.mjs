@@ -130,7 +130,7 @@ describe('generator in the page', { timeout: 240_000 }, () => {
     assert.match(m[3], /frames must be an integer/);
     assert.match(m[4], /^generate: temperature must be a number from 0 to 2, got 3/);
     assert.match(m[5], /temperature must be a number from 0 to 2/);
-    assert.match(m[6], /^generate: refine must be true or false, got yes/);
+    assert.match(m[6], /^generate: refine must be true or false, got "yes"/);
     assert.match(m[7], /seed must be an integer/);
     assert.match(m[8], /unknown option "colour"/);
     assert.match(m[9], /options must be an object/);

@@ -131,7 +131,7 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
       const one = await pg.generate({ model: 'generator', frames: 1, seed: 1, refine: true });
       return { messages, unchanged: pg.current() === before, frames: pg.state().frames, one: { frames: one.frames, contacts: one.contacts.length, finite: Array.from(one.positions).every(Number.isFinite) } };
     });
-    assert.match(r.messages[0], /^generate: refine must be true or false, got yes/);
+    assert.match(r.messages[0], /^generate: refine must be true or false, got "yes"/);
     assert.match(r.messages[1], /refine must be true or false, got 1/);
     assert.match(r.messages[2], /refine must be true or false, got null/);
     assert.equal(r.unchanged, true, 'current() is unchanged');

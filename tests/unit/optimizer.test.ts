@@ -6,7 +6,9 @@ import { GeneratorCore } from '../../web/runtime/generatorCore';
 import { parseGeneratorInfo } from '../../web/model/generatorInfo';
 import { footSkating } from '../../web/motion/footSkating';
 import { checkSchedule, LiveController, simulateControl } from '../../web/optimizer/liveControl';
-import { angleDifference, GroundPath } from '../../web/optimizer/path';
+import { angleDifference, GroundPath, type GroundPoint } from '../../web/optimizer/path';
+import { OptimizerRequests } from '../../web/runtime/optimizerRequests';
+import type { FollowPathParams } from '../../web/runtime/protocol';
 import { followPath } from '../../web/optimizer/pathFollower';
 import { rollout, type SteerRequest, type Variables } from '../../web/optimizer/rollout';
 import { readRepoFile } from './corpus';
@@ -82,6 +84,34 @@ describe('followPath', () => {
     const m = { fps: 30, frames: a.frames, joints: info.skeleton.joints, parents: info.skeleton.parents, positions: a.positions, contacts: a.contacts };
     expect(footSkating(m)).toBeLessThan(2); // m/s; a sliding, unconstrained root would be far above
   }, 60000);
+});
+
+describe('followPath requests (the worker side)', () => {
+  const shape: GroundPoint[] = [[0, 0], [0, 2], [1.5, 3.5]];
+  const request = (points: GroundPoint[]): FollowPathParams => ({ points, gait: 'walk', seed: 3 });
+  const ignore = () => undefined;
+
+  it('give the same motion wherever the path lies, moved there', async () => {
+    const requests = new OptimizerRequests(core);
+    const [dx, dz] = [9000, -7000]; // near the ±10 km limit; exact in float64, so the moved path is the same shape
+    const here = await requests.followPath(request(shape), ignore);
+    const there = await requests.followPath(request(shape.map(([x, z]) => [x + dx, z + dz])), ignore);
+    expect(bytes(there.features)).toEqual(bytes(here.features));
+    expect(bytes(there.contacts)).toEqual(bytes(here.contacts));
+    const { optimizeMs: _h, ...hereStats } = here.stats;
+    const { optimizeMs: _t, ...thereStats } = there.stats;
+    expect(thereStats).toEqual(hereStats);
+    const moved = (values: Float32Array, stride: number, zAt: number) => Array.from(values, (v, i) => Math.fround(v + (i % stride === 0 ? dx : i % stride === zAt ? dz : 0)));
+    expect(Array.from(there.positions)).toEqual(moved(here.positions, 3, 2));
+    expect(Array.from(there.path)).toEqual(moved(here.path, 2, 1));
+  }, 120000);
+
+  it('refuse coordinates float32 positions cannot hold, before optimising', async () => {
+    const requests = new OptimizerRequests(core);
+    for (const far of [1e300, 1e15, 1e5]) {
+      await expect(requests.followPath(request(shape.map(([x, z]) => [x + far, z])), ignore)).rejects.toThrow(/^points\[0\] .* is too far out: x and z must be within ±10000 m/);
+    }
+  });
 });
 
 describe('LiveController', () => {

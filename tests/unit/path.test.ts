@@ -1,7 +1,7 @@
 // Ground paths for the path follower (web/optimizer/path.ts): checking user points, resampling,
 // smoothing of strokes, projection and headings, against hand-computed geometry.
 import { describe, expect, it } from 'vitest';
-import { angleDifference, checkPathPoints, GroundPath, PATH_SPACING, type GroundPoint } from '../../web/optimizer/path';
+import { angleDifference, checkPathPoints, GroundPath, MAX_PATH_COORDINATE, moveBack, PATH_SPACING, relativeToStart, type GroundPoint } from '../../web/optimizer/path';
 import { readRepoFile } from './corpus';
 
 const BENCHMARK_PATHS: Record<string, GroundPoint[]> = Object.fromEntries(
@@ -15,6 +15,27 @@ describe('checkPathPoints', () => {
     expect(() => checkPathPoints([[0, 0]])).toThrow(/at least 2/);
     expect(() => checkPathPoints([[0, 0], [1, NaN]])).toThrow(/points\[1\] must be a pair of finite numbers/);
     expect(() => checkPathPoints([[0, 0], [1, 2, 3]])).toThrow(/points\[1\]/);
+  });
+
+  it('refuses points that float32 positions cannot hold to a millimetre, saying why', () => {
+    const edge = MAX_PATH_COORDINATE;
+    expect(checkPathPoints([[edge, -edge], [edge - 3, -edge]])).toEqual([[edge, -edge], [edge - 3, -edge]]);
+    for (const far of [1e300, 1e15, 1e5, -(edge + 1)]) {
+      expect(() => checkPathPoints([[0, 0], [far, 5]])).toThrow(`points[1] [${far}, 5] is too far out: x and z must be within ±10000 m`);
+      expect(() => checkPathPoints([[5, far], [0, 0]])).toThrow(/^points\[0\] .* is too far out/);
+    }
+    // The float32 step at the limit is under a millimetre (at 100 km it is 8 mm).
+    expect(Math.fround(edge + 200 + 2 ** -10) - Math.fround(edge + 200)).toBeLessThanOrEqual(0.001);
+  });
+});
+
+describe('relativeToStart and moveBack', () => {
+  it('move a path to the origin and positions back, exactly for exactly representable offsets', () => {
+    const { origin, local } = relativeToStart([[9000, -7000], [9000, -6998], [9001.5, -6996.5]]);
+    expect(origin).toEqual([9000, -7000]);
+    expect(local).toEqual([[0, 0], [0, 2], [1.5, 3.5]]);
+    const positions = Float32Array.from([0.25, 1, -0.5, 1.1, 0.9, 3.3]);
+    expect(Array.from(moveBack(positions.slice(), origin))).toEqual([9000.25, 1, -7000.5, Math.fround(9000 + Math.fround(1.1)), Math.fround(0.9), Math.fround(-7000 + Math.fround(3.3))]);
   });
 });
 

@@ -12,19 +12,14 @@ import type { App } from '../ui/app';
 import { errorMessage } from '../ui/dom';
 import { checkSchedule } from '../optimizer/liveControl';
 import { checkPathPoints, GroundPath } from '../optimizer/path';
-import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed } from '../optimizer/options';
+import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed, optional } from '../optimizer/options';
+import { describeValue } from '../motion/describe';
+import { loadManifest, type ModelInfo } from '../model/manifest';
 
 declare const __APP_VERSION__: string;
 
 /** A model listed in public/models/index.json (the manifest's `file` is internal and not exposed). */
-export interface ModelInfo {
-  id: string;
-  kind: string;
-  skeleton: string;
-  fps: number;
-  styles?: string[];
-  bytes: number;
-}
+export type { ModelInfo };
 
 export type ImportFormat = 'bvh' | 'amc';
 
@@ -47,7 +42,7 @@ export interface GenerateOptions {
   seed: number;
   /** acLSTM models only, and required there: one of the model's `styles` ("salsa", "indian", "martial"). */
   style?: string;
-  /** Generator only. Sampling temperature 0…2 (default 0.5): 0 = each step's most likely mixture mean, 1 = the trained distribution. */
+  /** Generator only. Sampling temperature 0…2 (left out: 0.5; null is refused): 0 = each step's most likely mixture mean, 1 = the trained distribution. */
   temperature?: number;
   /**
    * Generator only (default false). true: the same sampled frames run through the refiner model (loaded on
@@ -57,7 +52,7 @@ export interface GenerateOptions {
 }
 
 export interface FollowPathOptions {
-  /** The path on the ground: [x, z] pairs in metres, at least 2, 0.5–200 m long. The character starts at the first point facing along the path. */
+  /** The path on the ground: [x, z] pairs in metres, at least 2, each x and z within ±10000 m, 0.5–200 m long. The character starts at the first point facing along the path. */
   points: [number, number][];
   /** "walk" (default) or "run": picks the seed states and the pace. */
   gait?: 'walk' | 'run';
@@ -85,7 +80,7 @@ export interface FollowPathStats {
 export type FollowedPathMotion = Motion & { contacts: Uint8Array; stats: FollowPathStats };
 
 export interface SimulateControlOptions {
-  /** Length of the simulated run, seconds (0 < seconds ≤ 600). */
+  /** Length of the simulated run, seconds (0 < seconds ≤ 600), rounded to whole frames (at least one). */
   seconds: number;
   /** Targets over time: [{ t: 0, speed, heading }, …] with t in seconds, increasing; speed 0–4 m/s; heading in radians (0 faces +z). */
   schedule: { t: number; speed: number; heading: number }[];
@@ -163,43 +158,20 @@ declare global {
   }
 }
 
-interface ManifestEntry extends ModelInfo {
-  file: string;
-}
-
-function parseManifest(json: unknown): ModelInfo[] {
-  const models = (json as { models?: unknown })?.models;
-  if (!Array.isArray(models)) throw new Error('models/index.json: expected { "models": [...] }');
-  return models.map((m: ManifestEntry, i) => {
-    if (typeof m?.id !== 'string' || typeof m.kind !== 'string' || typeof m.skeleton !== 'string' || typeof m.fps !== 'number' || typeof m.bytes !== 'number') {
-      throw new Error(`models/index.json: entry ${i} needs id, kind, skeleton, fps and bytes`);
-    }
-    const info: ModelInfo = { id: m.id, kind: m.kind, skeleton: m.skeleton, fps: m.fps, bytes: m.bytes };
-    if (Array.isArray(m.styles)) info.styles = m.styles.map(String);
-    return info;
-  });
-}
-
-async function loadManifest(): Promise<ModelInfo[]> {
-  const res = await fetch(`${import.meta.env.BASE_URL}models/index.json`, { cache: 'no-cache' });
-  if (!res.ok) throw new Error(`models/index.json: HTTP ${res.status}`);
-  return parseManifest(await res.json());
-}
-
 type GeneratorCall = { kind: 'lstm-gmm'; model: string; frames: number; seed: number; temperature: number; refine: boolean };
 type DanceCall = { kind: 'aclstm'; model: string; frames: number; seed: number; style: string };
 
 /** Checks generate's options against the model they name (`models`: the manifest); the error says what is wrong. */
-function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorCall | DanceCall {
+export function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorCall | DanceCall {
   if (typeof options !== 'object' || options === null || Array.isArray(options)) {
-    throw new TypeError('options must be an object: { model, frames, seed, temperature? } (acLSTM: { model, style, frames, seed })');
+    throw new TypeError(`options must be an object: { model, frames, seed, temperature? } (acLSTM: { model, style, frames, seed }), got ${describeValue(options)}`);
   }
   const o = options as Partial<Record<keyof GenerateOptions, unknown>>;
   const usable = models.filter((m) => m.kind === 'lstm-gmm' || m.kind === 'aclstm');
   const available = usable.map((m) => m.id).join(', ');
-  if (typeof o.model !== 'string') throw new TypeError(`model must be a model id string (available: ${available || 'none'})`);
+  if (typeof o.model !== 'string') throw new TypeError(`model must be a model id string (available: ${available || 'none'}), got ${describeValue(o.model)}`);
   const entry = usable.find((m) => m.id === o.model);
-  if (!entry) throw new Error(`unknown model "${o.model}" (available: ${available || 'none — the model list did not load'})`);
+  if (!entry) throw new Error(`unknown model ${describeValue(o.model)} (available: ${available || 'none — the model list did not load'})`);
   const dance = entry.kind === 'aclstm';
   if (dance) {
     // Dance models have no sampling and no refiner: say so rather than silently ignoring the option.
@@ -208,25 +180,25 @@ function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorCall | D
   }
   const known = dance ? ['model', 'style', 'frames', 'seed'] : ['model', 'frames', 'seed', 'temperature', 'refine'];
   for (const k of Object.keys(options)) {
-    if (!known.includes(k)) throw new TypeError(`unknown option "${k}" for model "${entry.id}" (known: ${known.join(', ')})`);
+    if (!known.includes(k)) throw new TypeError(`unknown option ${describeValue(k)} for model "${entry.id}" (known: ${known.join(', ')})`);
   }
   if (typeof o.frames !== 'number' || !Number.isInteger(o.frames) || o.frames < 1 || o.frames > GENERATE_MAX_FRAMES) {
-    throw new RangeError(`frames must be an integer from 1 to ${GENERATE_MAX_FRAMES}, got ${String(o.frames)}`);
+    throw new RangeError(`frames must be an integer from 1 to ${GENERATE_MAX_FRAMES}, got ${describeValue(o.frames)}`);
   }
   const seed = checkSeed(o.seed);
   if (dance) {
     const styles = entry.styles ?? [];
     if (o.style === undefined) throw new TypeError(`style is required for model "${entry.id}" (styles: ${styles.join(', ')})`);
     if (typeof o.style !== 'string' || !styles.includes(o.style)) {
-      throw new RangeError(`unknown style ${typeof o.style === 'string' ? `"${o.style}"` : String(o.style)} for model "${entry.id}" (styles: ${styles.join(', ')})`);
+      throw new RangeError(`unknown style ${describeValue(o.style)} for model "${entry.id}" (styles: ${styles.join(', ')})`);
     }
     return { kind: 'aclstm', model: entry.id, frames: o.frames, seed, style: o.style };
   }
-  const temperature = o.temperature ?? GENERATE_DEFAULT_TEMPERATURE;
+  const temperature = optional(o.temperature, GENERATE_DEFAULT_TEMPERATURE);
   if (typeof temperature !== 'number' || !Number.isFinite(temperature) || temperature < 0 || temperature > 2) {
-    throw new RangeError(`temperature must be a number from 0 to 2, got ${String(o.temperature)}`);
+    throw new RangeError(`temperature must be a number from 0 to 2 (or left out for ${GENERATE_DEFAULT_TEMPERATURE}), got ${describeValue(temperature)}`);
   }
-  if (o.refine !== undefined && typeof o.refine !== 'boolean') throw new TypeError(`refine must be true or false, got ${String(o.refine)}`);
+  if (o.refine !== undefined && typeof o.refine !== 'boolean') throw new TypeError(`refine must be true or false, got ${describeValue(o.refine)}`);
   const refine = o.refine === true;
   if (refine && !models.some((m) => m.kind === 'refiner')) throw new Error('refine is not available: no refiner model is listed in models/index.json');
   return { kind: 'lstm-gmm', model: entry.id, frames: o.frames, seed, temperature, refine };
@@ -234,21 +206,21 @@ function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorCall | D
 
 /** Throws unless `options` is a plain object whose keys are all in `known`. */
 function checkKeys(options: unknown, known: string[], shape: string): Record<string, unknown> {
-  if (typeof options !== 'object' || options === null || Array.isArray(options)) throw new TypeError(`options must be an object: ${shape}`);
+  if (typeof options !== 'object' || options === null || Array.isArray(options)) throw new TypeError(`options must be an object: ${shape}, got ${describeValue(options)}`);
   for (const k of Object.keys(options)) {
-    if (!known.includes(k)) throw new TypeError(`unknown option "${k}" (known: ${known.join(', ')})`);
+    if (!known.includes(k)) throw new TypeError(`unknown option ${describeValue(k)} (known: ${known.join(', ')})`);
   }
   return options as Record<string, unknown>;
 }
 
 /** Throws unless `options` are view options: layer switches true or false, framing "character" or "all". */
 function checkView(options: unknown): ViewOptions {
-  if (typeof options !== 'object' || options === null) throw new TypeError('options must be an object');
+  if (typeof options !== 'object' || options === null) throw new TypeError(`options must be an object, got ${describeValue(options)}`);
   const known = ['follow', 'trail', 'footprints', 'framing'];
   for (const [k, v] of Object.entries(options)) {
-    if (!known.includes(k)) throw new TypeError(`unknown option "${k}" (known: ${known.join(', ')})`);
+    if (!known.includes(k)) throw new TypeError(`unknown option ${describeValue(k)} (known: ${known.join(', ')})`);
     if (k === 'framing' ? v !== 'character' && v !== 'all' : typeof v !== 'boolean') {
-      throw new TypeError(k === 'framing' ? 'framing must be "character" or "all"' : `${k} must be true or false`);
+      throw new TypeError(`${k === 'framing' ? 'framing must be "character" or "all"' : `${k} must be true or false`}, got ${describeValue(v)}`);
     }
   }
   return options as ViewOptions;
@@ -306,7 +278,7 @@ export function createPlayground(app: App): Playground {
   let models: ModelInfo[] = [];
   const { guarded, guardedAsync } = errorGuards(app);
 
-  const ready = loadManifest().then(
+  const ready = loadManifest(`${import.meta.env.BASE_URL}models/index.json`).then(
     (m) => {
       models = m;
     },
@@ -323,8 +295,8 @@ export function createPlayground(app: App): Playground {
 
     importMotion(text, format, asfText) {
       return guardedAsync('importMotion', async () => {
-        if (typeof text !== 'string') throw new TypeError(`text must be a string, got ${text === null ? 'null' : typeof text}`);
-        if (format !== 'bvh' && format !== 'amc') throw new TypeError(`format must be "bvh" or "amc", got ${JSON.stringify(format)}`);
+        if (typeof text !== 'string') throw new TypeError(`text must be a string, got ${describeValue(text)}`);
+        if (format !== 'bvh' && format !== 'amc') throw new TypeError(`format must be "bvh" or "amc", got ${describeValue(format)}`);
         if (format === 'amc' && typeof asfText !== 'string') throw new TypeError('an AMC motion needs its skeleton: pass the ASF file text as asfText');
         return app.importer.importText(text, format, format === 'amc' ? asfText : undefined); // parsed in the import worker
       });
@@ -345,13 +317,13 @@ export function createPlayground(app: App): Playground {
     pause: () => app.viewer.pause(),
     seek(frame) {
       guarded('seek', () => {
-        if (typeof frame !== 'number' || !Number.isFinite(frame)) throw new TypeError(`frame must be a finite number, got ${String(frame)}`);
+        if (typeof frame !== 'number' || !Number.isFinite(frame)) throw new TypeError(`frame must be a finite number, got ${describeValue(frame)}`);
         app.viewer.seek(frame);
       });
     },
     setSpeed(x) {
       return guarded('setSpeed', () => {
-        if (typeof x !== 'number' || !Number.isFinite(x) || x <= 0) throw new TypeError(`speed must be a positive number, got ${String(x)}`);
+        if (typeof x !== 'number' || !Number.isFinite(x) || x <= 0) throw new TypeError(`speed must be a positive number, got ${describeValue(x)}`);
         return app.viewer.setSpeed(x);
       });
     },
@@ -389,9 +361,9 @@ export function createPlayground(app: App): Playground {
         // Checked here too (the worker checks again), so bad input fails fast and without a worker prefix.
         const points = checkPathPoints(o.points);
         GroundPath.fromPoints(points);
-        const gait = checkGait(o.gait ?? 'walk');
-        const seed = checkSeed(o.seed ?? 0);
-        const fitSigma = checkFitSigma(o.fitTolerance ?? 0.1, 'fitTolerance');
+        const gait = checkGait(optional(o.gait, 'walk'));
+        const seed = checkSeed(optional(o.seed, 0));
+        const fitSigma = checkFitSigma(optional(o.fitTolerance, 0.1), 'fitTolerance');
         const lockFeet = checkFootLock(o.footLock);
         await ready;
         const { client } = await app.generator.load();
@@ -407,7 +379,7 @@ export function createPlayground(app: App): Playground {
         const lockFeet = checkFootLock(o.footLock);
         const seconds = checkSeconds(o.seconds);
         const schedule = checkSchedule(o.schedule);
-        const seed = checkSeed(o.seed ?? 0);
+        const seed = checkSeed(optional(o.seed, 0));
         const gait = o.gait === undefined ? undefined : checkGait(o.gait);
         await ready;
         const { client } = await app.generator.load();

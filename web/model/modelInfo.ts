@@ -11,13 +11,13 @@ export class ModelInfoError extends Error {
 
 type InfoErrorClass = new (source: string, message: string) => Error;
 
-/** Fetches a model JSON and checks it with `parse`; every error is an `ErrorClass` naming the URL. */
-export async function loadModelInfo<T>(url: string | URL, parse: (raw: unknown, source: string) => T, ErrorClass: InfoErrorClass): Promise<T> {
+/** Fetches a model JSON (or the manifest) and checks it with `parse`; every error is an `ErrorClass` naming the URL. */
+export async function loadModelInfo<T>(url: string | URL, parse: (raw: unknown, source: string) => T, ErrorClass: InfoErrorClass, init?: RequestInit): Promise<T> {
   const source = String(url);
   const error = (message: string) => new ErrorClass(source, message);
   let response: Response;
   try {
-    response = await fetch(url);
+    response = await fetch(url, init);
   } catch (err) {
     throw error(`could not fetch (${err instanceof Error ? err.message : String(err)})`);
   }

@@ -7,6 +7,7 @@
 import { decodeFeatures } from '../model/featureDecode';
 import type { GeneratorInfo } from '../model/generatorInfo';
 import { Rng } from '../model/sampler';
+import { describeValue } from '../motion/describe';
 import { contactCost, lastToes, particleFeatures, type ToeState } from './objective';
 import { angleDifference } from './path';
 import { seedStreamState, type RolloutResult, type SteerRequest, type StepFn, type Steering, type StreamState } from './rollout';
@@ -153,13 +154,13 @@ export class LiveController {
    */
   async advance(goal: ControlTarget, frames = CONTROL_BATCH, particles?: number): Promise<ControlChunk> {
     checkTarget(goal);
-    if (!Number.isInteger(frames) || frames < 1 || frames > CONTROL_HORIZON) throw new RangeError(`frames must be an integer from 1 to ${CONTROL_HORIZON}, got ${frames}`);
+    if (!Number.isInteger(frames) || frames < 1 || frames > CONTROL_HORIZON) throw new RangeError(`frames must be an integer from 1 to ${CONTROL_HORIZON}, got ${describeValue(frames)}`);
     const started = performance.now();
     const { info, step, mean, std } = this.o;
     const fps = info.fps;
     const P = particles ?? this.o.particles ?? DEFAULT_CONTROL_PARTICLES, rounds = this.o.rounds ?? 2;
     if (!Number.isInteger(P) || P < MIN_CONTROL_PARTICLES || P > MAX_CONTROL_PARTICLES) {
-      throw new RangeError(`particles must be an integer from ${MIN_CONTROL_PARTICLES} to ${MAX_CONTROL_PARTICLES}, got ${P}`);
+      throw new RangeError(`particles must be an integer from ${MIN_CONTROL_PARTICLES} to ${MAX_CONTROL_PARTICLES}, got ${describeValue(P)}`);
     }
     const { result, particle: b } = await crossEntropySearch({
       rollout: { step, info, mean, std, start: this.state, temperature: this.o.temperature ?? 0.5, commit: frames, noiseScale: NOISE_SCALE },
@@ -196,9 +197,9 @@ export class LiveController {
 
 export function checkTarget(goal: ControlTarget): void {
   if (typeof goal?.speed !== 'number' || !Number.isFinite(goal.speed) || goal.speed < 0 || goal.speed > MAX_CONTROL_SPEED) {
-    throw new RangeError(`speed must be a number from 0 to ${MAX_CONTROL_SPEED} m/s, got ${String(goal?.speed)}`);
+    throw new RangeError(`speed must be a number from 0 to ${MAX_CONTROL_SPEED} m/s, got ${describeValue(goal?.speed)}`);
   }
-  if (typeof goal.heading !== 'number' || !Number.isFinite(goal.heading)) throw new RangeError(`heading must be a finite number of radians, got ${String(goal.heading)}`);
+  if (typeof goal.heading !== 'number' || !Number.isFinite(goal.heading)) throw new RangeError(`heading must be a finite number of radians, got ${describeValue(goal.heading)}`);
 }
 
 /** Eqs. (22) and (23): mean horizontal speed over the horizon vs the goal, last frame's facing vs the goal. */
@@ -224,12 +225,12 @@ export interface ScheduleEntry extends ControlTarget {
 
 /** Checks a control schedule: a non-empty list of { t, speed, heading }, t ≥ 0 and increasing, the first at t = 0. */
 export function checkSchedule(schedule: unknown): ScheduleEntry[] {
-  if (!Array.isArray(schedule) || schedule.length === 0) throw new TypeError('schedule must be a non-empty array of { t, speed, heading }');
+  if (!Array.isArray(schedule) || schedule.length === 0) throw new TypeError(`schedule must be a non-empty array of { t, speed, heading }, got ${describeValue(schedule)}`);
   return schedule.map((e, i) => {
-    if (typeof e !== 'object' || e === null) throw new TypeError(`schedule[${i}] must be an object { t, speed, heading }`);
+    if (typeof e !== 'object' || e === null) throw new TypeError(`schedule[${i}] must be an object { t, speed, heading }, got ${describeValue(e)}`);
     const { t, speed, heading } = e as Record<string, unknown>;
-    if (typeof t !== 'number' || !Number.isFinite(t) || t < 0) throw new RangeError(`schedule[${i}].t must be a number of seconds ≥ 0, got ${String(t)}`);
-    if (i === 0 && t !== 0) throw new RangeError(`schedule[0].t must be 0 (the target at the start), got ${t}`);
+    if (typeof t !== 'number' || !Number.isFinite(t) || t < 0) throw new RangeError(`schedule[${i}].t must be a number of seconds ≥ 0, got ${describeValue(t)}`);
+    if (i === 0 && t !== 0) throw new RangeError(`schedule[0].t must be 0 (the target at the start), got ${describeValue(t)}`);
     if (i > 0 && t <= (schedule[i - 1] as ScheduleEntry).t) throw new RangeError(`schedule[${i}].t (${t}) must be later than schedule[${i - 1}].t`);
     try {
       checkTarget({ speed, heading } as ControlTarget);

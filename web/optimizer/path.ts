@@ -1,5 +1,7 @@
 // Ground paths for the path follower: a drawn polyline (x, z pairs in metres) cleaned, smoothed and
-// resampled at even arc length, with lookups by arc length and nearest-point projection.
+// resampled at even arc length, with lookups by arc length and nearest-point projection; and moving a path
+// to the origin and its motion back (the follower works near the origin, see relativeToStart).
+import { describeValue } from '../motion/describe';
 
 export type GroundPoint = [number, number];
 
@@ -10,18 +12,46 @@ export const MIN_PATH_LENGTH = 0.5;
 /** And at most this long: 200 m is minutes of walking. */
 export const MAX_PATH_LENGTH = 200;
 export const MAX_PATH_POINTS = 20_000;
+/**
+ * Largest |x| or |z| of a path point (m). Motions hold float32 positions, whose steps are at most 1/1024 m
+ * (0.98 mm) below 16,384 m and 8 mm at 100 km: within 10 km (plus the 200 m a path can reach) every joint
+ * keeps the millimetre precision it has at the origin (the FK parity tolerance, docs/architecture.md).
+ */
+export const MAX_PATH_COORDINATE = 10_000;
 
-/** Checks user points: an array of ≥ 2 finite [x, z] pairs. Throws with what is wrong. */
+/** Checks user points: an array of ≥ 2 finite [x, z] pairs within ±MAX_PATH_COORDINATE. Throws with what is wrong. */
 export function checkPathPoints(points: unknown): GroundPoint[] {
-  if (!Array.isArray(points)) throw new TypeError('points must be an array of [x, z] pairs (metres)');
+  if (!Array.isArray(points)) throw new TypeError(`points must be an array of [x, z] pairs (metres), got ${describeValue(points)}`);
   if (points.length < 2) throw new RangeError(`points needs at least 2 [x, z] pairs, got ${points.length}`);
   if (points.length > MAX_PATH_POINTS) throw new RangeError(`points has ${points.length} pairs; at most ${MAX_PATH_POINTS} are accepted`);
   return points.map((p, i) => {
     if (!Array.isArray(p) || p.length !== 2 || !p.every((v) => typeof v === 'number' && Number.isFinite(v))) {
-      throw new TypeError(`points[${i}] must be a pair of finite numbers [x, z], got ${JSON.stringify(p)}`);
+      throw new TypeError(`points[${i}] must be a pair of finite numbers [x, z], got ${describeValue(p)}`);
+    }
+    if (Math.abs(p[0]) > MAX_PATH_COORDINATE || Math.abs(p[1]) > MAX_PATH_COORDINATE) {
+      throw new RangeError(`points[${i}] ${describeValue(p)} is too far out: x and z must be within ±${MAX_PATH_COORDINATE} m (float32 positions lose millimetre precision beyond)`);
     }
     return [p[0], p[1]];
   });
+}
+
+/**
+ * The points moved so that the first is at the origin, and that first point. The follower runs on the moved
+ * path, so the same shape gives the same motion wherever it lies (its root sums and float32 features never
+ * see large coordinates); `moveBack` then puts the motion where the path is.
+ */
+export function relativeToStart(points: GroundPoint[]): { origin: GroundPoint; local: GroundPoint[] } {
+  const [ox, oz] = points[0];
+  return { origin: [ox, oz], local: points.map(([x, z]) => [x - ox, z - oz]) };
+}
+
+/** Adds `origin` to the x and z of every point of `values` (x, y, z triples, e.g. frames × joints × 3 positions), in place, one rounding each. */
+export function moveBack(values: Float32Array, origin: GroundPoint): Float32Array {
+  for (let i = 0; i < values.length; i += 3) {
+    values[i] += origin[0];
+    values[i + 2] += origin[1];
+  }
+  return values;
 }
 
 /** Drops points closer than `minGap` to the previous kept one (pointer jitter, repeated events). */

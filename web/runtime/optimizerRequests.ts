@@ -2,9 +2,9 @@
 // (one live stream at a time, and its scripted twin simulateControl). The algorithms live in
 // web/optimizer/; this file checks the requests and packs results for the page.
 import { followPath, gaitSeeds, type Gait } from '../optimizer/pathFollower';
-import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed } from '../optimizer/options';
-import { checkSchedule, LiveController, simulateControl, checkTarget, CONTROL_HORIZON } from '../optimizer/liveControl';
-import { checkPathPoints, GroundPath } from '../optimizer/path';
+import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed, optional } from '../optimizer/options';
+import { checkSchedule, LiveController, simulateControl } from '../optimizer/liveControl';
+import { checkPathPoints, GroundPath, moveBack, relativeToStart } from '../optimizer/path';
 import { FootLock, footLock } from '../motion/footLock';
 import { footSkating } from '../motion/footSkating';
 import type { GeneratorCore } from './generatorCore';
@@ -44,20 +44,22 @@ export class OptimizerRequests {
     const points = checkPathPoints(p.points);
     const gait = checkGait(p.gait);
     const seed = checkSeed(p.seed);
-    const fitSigma = checkFitSigma(p.fitSigma ?? 0.1);
-    const path = p.stroke ? GroundPath.fromStroke(points) : GroundPath.fromPoints(points);
+    const fitSigma = checkFitSigma(optional(p.fitSigma, 0.1));
+    const lock = checkFootLock(p.footLock);
+    // Followed, locked and measured near the origin; moved back to where the path is last.
+    const { origin, local } = relativeToStart(points);
+    const path = p.stroke ? GroundPath.fromStroke(local) : GroundPath.fromPoints(local);
     const info = this.core.info;
     const r = await followPath({ step: this.step, info, mean: this.core.mean, std: this.core.std, path, gait, seed, fitSigma, onProgress: progress });
     const flat = new Float32Array(path.count * 2);
     for (let i = 0; i < path.count; i++) {
-      flat[2 * i] = path.xs[i];
-      flat[2 * i + 1] = path.zs[i];
+      flat[2 * i] = path.xs[i] + origin[0];
+      flat[2 * i + 1] = path.zs[i] + origin[1];
     }
-    const lock = checkFootLock(p.footLock);
-    const positions = lock ? this.lock(r.positions, r.contacts) : r.positions;
+    const locked = lock ? this.lock(r.positions, r.contacts) : r.positions;
     const skating = (pos: Float32Array) => footSkating({ fps: info.fps, frames: r.frames, joints: info.skeleton.joints, parents: info.skeleton.parents, positions: pos, contacts: r.contacts });
-    const stats = { ...r.stats, skating: skating(positions), skatingBeforeLock: skating(r.positions) };
-    return { frames: r.frames, features: r.features, positions, contacts: r.contacts, rootHeading: r.rootHeading, seedIndex: r.seedIndex, startFrame: 0, stats, path: flat };
+    const stats = { ...r.stats, skating: skating(locked), skatingBeforeLock: skating(r.positions) };
+    return { frames: r.frames, features: r.features, positions: moveBack(locked, origin), contacts: r.contacts, rootHeading: r.rootHeading, seedIndex: r.seedIndex, startFrame: 0, stats, path: flat };
   }
 
   /** The foot lock over a whole motion of the generator's skeleton (hips and above unchanged). */
@@ -76,8 +78,6 @@ export class OptimizerRequests {
   async controlPull(p: ControlTargetParams & { frames: number; particles?: number }): Promise<ControlChunkReply> {
     const live = this.live;
     if (!live) throw new Error('no control stream: send controlStart first');
-    checkTarget(p);
-    if (!Number.isInteger(p.frames) || p.frames < 1 || p.frames > CONTROL_HORIZON) throw new RangeError(`frames must be an integer from 1 to ${CONTROL_HORIZON}, got ${p.frames}`);
     const startFrame = live.controller.frame;
     const chunk = await live.controller.advance({ speed: p.speed, heading: p.heading }, p.frames, p.particles);
     // Planted feet locked frame by frame, continuing across batches (as simulateControl's whole-run lock).

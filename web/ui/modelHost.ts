@@ -3,19 +3,26 @@
 // model loads.
 
 /**
- * onnxruntime-web threads: `?threads=N` in the page URL; else, when cross-origin isolated, half the cores
- * (at most 4) so the worker's threads leave the page's own thread a core; else 1. On this project's
- * 2-core test machine that means 1: two threads measured 2× slower there (npm run bench), because the
- * second thread fights the renderer for the same cores.
+ * onnxruntime-web threads for a page whose URL query is `search`, on `cores` cores: `?threads=N` (an
+ * integer ≥ 1; anything else is ignored) capped at the core count, since threads beyond it only take
+ * turns on the same cores (64 on 2 cores made everything 4× slower); else, when cross-origin isolated,
+ * half the cores (at most 4) so the worker's threads leave the page's own thread a core; else 1. On this
+ * project's 2-core test machine that means 1: two threads measured 2× slower there (npm run bench),
+ * because the second thread fights the renderer for the same cores.
  */
-export function pageThreads(): number {
-  const param = new URLSearchParams(location.search).get('threads');
+export function threadCount(search: string, cores: number, isolated: boolean): number {
+  const param = new URLSearchParams(search).get('threads');
   if (param !== null) {
     const n = Number(param);
-    if (Number.isInteger(n) && n >= 1 && n <= 64) return n;
+    if (Number.isInteger(n) && n >= 1) return Math.min(n, cores);
   }
-  if (!globalThis.crossOriginIsolated) return 1;
-  return Math.max(1, Math.min(4, Math.floor((navigator.hardwareConcurrency || 1) / 2)));
+  if (!isolated) return 1;
+  return Math.max(1, Math.min(4, Math.floor(cores / 2)));
+}
+
+/** The thread count for this page (threadCount of its URL, core count and isolation). */
+export function pageThreads(): number {
+  return threadCount(location.search, Math.max(1, navigator.hardwareConcurrency || 1), globalThis.crossOriginIsolated);
 }
 
 /** The "Loading model…" indicator: shown while at least one load is running. */

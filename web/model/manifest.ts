@@ -1,0 +1,48 @@
+// The model manifest (public/models/index.json, written by training/onnx/manifest.py): the models the page
+// can run. Every error names the file, and for a bad entry its index and model file.
+import { describeValue } from '../motion/describe';
+import { quoteInput } from '../motion/text';
+import { loadModelInfo, ModelInfoError } from './modelInfo';
+
+/** A model listed in the manifest (its `file` is internal and not exposed). */
+export interface ModelInfo {
+  id: string;
+  kind: string;
+  skeleton: string;
+  fps: number;
+  styles?: string[];
+  bytes: number;
+}
+
+export class ManifestError extends ModelInfoError {
+  override readonly name = 'ManifestError';
+}
+
+/** Checks a parsed manifest; throws a ManifestError naming `source` and the first bad entry. */
+export function parseManifest(raw: unknown, source = 'models/index.json'): ModelInfo[] {
+  const fail = (message: string): never => {
+    throw new ManifestError(source, message);
+  };
+  const models = typeof raw === 'object' && raw !== null ? (raw as { models?: unknown }).models : undefined;
+  if (!Array.isArray(models)) return fail(`expected { "models": [...] }, got ${describeValue(raw)}`);
+  return models.map((m: Record<string, unknown> | null, i) => {
+    const entry = `entry ${i}${typeof m?.file === 'string' ? ` (${quoteInput(m.file)})` : ''}`;
+    if (typeof m !== 'object' || m === null) return fail(`${entry} must be an object, got ${describeValue(m)}`);
+    const { id, kind, skeleton, fps, bytes, styles } = m;
+    if (typeof id !== 'string' || typeof kind !== 'string' || typeof skeleton !== 'string' || typeof fps !== 'number' || typeof bytes !== 'number') {
+      return fail(`${entry} needs id, kind, skeleton (strings), fps and bytes (numbers)`);
+    }
+    if (!(fps > 0 && Number.isFinite(fps))) fail(`${entry}: fps must be a positive number, got ${describeValue(fps)}`);
+    if (styles !== undefined && !(Array.isArray(styles) && styles.every((s) => typeof s === 'string'))) {
+      fail(`${entry}: styles must be an array of strings, got ${describeValue(styles)}`);
+    }
+    const info: ModelInfo = { id, kind, skeleton, fps, bytes };
+    if (styles) info.styles = [...(styles as string[])];
+    return info;
+  });
+}
+
+/** Fetches and checks the manifest at `url` (not from the HTTP cache: it changes with every export). */
+export function loadManifest(url: string): Promise<ModelInfo[]> {
+  return loadModelInfo(url, parseManifest, ManifestError, { cache: 'no-cache' });
+}
