@@ -81,6 +81,21 @@ describe('path following and live control in the page', { timeout: 300_000 }, ()
     assert.match(lock.message, /footLock must be true or false/);
   });
 
+  test('a run shorter than a frame gives one frame that show and exportBVH take; a far path is refused with the limit', async () => {
+    const r = await suite.page.evaluate(async () => {
+      const pg = window.playground;
+      const m = await pg.simulateControl({ seconds: 0.01, schedule: [{ t: 0, speed: 1.2, heading: 0 }] });
+      pg.show(m, 'blink');
+      return { frames: m.frames, shown: pg.state().frames, exported: /Frames: (\d+)/.exec(pg.exportBVH(m))?.[1] };
+    });
+    assert.deepEqual(r, { frames: 1, shown: 1, exported: '1' });
+    const far = await failure(suite.page, 'followPath', { points: [[1e15, 0], [1e15, 5]] });
+    assert.match(far.message, /^followPath: points\[0\] \[1000000000000000, 0\] is too far out: x and z must be within ±10000 m/);
+    assert.equal(far.shown, 1);
+    const nan = await failure(suite.page, 'followPath', { points: [[0, 0], [NaN, 5]] });
+    assert.match(nan.message, /points\[1\] must be a pair of finite numbers \[x, z\], got \[NaN, 5\]$/);
+  });
+
   test('simulateControl turns to a new heading and holds the speed; compute is reported per frame', async () => {
     const m = await suite.page.evaluate(async () => {
       const r = await window.playground.simulateControl({ seconds: 4, seed: 2, schedule: [{ t: 0, speed: 1.2, heading: 0 }, { t: 1, speed: 1.2, heading: Math.PI / 2 }] });

@@ -4,7 +4,9 @@
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { GeneratorCore } from '../../web/runtime/generatorCore';
 import { parseGeneratorInfo } from '../../web/model/generatorInfo';
+import { exportBVH } from '../../web/motion/bvh';
 import { footSkating } from '../../web/motion/footSkating';
+import { validateMotion } from '../../web/motion/validate';
 import { checkSchedule, LiveController, simulateControl } from '../../web/optimizer/liveControl';
 import { angleDifference, GroundPath, type GroundPoint } from '../../web/optimizer/path';
 import { OptimizerRequests } from '../../web/runtime/optimizerRequests';
@@ -127,6 +129,15 @@ describe('LiveController', () => {
     expect(sim.targets[29].heading).toBe(0);
     expect(sim.targets[30].heading).toBe(Math.PI / 2);
   }, 60000);
+
+  it('gives at least one frame for a run shorter than a frame, a motion show and exportBVH take', async () => {
+    const controller = new LiveController({ step, info, mean: core.mean, std: core.std, seed: 5, seedIndex: 0 });
+    const sim = await simulateControl(controller, checkSchedule([{ t: 0, speed: 1.2, heading: 0 }]), 0.01, 30);
+    expect(sim.chunks.map((c) => c.frames)).toEqual([1]);
+    expect(sim.targets).toHaveLength(1);
+    const motion = validateMotion({ fps: 30, frames: 1, joints: info.skeleton.joints, parents: info.skeleton.parents, positions: sim.chunks[0].positions });
+    expect(exportBVH(motion)).toMatch(/Frames: 1\s/);
+  });
 
   it('refuses bad schedules and targets with messages saying why', async () => {
     expect(() => checkSchedule([])).toThrow(/non-empty array/);

@@ -252,7 +252,8 @@ export interface SimulatedControl {
  * batch's first frame, exactly as the page does with the user's input at that moment.
  */
 export async function simulateControl(controller: LiveController, schedule: ScheduleEntry[], seconds: number, fps: number, onProgress?: (fraction: number) => void): Promise<SimulatedControl> {
-  const total = Math.round(seconds * fps);
+  // At least one frame: every accepted length (any seconds above 0) gives a motion show and exportBVH take.
+  const total = Math.max(1, Math.round(seconds * fps));
   const chunks: ControlChunk[] = [];
   const targets: ControlTarget[] = [];
   let done = 0;
