@@ -51,6 +51,8 @@ export class Viewer {
   displayFps = 0;
 
   private readonly floor: Floor;
+  /** Beyond its far distance everything is the background colour. */
+  private readonly fog: THREE.Fog;
   private readonly glow = new FloorGlow();
   private readonly marks = new GroundMarks();
   private figure: Figure | null = null;
@@ -86,7 +88,8 @@ export class Viewer {
     this.scene.background = BACKGROUND;
     // A GPU can afford a wider grid reaching further before the fog; software GL gets a smaller stage.
     this.floor = new Floor(high ? 24 : 12);
-    this.scene.fog = high ? new THREE.Fog(BACKGROUND, 8, 26) : new THREE.Fog(BACKGROUND, 5, 14);
+    this.fog = high ? new THREE.Fog(BACKGROUND, 8, 26) : new THREE.Fog(BACKGROUND, 5, 14);
+    this.scene.fog = this.fog;
     this.renderer.outputColorSpace = THREE.LinearSRGBColorSpace; // colours are used as given (see palette.ts)
     this.renderer.domElement.classList.add('viewer-canvas');
     container.appendChild(this.renderer.domElement);
@@ -454,6 +457,7 @@ export class Viewer {
     if (this.dirty) {
       this.dirty = false;
       this.floor.setCenter(this.controls.target.x, this.controls.target.z);
+      this.marks.drawFor(this.camera, Math.min(this.fog.far, this.camera.far));
       this.renderer.render(this.scene, this.camera);
       this.placeLabels();
     }
