@@ -7,6 +7,7 @@ import { importMotion } from '../../web/motion/io';
 import { MotionFormatError } from '../../web/motion/types';
 import { readCorpus } from './corpus';
 import { MAX_JOINTS } from '../../web/motion/validate';
+import { generatedBVH } from './bvhText';
 import { generatedASF, hierarchyParents, parentLinks, seededRandom } from './fuzz';
 
 /** Runs fn, expects a MotionFormatError of that format (and line), returns its message. */
@@ -72,9 +73,9 @@ describe('bad BVH input', () => {
   it('rejects NaN, infinities and non-numeric values', () => {
     for (const bad of ['NaN', 'nan', 'Infinity', '-inf', 'abc', '1.2.3', '0x1F', '1e999', '12,5']) {
       const text = withLine(FIRST_FRAME_LINE + 3, (l) => l.replace(/^(\S+\s+\S+\s+)\S+/, `$1${bad}`));
-      expect(formatError(() => parseBVH(text), 'bvh', FIRST_FRAME_LINE + 3)).toBe(`BVH line ${FIRST_FRAME_LINE + 3}: expected a number, found "${bad}"`);
+      expect(formatError(() => parseBVH(text), 'bvh', FIRST_FRAME_LINE + 3)).toBe(`BVH line ${FIRST_FRAME_LINE + 3}: expected a position in file units, found "${bad}"`);
     }
-    expect(formatError(() => parseBVH(BVH.replace('OFFSET 2.36836 -6.50702 0.00000', 'OFFSET 2.36836 NaN 0.00000')), 'bvh', 16)).toMatch(/expected an OFFSET y value, found "NaN"/);
+    expect(formatError(() => parseBVH(BVH.replace('OFFSET 2.36836 -6.50702 0.00000', 'OFFSET 2.36836 NaN 0.00000')), 'bvh', 16)).toMatch(/expected an OFFSET y value in file units, found "NaN"/);
   });
 
   it('rejects frame counts that do not match the data or are absurd', () => {
@@ -84,7 +85,7 @@ describe('bad BVH input', () => {
     expect(formatError(() => parseBVH(BVH.replace('Frames: 450', 'Frames: -3')), 'bvh', 186)).toMatch(/expected a positive whole frame count/);
     expect(formatError(() => parseBVH(BVH.replace('Frames: 450', 'Frames: 4.5')), 'bvh', 186)).toMatch(/expected a positive whole frame count/);
     expect(formatError(() => parseBVH(BVH.replace('Frames: 450', 'Frames lots')), 'bvh', 186)).toMatch(/expected "Frames: <number>"/);
-    expect(formatError(() => parseBVH(BVH.replace('Frame Time: .0083333', 'Frame Time: 0')), 'bvh', 187)).toMatch(/expected a positive frame time/);
+    expect(formatError(() => parseBVH(BVH.replace('Frame Time: .0083333', 'Frame Time: 0')), 'bvh', 187)).toMatch(/expected a frame time from 0.0001 to 1 second, found "0"/);
   });
 
   it('rejects more than 100 million values before allocating them', () => {
@@ -107,7 +108,7 @@ describe('bad BVH input', () => {
     expect(formatError(() => parseBVH(BVH.replace('CHANNELS 3 Zrotation Yrotation Xrotation', 'CHANNELS 3 Zrotation Wrotation Xrotation')), 'bvh', 9)).toMatch(/"Wrotation" is not a channel name/);
     expect(formatError(() => parseBVH(BVH.replace('CHANNELS 3 Zrotation Yrotation Xrotation', 'CHANNELS 2 Zrotation Yrotation Xrotation')), 'bvh', 9)).toMatch(/declares 2 channels but lists more/);
     expect(formatError(() => parseBVH(BVH.replace('CHANNELS 3 Zrotation Yrotation Xrotation', 'CHANNELS 4 Zrotation Yrotation Xrotation')), 'bvh')).toMatch(/"JOINT" is not a channel name/);
-    expect(formatError(() => parseBVH(BVH.replace('CHANNELS 3 Zrotation Yrotation Xrotation', 'CHANNELS 9 Zrotation Yrotation Xrotation')), 'bvh', 9)).toMatch(/expected a channel count from 0 to 6, found 9/);
+    expect(formatError(() => parseBVH(BVH.replace('CHANNELS 3 Zrotation Yrotation Xrotation', 'CHANNELS 9 Zrotation Yrotation Xrotation')), 'bvh', 9)).toMatch(/expected a channel count from 0 to 6, found "9"/);
   });
 
   it('rejects a second ROOT and stray tokens', () => {
@@ -116,9 +117,110 @@ describe('bad BVH input', () => {
     expect(formatError(() => parseBVH(BVH.replace('OFFSET 0 0 0', 'OFSET 0 0 0')), 'bvh', 8)).toMatch(/unexpected "OFSET" in joint "LHipJoint"/);
   });
 
-  it('rejects values so large that positions overflow, instead of returning non-finite numbers', () => {
+  it('rejects position values so large that positions would overflow, instead of returning non-finite numbers', () => {
     const text = withLine(FIRST_FRAME_LINE, (l) => l.replace(/^\S+/, '1e300'));
-    expect(formatError(() => parseBVH(text), 'bvh')).toMatch(/overflow/);
+    expect(formatError(() => parseBVH(text), 'bvh', FIRST_FRAME_LINE)).toMatch(/expected a position in file units of at most 1000000000 in magnitude, found "1e300"$/);
+  });
+});
+
+describe('hostile BVH input (issue 21)', () => {
+  const LONG = 'q'.repeat(100_000);
+  const SMALL = 'HIERARCHY\nROOT Hips\n{\nOFFSET 0 0 0\nCHANNELS 3 Xposition Yposition Zposition\n}\nMOTION\nFrames: 1\nFrame Time: 0.04\n0 90 0\n';
+
+  it('quotes at most 40 characters of the input, whatever the file holds', () => {
+    expect(formatError(() => importMotion('x'.repeat(20e6), 'bvh'), 'bvh', 1)).toBe(`BVH line 1: expected "HIERARCHY" at the start, found "${'x'.repeat(40)}…"`);
+    const sites: Array<[string, string]> = [
+      ['joint name', SMALL.replace('ROOT Hips\n{\nOFFSET 0 0 0\n', `ROOT ${LONG}\n{\n`)],
+      ['keyword', BVH.replace('OFFSET 0 0 0', `${LONG} 0 0 0`)],
+      ['brace', BVH.replace('ROOT Hips\n{', `ROOT Hips\n${LONG}`)],
+      ['End Site', BVH.replace('End Site', `End ${LONG}`)],
+      ['channel name', BVH.replace('CHANNELS 3 Zrotation Yrotation', `CHANNELS 3 ${LONG} Yrotation`)],
+      ['channel count', BVH.replace('CHANNELS 3 Zrotation', `CHANNELS ${LONG} Zrotation`)],
+      ['after the hierarchy', BVH.replace('MOTION', `${LONG}\nMOTION`)],
+      ['Frames line', BVH.replace('Frames: 450', LONG)],
+      ['frame count', BVH.replace('Frames: 450', `Frames: ${LONG}`)],
+      ['frame time', BVH.replace('Frame Time: .0083333', `Frame Time: ${LONG}`)],
+      ['frame value', withLine(FIRST_FRAME_LINE, (l) => l.replace(/^\S+/, LONG))],
+    ];
+    for (const [site, text] of sites) {
+      const message = formatError(() => parseBVH(text), 'bvh');
+      expect(message.length, site).toBeLessThanOrEqual(300);
+      expect(message, site).toContain(`"${'q'.repeat(40)}…"`);
+      expect(message, site).not.toContain('q'.repeat(41));
+    }
+  });
+
+  it('rejects hierarchies past the joint limit while reading them, however deep or wide', () => {
+    // 3 × 1024 entries: room for an exported 1024-joint motion (helper joints and End Sites included).
+    const tooMany = /^BVH line \d+: more than 3072 JOINT and End Site entries \(at most 1024 joints are supported\)$/;
+    const random = seededRandom(21);
+    for (const [shape, joints] of [['wide', 200_000], ['chain', 10_000], ['random', 20_000]] as const) {
+      expect(formatError(() => parseBVH(generatedBVH(hierarchyParents(random, shape, joints))), 'bvh'), `${shape} ${joints}`).toMatch(tooMany);
+    }
+    // Under the entry limit, the joints that make it into the motion (non-zero OFFSETs) are counted.
+    expect(formatError(() => parseBVH(generatedBVH(hierarchyParents(random, 'chain', 1025))), 'bvh')).toBe('BVH: 1025 joints with a non-zero OFFSET; at most 1024 are supported');
+    const chain = parseBVH(generatedBVH(hierarchyParents(random, 'chain', 1024)));
+    expect(chain.joints.length).toBe(1024);
+    expect(chain.parents[1023]).toBe(1022);
+  });
+
+  it('rejects declared frame counts whose positions would pass 100 million values, before reading frames', () => {
+    // 1000 joints with no channels of their own: 1 value per frame line but 3000 position values per frame.
+    let text = 'HIERARCHY\nROOT j0\n{\nOFFSET 0 0 0\nCHANNELS 1 Xposition\n';
+    for (let j = 1; j < 1000; j++) text += `JOINT j${j}\n{\nOFFSET 0 0.1 0\nCHANNELS 0\n}\n`;
+    text += '}\nMOTION\nFrames: 40000\nFrame Time: 0.01\n0\n';
+    expect(formatError(() => parseBVH(text), 'bvh', 5003)).toBe('BVH line 5003: declares 40000 frames × 1000 joints × 3 = 120000000 position values; at most 100000000 are supported');
+  });
+
+  it('rejects absurd but finite values, naming the bound', () => {
+    const value = (index: number, v: string) => withLine(FIRST_FRAME_LINE, (l) => l.trim().split(/\s+/).map((x, i) => (i === index ? v : x)).join(' '));
+    expect(formatError(() => parseBVH(value(4, '1e300')), 'bvh', FIRST_FRAME_LINE)).toBe(`BVH line ${FIRST_FRAME_LINE}: expected a rotation in degrees of at most 1000000 in magnitude, found "1e300"`);
+    expect(formatError(() => parseBVH(value(10, '-1000001')), 'bvh', FIRST_FRAME_LINE)).toMatch(/expected a rotation in degrees of at most 1000000 in magnitude, found "-1000001"$/);
+    expect(parseBVH(value(10, '-999999')).frames).toBe(450); // many turns, but a rotation
+    expect(formatError(() => parseBVH(BVH.replace('OFFSET 2.36836 -6.50702 0.00000', 'OFFSET 2.36836 1e300 0.00000')), 'bvh', 16))
+      .toBe('BVH line 16: expected an OFFSET y value in file units of at most 1000000000 in magnitude, found "1e300"');
+    // Within the file bound but beyond 1000 km once in metres.
+    expect(formatError(() => parseBVH(SMALL.replace('0 90 0\n', '0 5e8 0\n'), { unitScale: 1 }), 'bvh', 10))
+      .toBe('BVH line 10: frame 1 puts joint "Hips" at y = 500000000 m (at most ±1000000 m on each axis)');
+    for (const time of ['10', '1.5', '0.00005', '0', '-0.01']) {
+      expect(formatError(() => parseBVH(SMALL.replace('Frame Time: 0.04', `Frame Time: ${time}`)), 'bvh', 9), time)
+        .toBe(`BVH line 9: expected a frame time from 0.0001 to 1 second, found "${time}"`);
+    }
+    expect(parseBVH(SMALL.replace('Frame Time: 0.04', 'Frame Time: 1')).fps).toBe(1);
+    expect(parseBVH(SMALL.replace('Frame Time: 0.04', 'Frame Time: 0.0001')).fps).toBe(10000);
+  });
+
+  it('rejects joint names with control characters, showing them escaped', () => {
+    expect(formatError(() => parseBVH(SMALL.replace('Hips', 'Hi\u0007ps')), 'bvh', 2)).toBe('BVH line 2: joint name "Hi\\u0007ps" contains a control character');
+  });
+
+  it('reads U+2028 and U+2029 line separators as line breaks', () => {
+    const motion = parseBVH(BVH);
+    for (const separator of ['\u2028', '\u2029', '\r\n', '\r']) {
+      const back = parseBVH(BVH.replace(/\n/g, separator));
+      expect(back.joints).toEqual(motion.joints);
+      expect(back.positions).toEqual(motion.positions);
+    }
+  });
+
+  it('detects every truncation but one inside the last number at the very end of the file', () => {
+    // docs/api.md: a file cut inside its last number, with nothing after it, reads as a shorter number.
+    const text = BVH_LINES.slice(0, FIRST_FRAME_LINE + 1).join('\n').replace('Frames: 450', 'Frames: 2');
+    const lastLine = BVH_LINES[FIRST_FRAME_LINE];
+    const lastNumberStart = text.length - lastLine.length + lastLine.trimEnd().lastIndexOf(' ') + 1;
+    for (let cut = text.length - lastLine.length - 200; cut < text.length; cut++) {
+      const prefix = text.slice(0, cut);
+      let accepted = true;
+      try {
+        parseBVH(prefix);
+      } catch (e) {
+        expect(e).toBeInstanceOf(MotionFormatError);
+        accepted = false;
+      }
+      // Accepted exactly when the cut keeps part of the last number and that part is still a number ("1.", not "1e").
+      const kept = prefix.slice(lastNumberStart).trim();
+      expect(accepted, `cut at ${cut}: ${JSON.stringify(prefix.slice(-12))}`).toBe(cut > lastNumberStart && Number.isFinite(Number(kept)));
+    }
   });
 });
 

@@ -1,10 +1,11 @@
 import { describe, expect, it } from 'vitest';
-import { parseBVH, exportBVH } from '../../web/motion/bvh';
+import { bvhJointNames, parseBVH, exportBVH } from '../../web/motion/bvh';
 import { parseAMC, parseASF } from '../../web/motion/asfamc';
 import { forwardKinematics } from '../../web/motion/skeleton';
 import { eulerToQuat, type Quat } from '../../web/motion/math';
 import type { Motion } from '../../web/motion/types';
 import { readCorpus } from './corpus';
+import { seededRandom } from './fuzz';
 import { boneLengthDrift, distance, jointIndex, maxHeight, maxPositionError, position } from './motionStats';
 
 const CMU_UNIT = 0.0254 / 0.45;
@@ -235,5 +236,84 @@ describe('exportBVH', () => {
     for (const name of m.joints) {
       expect(distance(position(back, 0, jointIndex(back, name)), position(m, 0, jointIndex(m, name)))).toBeLessThan(1e-6);
     }
+  });
+});
+
+describe('exportBVH joint names (issue 21)', () => {
+  /** A motion with these joint names: a tree (joints 3, 6, 9 … branch off the root) in depth-first order. */
+  const namedMotion = (joints: string[]): Motion => {
+    const parents = joints.map((_, j) => (j === 0 ? -1 : j % 3 === 0 ? 0 : j - 1));
+    const positions = new Float32Array(joints.length * 3);
+    joints.forEach((_, j) => positions.set([0.05 * j, 0.9 + 0.3 * (j % 3), 0.02 * j], j * 3));
+    return { fps: 30, frames: 1, joints, parents, positions };
+  };
+  const roundTrip = (joints: string[]) => {
+    const m = namedMotion(joints);
+    const back = parseBVH(exportBVH(m), { unitScale: 0.01 });
+    expect(back.parents).toEqual(m.parents);
+    expect(maxPositionError(back, m)).toBeLessThan(1e-5);
+    return back.joints;
+  };
+
+  it('writes every name the importer can return as it is, so it comes back unchanged', () => {
+    const names = [
+      'Hips', 'Left Arm', 'a b c', 'End Site', 'Site', 'End', 'JOINT', 'ROOT', 'MOTION', 'HIERARCHY', 'OFFSET', 'CHANNELS',
+      'Frames:', 'Frame Time:', 'Xrotation', '#comment', '(a)', '[x]', '"quoted"', "it's", 'back\\slash', 'ünïcødé',
+      '日本語の関節', '🦴 bone', 'x_end', 'Hips_to_Left Arm', '0', '-1.5', 'q'.repeat(500), 'unnamed', '\ufffd',
+    ];
+    expect(bvhJointNames(names)).toEqual(names);
+    expect(roundTrip(names)).toEqual(names);
+  });
+
+  it('sanitises braces, whitespace and control characters into unique names the importer reads back', () => {
+    const cases: Array<[string, string]> = [
+      ['root', 'root'], ['brace{open', 'brace(open'], ['brace}close', 'brace)close'], ['{}', '()'],
+      ['two  spaces', 'two spaces'], [' leading', 'leading'], ['trailing ', 'trailing'], ['tab\there', 'tab here'],
+      ['new\nline', 'new line'], ['crlf\r\nline', 'crlf line'], ['sep\u2028line', 'sep line'], ['nbsp\u00a0name', 'nbsp name'],
+      ['bell\u0007name', 'bell_name'], ['nul\u0000name', 'nul_name'], ['\n\t', 'unnamed'], [' ', 'unnamed_2'],
+      // A name that needs no change keeps it; a sanitised one that collides gets the next free suffix.
+      ['a{b', 'a(b_2'], ['a(b', 'a(b'], ['x  y', 'x y_3'], ['x y', 'x y'], ['x\ty', 'x y_4'], ['x y_2', 'x y_2'],
+    ];
+    const names = cases.map(([name]) => name);
+    const expected = cases.map(([, written]) => written);
+    expect(bvhJointNames(names)).toEqual(expected);
+    expect(roundTrip(names)).toEqual(expected);
+    for (const name of expected) expect(bvhJointNames([name])).toEqual([name]);
+  });
+
+  it('round-trips seeded random names: kept where importable, else as bvhJointNames says, always unique', () => {
+    const random = seededRandom(5);
+    const pieces = ['a', 'Z', '0', '_', 'é', '🦴', '(', ')', ' ', '  ', '\t', '\n', '\r', '{', '}', '\u2028', '\u00a0', '\u0001', '\u0085'];
+    for (let round = 0; round < 20; round++) {
+      const names = new Set<string>();
+      while (names.size < 40) {
+        let name = '';
+        for (let k = 1 + random.int(6); k > 0; k--) name += random.pick(pieces);
+        names.add(name);
+      }
+      const joints = [...names];
+      const written = bvhJointNames(joints);
+      expect(new Set(written).size).toBe(joints.length);
+      joints.forEach((name, j) => {
+        if (!/[{}\s\u0000-\u0008\u000e-\u001f\u007f-\u009f]/.test(name)) expect(written[j]).toBe(name);
+      });
+      expect(roundTrip(joints)).toEqual(written);
+    }
+  });
+
+  it('writes deep skeletons without recursion: a 1024-joint chain round-trips', () => {
+    const J = 1024;
+    const positions = new Float32Array(J * 3);
+    for (let j = 0; j < J; j++) positions.set([0.001 * Math.sin(j), (1.7 * j) / (J - 1), 0], j * 3);
+    const m: Motion = { fps: 30, frames: 1, joints: Array.from({ length: J }, (_, j) => `j${j}`), parents: Array.from({ length: J }, (_, j) => j - 1), positions };
+    const back = parseBVH(exportBVH(m), { unitScale: 0.01 });
+    expect(back.joints).toEqual(m.joints);
+    expect(maxPositionError(back, m)).toBeLessThan(1e-4);
+  });
+
+  it('refuses frame rates under 1 fps, whose frame time the importer rejects', () => {
+    const m: Motion = { fps: 0.5, frames: 1, joints: ['a', 'b'], parents: [-1, 0], positions: new Float32Array([0, 0, 0, 0, 1.7, 0]) };
+    expect(() => exportBVH(m)).toThrow('BVH export needs at least 1 fps (a "Frame Time" of at most 1 s, as the importer reads), got 0.5');
+    expect(parseBVH(exportBVH({ ...m, fps: 1 })).fps).toBe(1);
   });
 });

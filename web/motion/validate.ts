@@ -1,8 +1,10 @@
 // Shape and value checks for Motion objects handed in by API users or produced by the parsers.
 import type { Motion } from './types';
-import { MAX_FRAMES, MAX_VALUES } from './text';
+import { MAX_FRAMES, MAX_VALUES, quoteInput } from './text';
 
 export const MAX_JOINTS = 1024;
+/** Largest coordinate of a joint position, in metres (1000 km from the origin along any axis). */
+export const MAX_POSITION = 1e6;
 
 function fail(message: string): never {
   throw new Error(`Invalid motion: ${message}`);
@@ -35,7 +37,7 @@ export function validateMotion(m: unknown): Motion {
   const seen = new Set<string>();
   joints.forEach((name, j) => {
     if (typeof name !== 'string' || name.length === 0) fail(`joints[${j}] must be a non-empty string`);
-    if (seen.has(name)) fail(`duplicate joint name "${name}"`);
+    if (seen.has(name)) fail(`duplicate joint name ${quoteInput(name)}`);
     seen.add(name);
   });
 
@@ -59,9 +61,9 @@ export function validateMotion(m: unknown): Motion {
     if (!Number.isFinite(positions[i])) {
       const frame = Math.floor(i / (joints.length * 3));
       const joint = Math.floor(i / 3) % joints.length;
-      fail(`positions contain a non-finite value (${positions[i]}) at frame ${frame}, joint "${joints[joint]}"`);
+      fail(`positions contain a non-finite value (${positions[i]}) at frame ${frame}, joint ${quoteInput(joints[joint])}`);
     }
-    if (Math.abs(positions[i]) > 1e6) fail(`position value ${positions[i]} at index ${i} is implausibly large (metres expected)`);
+    if (Math.abs(positions[i]) > MAX_POSITION) fail(`position value ${positions[i]} at index ${i} is implausibly large (metres expected)`);
   }
 
   const motion: Motion = { fps, frames, joints: joints.slice(), parents: parents.slice(), positions };
