@@ -70,7 +70,7 @@ describe('generate checks', () => {
   it('takes the default temperature only when it is left out: null is refused', () => {
     expect(checkGenerate({ model: 'generator', frames: 10, seed: 0 }, MODELS)).toMatchObject({ temperature: 0.5 });
     expect(checkGenerate({ model: 'generator', frames: 10, seed: 0, temperature: undefined }, MODELS)).toMatchObject({ temperature: 0.5 });
-    expect(messageOf(() => checkGenerate({ model: 'generator', frames: 10, seed: 0, temperature: null }, MODELS))).toMatch(/^temperature must be a number from 0 to 2 .*, got null$/);
+    expect(messageOf(() => checkGenerate({ model: 'generator', frames: 10, seed: 0, temperature: null }, MODELS))).toBe('temperature must be a number from 0 to 2, got null');
   });
 });
 

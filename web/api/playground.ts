@@ -196,7 +196,7 @@ export function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorC
   }
   const temperature = optional(o.temperature, GENERATE_DEFAULT_TEMPERATURE);
   if (typeof temperature !== 'number' || !Number.isFinite(temperature) || temperature < 0 || temperature > 2) {
-    throw new RangeError(`temperature must be a number from 0 to 2 (or left out for ${GENERATE_DEFAULT_TEMPERATURE}), got ${describeValue(temperature)}`);
+    throw new RangeError(`temperature must be a number from 0 to 2, got ${describeValue(temperature)}`);
   }
   if (o.refine !== undefined && typeof o.refine !== 'boolean') throw new TypeError(`refine must be true or false, got ${describeValue(o.refine)}`);
   const refine = o.refine === true;
