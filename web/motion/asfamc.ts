@@ -185,7 +185,7 @@ function readUnitsLine(skeleton: AsfSkeleton, k: string, parts: string[], lineNo
   }
 }
 
-/** Each entry of `names` once: the first repeated one, or undefined. */
+/** The first entry of `names` that repeats an earlier one, or undefined. */
 function firstRepeat(names: string[]): string | undefined {
   const seen = new Set<string>();
   for (const name of names) {
@@ -453,7 +453,7 @@ function readAMCFrames(
   return { frameValues, angleUnit };
 }
 
-const AMC_ANGLE = { deg: 'an angle in degrees', rad: 'an angle in radians' } as const;
+const AMC_ANGLE = { deg: `an angle in ${ANGLE_UNIT_NAMES.deg}`, rad: `an angle in ${ANGLE_UNIT_NAMES.rad}` } as const;
 
 /** A "bone v1 v2 …" line: its values into the bone's slots of the frame vector, each within its bound. */
 function readBoneValues(k: JointKinematics, parts: string[], frame: Float64Array, lineNo: number, angleUnit: 'deg' | 'rad'): void {
