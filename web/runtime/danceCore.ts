@@ -66,10 +66,10 @@ export class DanceCore extends SessionCore<DanceInfo> {
     };
   }
 
-  /** One raw session call: x (B×D normalised), style (B×S one-hot), h and c (layers×B×H). */
-  async step(batch: number, x: Float32Array, style: Float32Array, h: Float32Array, c: Float32Array): Promise<DanceStepOutputs> {
+  /** One raw session call: x (B×D normalised), style (B×S one-hot), h and c (layers×B×H); with `signal`, a cancellation checkpoint first. */
+  async step(batch: number, x: Float32Array, style: Float32Array, h: Float32Array, c: Float32Array, signal?: AbortSignal): Promise<DanceStepOutputs> {
     const { L, H, D, S } = this;
-    const read = await this.run({ x: [x, [batch, D]], style: [style, [batch, S]], h: [h, [L, batch, H]], c: [c, [L, batch, H]] });
+    const read = await this.run({ x: [x, [batch, D]], style: [style, [batch, S]], h: [h, [L, batch, H]], c: [c, [L, batch, H]] }, signal);
     return { y: read('y', batch * D), h_out: read('h_out', L * batch * H), c_out: read('c_out', L * batch * H) };
   }
 
@@ -81,8 +81,11 @@ export class DanceCore extends SessionCore<DanceInfo> {
     return list[seed % list.length];
   }
 
-  /** A new dance: zero state, warmed up on the seed motion; its root stands at the origin, where the seed ends. */
-  async createStream(params: DanceStreamParams): Promise<DanceStream> {
+  /**
+   * A new dance: zero state, warmed up on the seed motion; its root stands at the origin, where the seed
+   * ends. Stops (making no stream) when `signal` aborts.
+   */
+  async createStream(params: DanceStreamParams, signal?: AbortSignal): Promise<DanceStream> {
     const seedIndex = this.seedIndex(params.style, params.seed);
     const { L, H, D, S } = this;
     const style = new Float32Array(S);
@@ -93,7 +96,7 @@ export class DanceCore extends SessionCore<DanceInfo> {
     for (const frame of this.info.seeds[seedIndex].frames) {
       const input = new Float32Array(D);
       for (let d = 0; d < D; d++) input[d] = (frame[d] - this.mean[d]) / this.std[d];
-      ({ y: x, h_out: h, c_out: c } = await this.step(1, input, style, h, c));
+      ({ y: x, h_out: h, c_out: c } = await this.step(1, input, style, h, c, signal));
     }
     return { params: { style: params.style, seed: params.seed }, seedIndex, style, x, h, c, root: { x: 0, z: 0 }, frame: 0 };
   }
@@ -102,8 +105,12 @@ export class DanceCore extends SessionCore<DanceInfo> {
     return { style: stream.params.style, seedIndex: stream.seedIndex, seedName: this.info.seeds[stream.seedIndex].name };
   }
 
-  /** The stream's next `frames` frames: decoded, fitted to the skeleton, continuing its root path. */
-  async advance(stream: DanceStream, frames: number): Promise<DanceChunk> {
+  /**
+   * The stream's next `frames` frames: decoded, fitted to the skeleton, continuing its root path. With
+   * `signal` it stops at the step where the signal is seen aborted, the stream part-advanced: pass it only
+   * for a throwaway stream.
+   */
+  async advance(stream: DanceStream, frames: number, signal?: AbortSignal): Promise<DanceChunk> {
     checkFrameCount(frames);
     const { D } = this;
     const features = new Float32Array(frames * D);
@@ -111,7 +118,7 @@ export class DanceCore extends SessionCore<DanceInfo> {
       const row = features.subarray(t * D, (t + 1) * D);
       denormalise(stream.x, this.mean, this.std, row);
       if (!row.every(Number.isFinite)) throw new Error(`the model produced a non-finite value at frame ${stream.frame + t}`);
-      const out = await this.step(1, stream.x, stream.style, stream.h, stream.c);
+      const out = await this.step(1, stream.x, stream.style, stream.h, stream.c, signal);
       stream.x = out.y;
       stream.h = out.h_out;
       stream.c = out.c_out;
@@ -130,10 +137,11 @@ export class DanceCore extends SessionCore<DanceInfo> {
     return chunk;
   }
 
-  async generate(params: DanceGenerateParams): Promise<DanceChunk> {
+  /** `frames` frames of a new dance; stops when `signal` aborts (cancellation.ts). */
+  async generate(params: DanceGenerateParams, signal?: AbortSignal): Promise<DanceChunk> {
     const { frames, ...streamParams } = params;
     checkFrameCount(frames);
-    return this.advance(await this.createStream(streamParams), frames);
+    return this.advance(await this.createStream(streamParams, signal), frames, signal);
   }
 
   /** Times `steps` raw session calls at `batch` rows, each feeding its output and state back (the dance loop). */

@@ -25,12 +25,12 @@ serveModel({
     return new GeneratorCore(session, info, ort.Tensor, threads, { loadRefiner: (core) => loadRefiner(refinerInfoUrl, core.info, threads) });
   },
   streamParams: (r: StreamParams): StreamParams => ({ seed: r.seed, temperature: r.temperature, seedIndex: r.seedIndex, ...(r.refine === undefined ? {} : { refine: r.refine }) }),
-  extra(request, core, progress) {
+  extra(request, core, progress, signal) {
     const generator = core as GeneratorCore;
     if (request.type === 'refinerParity') return refinerParity(generator, request as unknown as { inputs: RefinerStepInputs; frames?: number[] });
     let optimizer = optimizers.get(generator);
     if (!optimizer) optimizers.set(generator, (optimizer = new OptimizerRequests(generator)));
-    return optimizer.handle(request as { type: string } & Record<string, unknown>, progress);
+    return optimizer.handle(request as { type: string } & Record<string, unknown>, progress, signal);
   },
 });
 

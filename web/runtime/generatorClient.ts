@@ -21,7 +21,7 @@ import type {
   StreamInfo,
   StreamParams,
 } from './protocol';
-import { ModelClient } from './workerClient';
+import { ModelClient, type ProgressOptions, type RequestOptions } from './workerClient';
 
 export type {
   BenchmarkResult,
@@ -95,26 +95,32 @@ export class GeneratorClient extends ModelClient<StreamParams, InitResult, Gener
     return this.request<RefinerParityResult>('refinerParity', { inputs, ...(frames ? { frames: Array.from(frames) } : {}) });
   }
 
-  /** Follows a ground path (optimised in the worker); `onProgress` hears the share of the path done. */
-  async followPath(params: FollowPathParams, onProgress?: (fraction: number) => void): Promise<FollowedPath> {
-    const chunk = await this.request<FollowPathChunk>('followPath', { ...params }, undefined, onProgress);
+  /**
+   * Follows a ground path (optimised in the worker); `onProgress` hears the share of the path done;
+   * cancelled with `signal` (the optimiser stops at its next model step).
+   */
+  async followPath(params: FollowPathParams, options: ProgressOptions = {}): Promise<FollowedPath> {
+    const chunk = await this.request<FollowPathChunk>('followPath', { ...params }, options);
     return { ...this.toMotion(chunk), stats: chunk.stats, path: chunk.path };
   }
 
   /** Starts (or replaces) the live-control stream at the origin, facing +z. */
-  controlStart(params: ControlStartParams): Promise<StreamInfo> {
-    return this.request<StreamInfo>('controlStart', { ...params });
+  controlStart(params: ControlStartParams, options: RequestOptions = {}): Promise<StreamInfo> {
+    return this.request<StreamInfo>('controlStart', { ...params }, options);
   }
 
-  /** The control stream's next `frames` frames (1…12), optimised toward `target`. */
-  async controlPull(frames: number, target: ControlTargetParams): Promise<ControlledMotion> {
-    const chunk = await this.request<ControlChunkReply>('controlPull', { frames, ...target });
+  /**
+   * The control stream's next `frames` frames (1…12), optimised toward `target`. Cancelled with `signal`
+   * while queued it never runs; once running it runs whole (as `pull`).
+   */
+  async controlPull(frames: number, target: ControlTargetParams, options: RequestOptions = {}): Promise<ControlledMotion> {
+    const chunk = await this.request<ControlChunkReply>('controlPull', { frames, ...target }, options);
     return { ...this.toMotion(chunk), speed: chunk.speed, heading: chunk.heading, computeMs: chunk.computeMs };
   }
 
-  /** The live-control loop driven by a schedule instead of a person. */
-  async simulateControl(params: SimulateControlParams, onProgress?: (fraction: number) => void): Promise<SimulatedControl> {
-    const c = await this.request<SimulatedControlChunk>('simulateControl', { ...params }, undefined, onProgress);
+  /** The live-control loop driven by a schedule instead of a person; cancelled with `signal` (as followPath). */
+  async simulateControl(params: SimulateControlParams, options: ProgressOptions = {}): Promise<SimulatedControl> {
+    const c = await this.request<SimulatedControlChunk>('simulateControl', { ...params }, options);
     const { speed, heading, targetSpeed, targetHeading, computeMs, batchMs, batchFrames } = c;
     return { ...this.toMotion(c), speed, heading, targetSpeed, targetHeading, computeMs, batchMs, batchFrames };
   }

@@ -85,10 +85,10 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
     };
   }
 
-  /** One raw session call: x (B×D normalised), h and c (layers×B×H). */
-  async step(batch: number, x: Float32Array, h: Float32Array, c: Float32Array): Promise<StepOutputs> {
+  /** One raw session call: x (B×D normalised), h and c (layers×B×H); with `signal`, a cancellation checkpoint first. */
+  async step(batch: number, x: Float32Array, h: Float32Array, c: Float32Array, signal?: AbortSignal): Promise<StepOutputs> {
     const { L, H, M, D } = this;
-    const read = await this.run({ x: [x, [batch, D]], h: [h, [L, batch, H]], c: [c, [L, batch, H]] });
+    const read = await this.run({ x: [x, [batch, D]], h: [h, [L, batch, H]], c: [c, [L, batch, H]] }, signal);
     return {
       weights: read('weights', batch * M),
       mu: read('mu', batch * M * D),
@@ -129,9 +129,10 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
 
   /**
    * Advances a stream by `frames` steps and decodes them, continuing its root trajectory; a `refine` stream
-   * also runs the same frames through the refiner and the foot lock (`refined`).
+   * also runs the same frames through the refiner and the foot lock (`refined`). With `signal` it stops at
+   * the step where the signal is seen aborted, the stream part-advanced: pass it only for a throwaway stream.
    */
-  async advance(stream: GeneratorStream, frames: number): Promise<GeneratedChunk> {
+  async advance(stream: GeneratorStream, frames: number, signal?: AbortSignal): Promise<GeneratedChunk> {
     checkFrameCount(frames);
     const { M, D } = this;
     let refiner: RefinerCore | undefined;
@@ -144,7 +145,7 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
     // What the refiner reads: the frames exactly as fed back to the generator (normalised, contacts snapped).
     const fedBack = refiner ? new Float32Array(frames * D) : undefined;
     for (let t = 0; t < frames; t++) {
-      const out = await this.step(1, stream.x, stream.h, stream.c);
+      const out = await this.step(1, stream.x, stream.h, stream.c, signal);
       const x = sampleMixture({ weights: out.weights, mu: out.mu, sigma: out.sigma, batch: 1, mixtures: M, dim: D }, stream.params.temperature, stream.rng);
       snapContacts(x, D, this.mean, this.std);
       denormalise(x, this.mean, this.std, features.subarray(t * D, (t + 1) * D));
@@ -169,9 +170,10 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
     return chunk;
   }
 
-  async generate(params: GenerateParams): Promise<GeneratedChunk> {
+  /** `frames` frames of a new stream; stops when `signal` aborts (cancellation.ts). */
+  async generate(params: GenerateParams, signal?: AbortSignal): Promise<GeneratedChunk> {
     const { frames, ...streamParams } = params;
-    return this.advance(this.createStream(streamParams), frames);
+    return this.advance(this.createStream(streamParams), frames, signal);
   }
 
   /** Times `steps` raw session calls at `batch` rows, all starting from the first seed state. */

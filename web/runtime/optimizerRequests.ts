@@ -1,12 +1,16 @@
 // The generator worker's optimiser requests: path following, and live control by speed and heading
 // (one live stream at a time, and its scripted twin simulateControl). The algorithms live in
-// web/optimizer/; this file checks the requests and packs results for the page.
+// web/optimizer/; this file checks the requests and packs results for the page. followPath and
+// simulateControl stop at the next model step once cancelled (their optimiser runs with a step that
+// passes a checkpoint, cancellation.ts); a controlPull that has started runs whole, so the live stream
+// always stands where its last reply left it.
 import { followPath, gaitSeeds, type Gait } from '../optimizer/pathFollower';
 import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed, optional } from '../optimizer/options';
 import { checkSchedule, LiveController, simulateControl } from '../optimizer/liveControl';
 import { checkPathPoints, GroundPath, moveBack, relativeToStart } from '../optimizer/path';
 import { FootLock, footLock } from '../motion/footLock';
 import { footSkating } from '../motion/footSkating';
+import type { StepFn } from '../optimizer/rollout';
 import type { GeneratorCore } from './generatorCore';
 import type { ControlChunkReply, ControlStartParams, ControlTargetParams, FollowPathChunk, FollowPathParams, SimulateControlParams, SimulatedControlChunk, StreamInfo } from './protocol';
 
@@ -15,32 +19,35 @@ export class OptimizerRequests {
 
   constructor(private readonly core: GeneratorCore) {}
 
-  private step = (batch: number, x: Float32Array, h: Float32Array, c: Float32Array) => this.core.step(batch, x, h, c);
+  /** The generator step the optimiser runs; with `signal`, each step is a cancellation checkpoint. */
+  private stepFn(signal?: AbortSignal): StepFn {
+    return (batch, x, h, c) => this.core.step(batch, x, h, c, signal);
+  }
 
-  private controller(seed: number, gait: Gait): { controller: LiveController; seedIndex: number } {
+  private controller(seed: number, gait: Gait, signal?: AbortSignal): { controller: LiveController; seedIndex: number } {
     const info = this.core.info;
     const seeds = gaitSeeds(info, gait);
     const seedIndex = seeds[seed % seeds.length];
-    return { controller: new LiveController({ step: this.step, info, mean: this.core.mean, std: this.core.std, seed, seedIndex }), seedIndex };
+    return { controller: new LiveController({ step: this.stepFn(signal), info, mean: this.core.mean, std: this.core.std, seed, seedIndex }), seedIndex };
   }
 
   /** Handles one optimiser request; undefined when `request` is not one. */
-  handle(request: { type: string } & Record<string, unknown>, progress: (fraction: number) => void): Promise<unknown> | undefined {
+  handle(request: { type: string } & Record<string, unknown>, progress: (fraction: number) => void, signal?: AbortSignal): Promise<unknown> | undefined {
     switch (request.type) {
       case 'followPath':
-        return this.followPath(request as unknown as FollowPathParams, progress);
+        return this.followPath(request as unknown as FollowPathParams, progress, signal);
       case 'controlStart':
         return Promise.resolve(this.controlStart(request as unknown as ControlStartParams));
       case 'controlPull':
         return this.controlPull(request as unknown as ControlTargetParams & { frames: number; particles?: number });
       case 'simulateControl':
-        return this.simulate(request as unknown as SimulateControlParams, progress);
+        return this.simulate(request as unknown as SimulateControlParams, progress, signal);
       default:
         return undefined;
     }
   }
 
-  async followPath(p: FollowPathParams, progress: (fraction: number) => void): Promise<FollowPathChunk> {
+  async followPath(p: FollowPathParams, progress: (fraction: number) => void, signal?: AbortSignal): Promise<FollowPathChunk> {
     const points = checkPathPoints(p.points);
     const gait = checkGait(p.gait);
     const seed = checkSeed(p.seed);
@@ -50,7 +57,7 @@ export class OptimizerRequests {
     const { origin, local } = relativeToStart(points);
     const path = p.stroke ? GroundPath.fromStroke(local) : GroundPath.fromPoints(local);
     const info = this.core.info;
-    const r = await followPath({ step: this.step, info, mean: this.core.mean, std: this.core.std, path, gait, seed, fitSigma, onProgress: progress });
+    const r = await followPath({ step: this.stepFn(signal), info, mean: this.core.mean, std: this.core.std, path, gait, seed, fitSigma, onProgress: progress });
     const flat = new Float32Array(path.count * 2);
     for (let i = 0; i < path.count; i++) {
       flat[2 * i] = path.xs[i] + origin[0];
@@ -89,12 +96,12 @@ export class OptimizerRequests {
     return { ...chunk, seedIndex: live.seedIndex, startFrame };
   }
 
-  async simulate(p: SimulateControlParams, progress: (fraction: number) => void): Promise<SimulatedControlChunk> {
+  async simulate(p: SimulateControlParams, progress: (fraction: number) => void, signal?: AbortSignal): Promise<SimulatedControlChunk> {
     checkSeconds(p.seconds);
     const schedule = checkSchedule(p.schedule);
     const seed = checkSeed(p.seed);
     const gait = p.gait === undefined ? (schedule[0].speed >= 2 ? 'run' : 'walk') : checkGait(p.gait);
-    const { controller, seedIndex } = this.controller(seed, gait);
+    const { controller, seedIndex } = this.controller(seed, gait, signal);
     const fps = this.core.info.fps;
     const sim = await simulateControl(controller, schedule, p.seconds, fps, progress);
     const frames = sim.targets.length;

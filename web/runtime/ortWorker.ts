@@ -1,26 +1,23 @@
 /// <reference lib="webworker" />
 // What every model worker shares: onnxruntime-web's wasm setup (threads when cross-origin isolated,
-// else 1), fetching a model's JSON and ONNX bytes, creating the session, and the request loop (one
-// request at a time, in order, each answered by exactly one reply carrying its id).
+// else 1), fetching a model's JSON and ONNX bytes, creating the session, and the model requests served
+// by the request loop (requestLoop.ts: one request at a time, in order, each answered by exactly one
+// reply carrying its id, cancellable).
 import * as ort from 'onnxruntime-web/wasm';
 // The runtime's files, handed to onnxruntime explicitly so Vite serves them in dev and emits them in a
 // build. The .mjs stays a file of its own (not bundled into the worker) because the threaded runtime
 // starts its helper workers from the .mjs's own URL.
 import ortWasmUrl from 'onnxruntime-web/ort-wasm-simd-threaded.wasm?url';
 import ortGlueUrl from 'onnxruntime-web/ort-wasm-simd-threaded.mjs?url';
-import { WORKER_ERROR_ID, type ModelRequest, type WorkerMessage } from './protocol';
+import { WORKER_ERROR_ID, type ModelRequest } from './protocol';
+import { describe, serveRequests, type Progress } from './requestLoop';
 
 declare const self: DedicatedWorkerGlobalScope;
 
-export { ort };
+export { describe, ort };
 
 /** Thread count onnxruntime settled on when it loaded its wasm (it cannot change afterwards). */
 let runtimeThreads: number | undefined;
-
-export function describe(err: unknown): string {
-  if (err instanceof Error) return err.message || err.name;
-  return typeof err === 'string' ? err : (JSON.stringify(err) ?? String(err));
-}
 
 function absolute(url: string): string {
   return new URL(url, self.location.href).href;
@@ -86,55 +83,20 @@ async function loadSession<Info>(
   return { session, info, threads: runtimeThreads };
 }
 
-/** ArrayBuffers in a result (up to two levels deep), handed over instead of copied. */
-function transferables(result: unknown): Transferable[] {
-  const found = new Set<ArrayBuffer>();
-  const visit = (value: unknown, depth: number) => {
-    if (ArrayBuffer.isView(value) && value.buffer instanceof ArrayBuffer) found.add(value.buffer);
-    else if (value && typeof value === 'object' && depth < 2) Object.values(value).forEach((v) => visit(v, depth + 1));
-  };
-  visit(result, 0);
-  return [...found];
-}
-
 /**
- * The worker's message loop: requests are handled one at a time, in order; each gets exactly one
- * reply with its id, an error reply (`<type>: <message>`) if `handle` throws. An unhandled rejection
- * is reported with WORKER_ERROR_ID, prefixed with `name` ("generator worker").
+ * What a model worker runs: a step-loop core over one session (GeneratorCore, DanceCore). Methods given
+ * a `signal` pass a checkpoint (cancellation.ts) before each model step and stop there once it aborts.
  */
-/** Reports the share done of the request being handled (0…1). */
-export type Progress = (fraction: number) => void;
-
-function serveRequests<Request extends { type: string }>(name: string, handle: (request: Request, progress: Progress) => Promise<unknown>): void {
-  const reply = (message: WorkerMessage, transfer: Transferable[] = []) => self.postMessage(message, transfer);
-  let queue: Promise<void> = Promise.resolve();
-  self.addEventListener('message', (event: MessageEvent<{ id: number } & Request>) => {
-    const request = event.data;
-    queue = queue.then(async () => {
-      try {
-        const result = await handle(request, (fraction) => reply({ id: request.id, progress: fraction }));
-        reply({ id: request.id, ok: true, result }, transferables(result));
-      } catch (err) {
-        reply({ id: request.id, ok: false, error: `${request.type}: ${describe(err)}` });
-      }
-    });
-  });
-  self.addEventListener('unhandledrejection', (event) => {
-    reply({ id: WORKER_ERROR_ID, ok: false, error: `${name}: ${describe(event.reason)}` });
-  });
-}
-
-/** What a model worker runs: a step-loop core over one session (GeneratorCore, DanceCore). */
 export interface ModelCore<Stream, StreamParams> {
   /** One step on fixed inputs: a model whose sizes disagree with its JSON fails at load time. */
   check(): Promise<void>;
   release(): Promise<void>;
   /** The `init` reply. */
   describe(loadMs: number): unknown;
-  generate(params: StreamParams & { frames: number }): Promise<unknown>;
-  createStream(params: StreamParams): Stream | Promise<Stream>;
+  generate(params: StreamParams & { frames: number }, signal?: AbortSignal): Promise<unknown>;
+  createStream(params: StreamParams, signal?: AbortSignal): Stream | Promise<Stream>;
   streamInfo(stream: Stream): unknown;
-  advance(stream: Stream, frames: number): Promise<unknown>;
+  advance(stream: Stream, frames: number, signal?: AbortSignal): Promise<unknown>;
   benchmark(batch: number, steps: number): Promise<unknown>;
   parity(inputs: never): Promise<unknown>;
 }
@@ -147,13 +109,15 @@ export interface ModelWorker<Info, Stream, P> {
   /** The stream parameters of a generate or startStream request. */
   streamParams(request: P): P;
   /** Requests of this model only (the generator's path following and control); undefined: not one of them. */
-  extra?(request: { type: string }, core: ModelCore<Stream, P>, progress: Progress): Promise<unknown> | undefined;
+  extra?(request: { type: string }, core: ModelCore<Stream, P>, progress: Progress, signal: AbortSignal): Promise<unknown> | undefined;
 }
 
 /**
  * Serves one model in this worker: `init` loads it (replacing any earlier one), `generate` makes a
  * motion in one go, `startStream` / `pull` / `restart` drive one endless stream, `benchmark` and
- * `parity` time and check raw steps.
+ * `parity` time and check raw steps. `generate`, `startStream` and `restart` stop where they are when
+ * cancelled (a cancelled start leaves no stream); a `pull` that has started runs whole, so the stream
+ * always stands where its last reply left it (a cancelled pull still queued never runs).
  */
 export function serveModel<Info, Stream, P, StepInputs>(spec: ModelWorker<Info, Stream, P>): void {
   let core: ModelCore<Stream, P> | undefined;
@@ -163,9 +127,9 @@ export function serveModel<Info, Stream, P, StepInputs>(spec: ModelWorker<Info, 
   const fail = (message: string): never => {
     throw new Error(message);
   };
-  const start = async (c: ModelCore<Stream, P>, params: P) => {
-    stream = undefined; // a failed start leaves no stale stream behind
-    stream = { value: await c.createStream(params), params };
+  const start = async (c: ModelCore<Stream, P>, params: P, signal: AbortSignal) => {
+    stream = undefined; // a failed or cancelled start leaves no stale stream behind
+    stream = { value: await c.createStream(params, signal), params };
     return c.streamInfo(stream.value);
   };
 
@@ -186,24 +150,27 @@ export function serveModel<Info, Stream, P, StepInputs>(spec: ModelWorker<Info, 
     return core.describe(performance.now() - started);
   }
 
-  serveRequests<ModelRequest<P, StepInputs>>(`${spec.name} worker`, async (request, progress) => {
+  self.addEventListener('unhandledrejection', (event) => {
+    self.postMessage({ id: WORKER_ERROR_ID, ok: false, error: `${spec.name} worker: ${describe(event.reason)}` });
+  });
+  serveRequests<ModelRequest<P, StepInputs>>(self, async (request, progress, signal) => {
     switch (request.type) {
       case 'init':
         return init(request.modelUrl, request.infoUrl, request.threads);
       case 'generate':
-        return requireCore().generate({ ...spec.streamParams(request), frames: request.frames });
+        return requireCore().generate({ ...spec.streamParams(request), frames: request.frames }, signal);
       case 'startStream':
-        return start(requireCore(), spec.streamParams(request));
+        return start(requireCore(), spec.streamParams(request), signal);
       case 'pull':
         return requireCore().advance(requireStream().value, request.frames);
       case 'restart':
-        return start(requireCore(), requireStream().params);
+        return start(requireCore(), requireStream().params, signal);
       case 'benchmark':
         return requireCore().benchmark(request.batch, request.steps);
       case 'parity':
         return requireCore().parity(request.inputs as never);
       default: {
-        const handled = spec.extra?.(request, requireCore(), progress);
+        const handled = spec.extra?.(request, requireCore(), progress, signal);
         if (handled) return handled;
         throw new Error(`unknown request type "${(request as { type?: unknown }).type}"`);
       }

@@ -115,8 +115,20 @@ export interface ParityResult {
   outputs: StepOutputs;
 }
 
-/** A worker's answer to one request (the same shape for every model worker). */
-export type WorkerReply = { id: number; ok: true; result: unknown } | { id: number; ok: false; error: string };
+/**
+ * A worker's answer to one request (the same shape for every model worker). A cancelled request's error
+ * reply has `name` "AbortError" (cancellation.ts).
+ */
+export type WorkerReply = { id: number; ok: true; result: unknown } | { id: number; ok: false; error: string; name?: string };
+/**
+ * Asks the worker to cancel request `request` (the id it was sent with); not itself answered. A queued
+ * request is dropped without running and answered with an AbortError reply; a running one stops at its
+ * next checkpoint (requestLoop.ts) and is answered so too, or, having none left, is answered as usual.
+ */
+export interface CancelMessage {
+  type: 'cancel';
+  request: number;
+}
 /** Sent any number of times before a long request's reply: the share done (0…1). */
 export interface WorkerProgress {
   id: number;

@@ -2,6 +2,7 @@
 // its input and output names, normalisation, float32 feeds, reading outputs with clear errors, and
 // timing raw calls.
 import type { InferenceSession, Tensor, TensorConstructor } from 'onnxruntime-web';
+import { checkpoint } from './cancellation';
 import type { BenchmarkResult } from './protocol';
 
 /** Throws unless the session has every input and output the model's JSON names. */
@@ -86,9 +87,11 @@ export abstract class SessionCore<Info extends SessionModelInfo> {
 
   /**
    * One session call on float32 feeds (`name: [data, dims]`); returns a reader for outputs of known
-   * size, which names the files to blame when a size disagrees with the JSON.
+   * size, which names the files to blame when a size disagrees with the JSON. With `signal`, passes a
+   * checkpoint first (cancellation.ts): throws CancelledError instead of running once it has aborted.
    */
-  protected async run(feeds: Record<string, [Float32Array, number[]]>): Promise<(name: string, size: number) => Float32Array> {
+  protected async run(feeds: Record<string, [Float32Array, number[]]>, signal?: AbortSignal): Promise<(name: string, size: number) => Float32Array> {
+    if (signal) await checkpoint(signal);
     const tensors: Record<string, Tensor> = {};
     for (const [name, [data, dims]] of Object.entries(feeds)) tensors[name] = new this.Tensor('float32', data, dims);
     const out = await this.session.run(tensors);

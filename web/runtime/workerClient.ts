@@ -1,14 +1,27 @@
 // Main-thread side of a model worker, shared by GeneratorClient and DanceClient: requests carry an id
 // and are matched to replies by it (in any order), an error reply rejects its request with the worker's
-// message, a crashed or stalled worker rejects everything pending and every later call, and dispose
-// stops the worker.
+// message, a request whose signal aborts rejects at once with a CancelledError (name "AbortError") and
+// is cancelled in the worker, a crashed or stalled worker rejects everything pending and every later
+// call, and dispose stops the worker.
 import type { Motion } from '../motion/types';
-import { WORKER_ERROR_ID, type BenchmarkResult, type WorkerMessage } from './protocol';
+import { CANCELLED_ERROR_NAME, CancelledError } from './cancellation';
+import { WORKER_ERROR_ID, type BenchmarkResult, type CancelMessage, type WorkerMessage } from './protocol';
+
+/** Options of any request: `signal` cancels it (cancellation.ts). */
+export interface RequestOptions {
+  signal?: AbortSignal;
+}
+
+/** Options of a long request that reports progress: `onProgress` hears the share done (0…1). */
+export interface ProgressOptions extends RequestOptions {
+  onProgress?: (fraction: number) => void;
+}
 
 interface Pending {
   resolve: (value: unknown) => void;
   reject: (error: Error) => void;
-  timer?: ReturnType<typeof setTimeout>;
+  /** Clears the timeout and stops listening to the signal. */
+  settle: () => void;
   onProgress?: (fraction: number) => void;
 }
 
@@ -37,17 +50,35 @@ export class WorkerClient {
 
   /**
    * Sends one request; `timeoutMs` gives up on the whole worker if it has not answered by then;
-   * `onProgress` hears the worker's progress reports for it.
+   * `onProgress` hears the worker's progress reports for it. When `signal` aborts (or has already), the
+   * request rejects at once with a CancelledError ("<label> <type>: cancelled") and the worker is told
+   * to cancel it; its reply, if one still comes, is dropped.
    */
-  protected request<T>(type: string, body: object, timeoutMs?: number, onProgress?: (fraction: number) => void): Promise<T> {
+  protected request<T>(type: string, body: object, options: ProgressOptions & { timeoutMs?: number } = {}): Promise<T> {
     if (this.failure || !this.worker) return Promise.reject(this.failure ?? new Error(`${this.label} worker is not running`));
+    const { signal, onProgress, timeoutMs } = options;
+    const cancelled = () => new CancelledError(`${this.label} ${type}: cancelled`, { cause: signal?.reason });
+    if (signal?.aborted) return Promise.reject(cancelled());
     const id = this.nextId++;
     return new Promise<T>((resolve, reject) => {
-      const entry: Pending = { resolve: resolve as (value: unknown) => void, reject, onProgress };
-      if (timeoutMs !== undefined) {
-        // A worker that stalls would hold every later request in its queue too: give up on it entirely.
-        entry.timer = setTimeout(() => this.fail(new Error(`${this.label} ${type}: no answer from the worker within ${timeoutMs / 1000} s`)), timeoutMs);
-      }
+      // A worker that stalls would hold every later request in its queue too: give up on it entirely.
+      const timer = timeoutMs === undefined ? undefined : setTimeout(() => this.fail(new Error(`${this.label} ${type}: no answer from the worker within ${timeoutMs / 1000} s`)), timeoutMs);
+      const onAbort = () => {
+        if (!this.pending.delete(id)) return;
+        entry.settle();
+        this.worker?.postMessage({ type: 'cancel', request: id } satisfies CancelMessage);
+        reject(cancelled());
+      };
+      const entry: Pending = {
+        resolve: resolve as (value: unknown) => void,
+        reject,
+        onProgress,
+        settle: () => {
+          clearTimeout(timer);
+          signal?.removeEventListener('abort', onAbort);
+        },
+      };
+      signal?.addEventListener('abort', onAbort, { once: true });
       this.pending.set(id, entry);
       this.worker!.postMessage({ id, type, ...body });
     });
@@ -65,16 +96,16 @@ export class WorkerClient {
     const entry = this.pending.get(message.id);
     if (!entry) return;
     this.pending.delete(message.id);
-    clearTimeout(entry.timer);
+    entry.settle();
     if (message.ok) entry.resolve(message.result);
-    else entry.reject(new Error(`${this.label} ${message.error}`));
+    else entry.reject(message.name === CANCELLED_ERROR_NAME ? new CancelledError(`${this.label} ${message.error}`) : new Error(`${this.label} ${message.error}`));
   }
 
   /** Rejects everything pending, stops the worker and makes later calls reject with the same error. */
   private fail(error: Error): void {
     this.failure ??= error;
     for (const entry of this.pending.values()) {
-      clearTimeout(entry.timer);
+      entry.settle();
       entry.reject(error);
     }
     this.pending.clear();
@@ -120,28 +151,31 @@ export abstract class ModelClient<P extends object, Init extends ModelSkeleton, 
 
   /** Loads the model; resolves with what the worker reports about it. Call before anything else. */
   async init(): Promise<Init> {
-    this.loaded = await this.request<Init>('init', { ...this.urls, threads: this.threads }, this.initTimeoutMs);
+    this.loaded = await this.request<Init>('init', { ...this.urls, threads: this.threads }, { timeoutMs: this.initTimeoutMs });
     return this.loaded;
   }
 
-  /** `frames` new frames; the same parameters always give bit-identical output. */
-  async generate(params: P & { frames: number }): Promise<M> {
-    return this.toMotion(await this.request<Chunk>('generate', { ...params }));
+  /** `frames` new frames; the same parameters always give bit-identical output. Cancelled with `signal` (it stops between model steps). */
+  async generate(params: P & { frames: number }, options: RequestOptions = {}): Promise<M> {
+    return this.toMotion(await this.request<Chunk>('generate', { ...params }, options));
   }
 
-  /** Starts (or replaces) the endless stream; frames come from `pull`. */
-  startStream(params: P): Promise<Info> {
-    return this.request<Info>('startStream', { ...params });
+  /** Starts (or replaces) the endless stream; frames come from `pull`. A cancelled start leaves no stream. */
+  startStream(params: P, options: RequestOptions = {}): Promise<Info> {
+    return this.request<Info>('startStream', { ...params }, options);
   }
 
-  /** The stream's next `frames` frames, continuing its state and root trajectory. */
-  async pull(frames: number): Promise<M> {
-    return this.toMotion(await this.request<Chunk>('pull', { frames }));
+  /**
+   * The stream's next `frames` frames, continuing its state and root trajectory. Cancelled with `signal`
+   * while queued it never runs; once running it runs whole (the stream moves on, the reply is dropped).
+   */
+  async pull(frames: number, options: RequestOptions = {}): Promise<M> {
+    return this.toMotion(await this.request<Chunk>('pull', { frames }, options));
   }
 
   /** Back to the start of the stream, with the parameters it was started with. */
-  restart(): Promise<Info> {
-    return this.request<Info>('restart', {});
+  restart(options: RequestOptions = {}): Promise<Info> {
+    return this.request<Info>('restart', {}, options);
   }
 
   /** Times `steps` raw session calls at `batch` streams. */

@@ -55,7 +55,7 @@ export class DanceMode extends LiveMode<DanceMotion> {
     this.seed.dataset.style = this.style.value;
   }
 
-  protected async open(): Promise<LiveStream<DanceMotion>> {
+  protected async open(signal: AbortSignal): Promise<LiveStream<DanceMotion>> {
     const id = this.model.value;
     const { client, info } = await this.app.dance(id).load();
     this.client = { id, client };
@@ -63,13 +63,13 @@ export class DanceMode extends LiveMode<DanceMotion> {
     this.listStyles(info);
     this.listSeeds(info, this.seed.dataset.style === this.style.value ? Number(this.seed.value) || 0 : 0);
     const style = this.style.value;
-    const stream = await client.startStream({ style, seed: Number(this.seed.value) || 0 });
+    const stream = await client.startStream({ style, seed: Number(this.seed.value) || 0 }, { signal });
     this.seedName = stream.seedName;
     this.meter = new PoseChangeMeter(info.joints.length, info.fps);
     this.measured = 0;
     this.plot.reset(info.realPoseChange[style]);
     this.app.setLiveLabel('Dance', `${this.modelLabel} · ${style} · ${info.fps} fps · live`);
-    return { skeleton: info, pull: (frames) => client.pull(frames) };
+    return { skeleton: info, pull: (frames) => client.pull(frames, { signal }) };
   }
 
   protected forget(): void {

@@ -1,6 +1,7 @@
 // What the live modes (Random walk, Dance) share: a model streams endlessly in its worker, a chunk at a
 // time, a little ahead of the playhead; the viewer shows a rolling window of the last seconds
-// (interpolated at the display rate), so memory and drawing stay bounded for hours.
+// (interpolated at the display rate), so memory and drawing stay bounded for hours. A restart (a setting
+// changed) or stop (the mode left) cancels the stream's requests still in the worker's queue.
 
 import { detectContacts } from '../../motion/contacts';
 import type { Motion } from '../../motion/types';
@@ -41,6 +42,8 @@ export abstract class LiveMode<Chunk extends LiveChunk> {
   private active = false;
   /** Bumped on every (re)start and stop: a running loop whose token is stale ends. */
   private token = 0;
+  /** Cancels the running stream's requests (aborted on every restart and stop). */
+  private requests = new AbortController();
   private skeleton: LiveSkeleton | null = null;
   private positions = new Float32Array(0);
   private contacts = new Uint8Array(0);
@@ -75,6 +78,7 @@ export abstract class LiveMode<Chunk extends LiveChunk> {
   stop(): void {
     this.active = false;
     this.token++;
+    this.requests.abort();
   }
 
   /** Parameters are fixed for a stream: a change starts it again with them. */
@@ -82,8 +86,11 @@ export abstract class LiveMode<Chunk extends LiveChunk> {
     if (this.active) void this.restart();
   }
 
-  /** Loads the model (first time) and starts a new stream with the current settings. */
-  protected abstract open(): Promise<LiveStream<Chunk>>;
+  /**
+   * Loads the model (first time) and starts a new stream with the current settings; the stream's requests
+   * (its start and every pull) carry `signal`, which aborts when the stream is replaced or stopped.
+   */
+  protected abstract open(signal: AbortSignal): Promise<LiveStream<Chunk>>;
   /** Forgets the model after a failure, so the next start loads it afresh. */
   protected abstract forget(): void;
   /** Called with each new chunk once it is shown (`first`: a new stream). */
@@ -93,9 +100,11 @@ export abstract class LiveMode<Chunk extends LiveChunk> {
 
   private async restart(): Promise<void> {
     const token = ++this.token;
+    this.requests.abort();
+    this.requests = new AbortController();
     this.status.textContent = 'loading…';
     try {
-      const stream = await this.open();
+      const stream = await this.open(this.requests.signal);
       if (token !== this.token) return;
       this.skeleton = stream.skeleton;
       this.frames = 0;

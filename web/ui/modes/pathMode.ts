@@ -2,6 +2,7 @@
 // follower (web/optimizer) optimises the motion in the generator worker; the result plays with the
 // path as followed (mint) and the character's root trajectory (the viewer's purple trail) on the ground.
 // Redrawing replaces the path; a stroke that is too short, or a failed optimisation, keeps what was there.
+// A new path drawn while the last one is being walked, or leaving the mode, cancels that optimisation.
 
 import * as THREE from 'three';
 import { MAX_PATH_LENGTH, MIN_PATH_LENGTH } from '../../optimizer/path';
@@ -58,7 +59,8 @@ export class PathMode {
   private readonly line = new GroundLine(TARGET_COLOR, 0.05, 0.75);
 
   private active = false;
-  private busy = false;
+  /** The optimisation under way (aborted when it is no longer wanted), or null. */
+  private optimising: AbortController | null = null;
   /** The drawn path (empty: none). */
   private points: Point[] = [];
   private result: Result | null = null;
@@ -107,6 +109,7 @@ export class PathMode {
 
   leave(): void {
     this.active = false;
+    this.cancelOptimisation();
     this.cancelStroke();
     this.line.clear();
     const viewer = this.app.viewer;
@@ -157,10 +160,6 @@ export class PathMode {
 
   private onDown(e: PointerEvent): void {
     if (!this.active || this.stroke || !e.isPrimary || e.button !== 0 || e.ctrlKey || e.metaKey || e.altKey) return;
-    if (this.busy) {
-      this.app.note('The character is still being fitted to the last path: wait for it, then draw again.');
-      return;
-    }
     const p = this.groundAt(e);
     if (!p) return; // off the ground: let the controls turn the view
     const viewer = this.app.viewer;
@@ -221,6 +220,8 @@ export class PathMode {
       return;
     }
     this.points = s.points;
+    // The walk being optimised is for the path just replaced.
+    this.cancelOptimisation();
     this.showState();
   }
 
@@ -260,6 +261,19 @@ export class PathMode {
 
   // ---------- optimising ----------
 
+  private get busy(): boolean {
+    return this.optimising !== null;
+  }
+
+  /** Stops the optimisation under way, if any: its walk is no longer wanted (a new path, or the mode left). */
+  private cancelOptimisation(): void {
+    const run = this.optimising;
+    if (!run) return;
+    this.optimising = null;
+    run.abort();
+    this.showState();
+  }
+
   private async go(): Promise<void> {
     if (this.busy) return;
     const points = this.points;
@@ -268,25 +282,27 @@ export class PathMode {
       return;
     }
     const { gait, seed, fitSigma } = this.params();
-    this.busy = true;
+    const run = (this.optimising = new AbortController());
     this.progress.value = 0;
     this.showState();
     let client: GeneratorClient | undefined;
     try {
       client = (await this.app.generator.load()).client;
-      const r = await client.followPath({ points, gait, seed, fitSigma, stroke: true }, (fraction) => {
+      const onProgress = (fraction: number) => {
         this.progress.value = fraction;
         this.status.textContent = `finding a ${gait} along the path… ${Math.round(fraction * 100)} %`;
-      });
+      };
+      const r = await client.followPath({ points, gait, seed, fitSigma, stroke: true }, { signal: run.signal, onProgress });
+      if (run.signal.aborted) return;
       const motion: Motion = { fps: r.fps, frames: r.frames, joints: r.joints, parents: r.parents, positions: r.positions, contacts: r.contacts };
       this.result = { motion, path: r.path, stats: r.stats, gait, points };
-      this.busy = false;
-      if (this.active) {
-        // A stroke drawn meanwhile is not possible (drawing waits), so the result is for the drawn path.
-        this.display(this.result);
-      }
+      this.optimising = null;
+      // Not cancelled by a new path or by leaving the mode: the result is for the drawn path, in Path mode.
+      this.display(this.result);
     } catch (e) {
-      this.busy = false;
+      // Cancelled: whatever cancelled it has already set the state, and the walk is not wanted.
+      if (run.signal.aborted) return;
+      this.optimising = null;
       const message = errorMessage(e);
       // A request the worker refused leaves the worker fine; anything else (a crash) needs a new one.
       if (client && !message.startsWith('generator followPath:')) this.app.generator.reset(client);

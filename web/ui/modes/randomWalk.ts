@@ -87,7 +87,7 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     return { seed, temperature, ...(idx === undefined ? {} : { seedIndex: idx }), refine: this.refine.checked };
   }
 
-  protected async open(): Promise<LiveStream<WalkChunk>> {
+  protected async open(signal: AbortSignal): Promise<LiveStream<WalkChunk>> {
     const { client, info } = await this.app.generator.load();
     this.client = client;
     if (!this.seedsListed) {
@@ -95,7 +95,7 @@ export class RandomWalk extends LiveMode<WalkChunk> {
       this.seedsListed = true;
     }
     const params = this.params();
-    const stream = await client.startStream(params);
+    const stream = await client.startStream(params, { signal });
     this.seedName = stream.seedName;
     this.refining = params.refine;
     this.walkSkeleton = info;
@@ -103,7 +103,7 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     this.aligner = params.refine ? new CompanionAligner(info.joints.length, info.fps) : null;
     this.app.setLiveLabel('Random walk', params.refine ? 'generator + refiner · 30 fps · live' : 'generator · 30 fps · live');
     const pull = async (frames: number): Promise<WalkChunk> => {
-      const m = await client.pull(frames);
+      const m = await client.pull(frames, { signal });
       if (!params.refine) return m;
       if (!m.refined) throw new Error('the generator worker sent no refined frames');
       return { ...m, positions: m.refined.positions, contacts: m.refined.contacts, raw: { positions: m.positions, contacts: m.contacts, rootHeading: m.rootHeading } };

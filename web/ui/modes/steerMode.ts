@@ -159,10 +159,10 @@ export class SteerMode extends LiveMode<ControlledMotion> {
     this.app.viewer.invalidate();
   }
 
-  protected async open(): Promise<LiveStream<ControlledMotion>> {
+  protected async open(signal: AbortSignal): Promise<LiveStream<ControlledMotion>> {
     const { client, info } = await this.app.generator.load();
     this.client = client;
-    const stream = await client.controlStart({ seed: 0, gait: this.gaitValue });
+    const stream = await client.controlStart({ seed: 0, gait: this.gaitValue }, { signal });
     this.seedName = stream.seedName;
     // The stream starts at the origin facing +z, at the slider's speed.
     this.heading = 0;
@@ -171,7 +171,7 @@ export class SteerMode extends LiveMode<ControlledMotion> {
     this.computeMs = 0;
     this.particles = PARTICLES_MAX;
     this.app.setLiveLabel('Steer', `generator · ${info.fps} fps · live control · ${this.gaitValue}`);
-    return { skeleton: info, pull: (frames) => client.controlPull(frames, { speed: this.targetSpeed, heading: this.heading, particles: this.particles }) };
+    return { skeleton: info, pull: (frames) => client.controlPull(frames, { speed: this.targetSpeed, heading: this.heading, particles: this.particles }, { signal }) };
   }
 
   protected forget(): void {
