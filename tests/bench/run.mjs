@@ -92,6 +92,58 @@ async function playbackBenchmark(ctx, query) {
 }
 
 /**
+ * A long clip playing (default quality, trail and footprints on): CMU 16_11 (a walk, 120 fps) taken at
+ * 30 fps and repeated end to end, each repetition starting where the last one ended (the root walks on
+ * in a straight line), until `frames` frames; built in the page and shown with playground.show, which
+ * detects its contacts (footprints). Warms up, then measures like playback-auto.
+ */
+async function longClipBenchmark(ctx, frames) {
+  const { context, page, problems } = await openPlayground(ctx.browser, ctx.url, VIEWPORT);
+  try {
+    const amc = corpusText('cmu/amc/16_11.amc.gz');
+    const asf = corpusText('cmu/asf/16.asf');
+    const built = await page.evaluate(
+      async ({ amc, asf, frames }) => {
+        const clip = await window.playground.importMotion(amc, 'amc', asf);
+        const step = 4; // 120 → 30 fps
+        const J = clip.joints.length, root = clip.parents.indexOf(-1), src = clip.positions;
+        const lap = Math.floor(clip.frames / step);
+        const at = (f, k) => src[(f * step * J + root) * 3 + k];
+        const dx = at(lap - 1, 0) - at(0, 0), dz = at(lap - 1, 2) - at(0, 2);
+        const positions = new Float32Array(frames * J * 3);
+        for (let f = 0; f < frames; f++) {
+          const n = Math.floor(f / lap), from = (f % lap) * step * J * 3, to = f * J * 3;
+          for (let k = 0; k < J * 3; k += 3) {
+            positions[to + k] = src[from + k] + n * dx;
+            positions[to + k + 1] = src[from + k + 1];
+            positions[to + k + 2] = src[from + k + 2] + n * dz;
+          }
+        }
+        const started = performance.now();
+        window.playground.show({ fps: clip.fps / step, frames, joints: clip.joints, parents: clip.parents, positions }, `16_11 ×${Math.ceil(frames / lap)}`);
+        return { showMs: performance.now() - started, laps: frames / lap };
+      },
+      { amc, asf, frames },
+    );
+    await page.waitForTimeout(WARMUP_SECONDS * 1000);
+    const measured = await measureFrames(page, SECONDS, { clock: true });
+    const state = await page.evaluate(() => window.playground.state());
+    const stats = await page.evaluate(() => window.playground.stats());
+    if (!state.playing) throw new Error('clip stopped playing during the benchmark');
+    return {
+      clip: `cmu/amc/16_11 at 30 fps repeated ${built.laps.toFixed(1)}× (31 joints, ${frames} frames)`,
+      viewport: `${VIEWPORT.width}x${VIEWPORT.height}`,
+      show_ms: Math.round(built.showMs),
+      ...measured,
+      target_fps: 55,
+      ...displayFields(stats, problems),
+    };
+  } finally {
+    await context.close();
+  }
+}
+
+/**
  * Raw step throughput of a model client (`client`: its module, export and options) via its `benchmark`,
  * in a page opened with `?threads=N`. With `generate`, also the end-to-end rate of `generate` (steps,
  * decoding and, for the dance models, the skeleton fit) after a short warm-up call.
@@ -474,6 +526,11 @@ export const BENCHMARKS = [
     description: 'one character playing, ?quality=high (MSAA, full resolution unless too slow)',
     run: (ctx) => playbackBenchmark(ctx, '?quality=high'),
   },
+  ...[10_000, 100_000].map((frames) => ({
+    name: `long-clip-${frames / 1000}k`,
+    description: `a ${frames.toLocaleString('en')}-frame clip playing (16_11 repeated, 30 fps), default quality, trail and footprints on — target ≥ 55 fps mean`,
+    run: (ctx) => longClipBenchmark(ctx, frames),
+  })),
   ...GENERATOR_BENCHMARKS,
   {
     name: 'refiner-cost',
