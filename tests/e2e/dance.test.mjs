@@ -196,7 +196,7 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
     assert.match(m[8], /seed must be an integer .* got undefined/);
     assert.match(m[9], /^generate: temperature is not meaningful for acLSTM models/);
     assert.match(m[10], /^generate: refine is not available for acLSTM models/);
-    assert.match(m[11], /^generate: unknown option "tempo" for model "aclstm-vanilla" \(known: model, style, frames, seed\)/);
+    assert.match(m[11], /^generate: unknown option "tempo" for model "aclstm-vanilla" \(known: model, style, frames, seed, signal\)/);
     assert.match(m[12], /^generate: unknown option "style" for model "generator"/);
     assert.match(m[13], /^generate: unknown model "aclstm-plus" \(available: .*\baclstm\b.*\)/);
     assert.equal(results.same, true, 'current() is unchanged');

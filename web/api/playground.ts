@@ -10,6 +10,7 @@ import type { PlaybackState } from '../viewer/playback';
 import type { RenderStats } from '../viewer/viewer';
 import type { App } from '../ui/app';
 import { errorMessage } from '../ui/dom';
+import { CancelledError, isCancelled, unlessAborted } from '../runtime/cancellation';
 import { checkSchedule } from '../optimizer/liveControl';
 import { checkPathPoints, GroundPath } from '../optimizer/path';
 import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed, optional } from '../optimizer/options';
@@ -30,7 +31,16 @@ export interface ViewOptions {
   framing?: 'character' | 'all';
 }
 
-export interface GenerateOptions {
+/** Options of a request that can be cancelled (docs/api.md "Cancelling requests"). */
+export interface CancellableOptions {
+  /**
+   * Cancels the call when it aborts (an AbortController's signal): the call rejects at once with an Error
+   * named "AbortError", and the model worker stops the work between two model steps.
+   */
+  signal?: AbortSignal;
+}
+
+export interface GenerateOptions extends CancellableOptions {
   /** A model id from `models()` of kind "lstm-gmm" ("generator") or "aclstm" ("aclstm", "aclstm-vanilla"). */
   model: string;
   /** Number of frames, an integer 1…100000. */
@@ -51,7 +61,7 @@ export interface GenerateOptions {
   refine?: boolean;
 }
 
-export interface FollowPathOptions {
+export interface FollowPathOptions extends CancellableOptions {
   /** The path on the ground: [x, z] pairs in metres, at least 2, each x and z within ±10000 m, 0.5–200 m long. The character starts at the first point facing along the path. */
   points: [number, number][];
   /** "walk" (default) or "run": picks the seed states and the pace. */
@@ -79,7 +89,7 @@ export interface FollowPathStats {
 
 export type FollowedPathMotion = Motion & { contacts: Uint8Array; stats: FollowPathStats };
 
-export interface SimulateControlOptions {
+export interface SimulateControlOptions extends CancellableOptions {
   /** Length of the simulated run, seconds (0 < seconds ≤ 600), rounded to whole frames (at least one). */
   seconds: number;
   /** Targets over time: [{ t: 0, speed, heading }, …] with t in seconds, increasing; speed 0–4 m/s; heading in radians (0 faces +z). */
@@ -137,17 +147,17 @@ export interface Playground {
   stats(): RenderStats;
   /**
    * A new motion from a generator or dance model (loaded on first use). Same arguments → bit-identical
-   * motion. Does not show it (call `show`).
+   * motion. Does not show it (call `show`). `signal` cancels it.
    */
   generate(options: GenerateOptions): Promise<Motion>;
   /**
    * A walk or run along a ground path, optimised with the generator (Wang, Chai, Xia §5.2). Does not
-   * show it (call `show`). Resolves with the motion and how well it follows the path.
+   * show it (call `show`). Resolves with the motion and how well it follows the path. `signal` cancels it.
    */
   followPath(options: FollowPathOptions): Promise<FollowedPathMotion>;
   /**
    * The live steering loop driven by a schedule of speed and heading targets instead of a person (the
-   * same code as the Steer mode). Does not show it.
+   * same code as the Steer mode). Does not show it. `signal` cancels it.
    */
   simulateControl(options: SimulateControlOptions): Promise<ControlledMotion>;
 }
@@ -178,7 +188,7 @@ export function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorC
     if ('temperature' in o) throw new TypeError(`temperature is not meaningful for acLSTM models: they are deterministic (the seed only picks the seed motion); leave it out`);
     if ('refine' in o) throw new TypeError(`refine is not available for acLSTM models (there is no refiner for dance); leave it out`);
   }
-  const known = dance ? ['model', 'style', 'frames', 'seed'] : ['model', 'frames', 'seed', 'temperature', 'refine'];
+  const known = dance ? ['model', 'style', 'frames', 'seed', 'signal'] : ['model', 'frames', 'seed', 'temperature', 'refine', 'signal'];
   for (const k of Object.keys(options)) {
     if (!known.includes(k)) throw new TypeError(`unknown option ${describeValue(k)} for model "${entry.id}" (known: ${known.join(', ')})`);
   }
@@ -226,10 +236,24 @@ function checkView(options: unknown): ViewOptions {
   return options as ViewOptions;
 }
 
+/**
+ * The `signal` option: undefined when left out, else anything with an AbortSignal's `aborted` and
+ * `addEventListener` (so a signal from the page embedding this one in an iframe works too).
+ */
+function checkSignal(options: unknown): AbortSignal | undefined {
+  const signal = typeof options === 'object' && options !== null ? (options as { signal?: unknown }).signal : undefined;
+  if (signal === undefined) return undefined;
+  const s = signal as Partial<AbortSignal> | null;
+  if (typeof s !== 'object' || s === null || typeof s.aborted !== 'boolean' || typeof s.addEventListener !== 'function') {
+    throw new TypeError(`signal must be an AbortSignal (an AbortController's signal), got ${describeValue(signal)}`);
+  }
+  return signal as AbortSignal;
+}
+
 /** A dance as a Motion: the fitted positions, and foot contacts detected as for imported clips. */
-async function generateDance(app: App, o: DanceCall): Promise<Motion> {
+async function generateDance(app: App, o: DanceCall, signal: AbortSignal | undefined): Promise<Motion> {
   const { client } = await app.dance(o.model).load();
-  const m = await client.generate({ style: o.style, seed: o.seed, frames: o.frames });
+  const m = await client.generate({ style: o.style, seed: o.seed, frames: o.frames }, { signal });
   const motion: Motion = { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions };
   try {
     motion.contacts = detectContacts(motion);
@@ -262,21 +286,30 @@ function errorGuards(app: App) {
     }
   }
 
-  /** Like `guarded` for promises. */
+  /** Like `guarded` for promises; a cancelled call rejects with `context: cancelled` (an AbortError), not shown on the page. */
   async function guardedAsync<T>(context: string, fn: () => Promise<T>): Promise<T> {
     try {
       return await fn();
     } catch (e) {
+      if (isCancelled(e)) throw new CancelledError(`${context}: cancelled`, { cause: e });
       throw reported(context, e);
     }
   }
 
-  return { guarded, guardedAsync };
+  /** Like `guardedAsync` for a call with a `signal` option (checked first): `fn` gets it, and the call rejects as soon as it aborts. */
+  function cancellable<T>(context: string, options: unknown, fn: (signal: AbortSignal | undefined) => Promise<T>): Promise<T> {
+    return guardedAsync(context, () => {
+      const signal = checkSignal(options);
+      return unlessAborted(signal, () => fn(signal));
+    });
+  }
+
+  return { guarded, guardedAsync, cancellable };
 }
 
 export function createPlayground(app: App): Playground {
   let models: ModelInfo[] = [];
-  const { guarded, guardedAsync } = errorGuards(app);
+  const { guarded, guardedAsync, cancellable } = errorGuards(app);
 
   const ready = loadManifest(`${import.meta.env.BASE_URL}models/index.json`).then(
     (m) => {
@@ -342,12 +375,12 @@ export function createPlayground(app: App): Playground {
     stats: () => app.viewer.stats(),
 
     generate(options) {
-      return guardedAsync('generate', async () => {
+      return cancellable('generate', options, async (signal) => {
         await ready;
         const o = checkGenerate(options, models);
-        if (o.kind === 'aclstm') return generateDance(app, o);
+        if (o.kind === 'aclstm') return generateDance(app, o, signal);
         const { client } = await app.generator.load();
-        const m = await client.generate({ frames: o.frames, seed: o.seed, temperature: o.temperature, ...(o.refine ? { refine: true } : {}) });
+        const m = await client.generate({ frames: o.frames, seed: o.seed, temperature: o.temperature, ...(o.refine ? { refine: true } : {}) }, { signal });
         const shown = o.refine ? m.refined : m;
         if (!shown) throw new Error('the generator worker returned no refined frames');
         const motion: Motion = { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: shown.positions, contacts: shown.contacts };
@@ -356,8 +389,8 @@ export function createPlayground(app: App): Playground {
     },
 
     followPath(options) {
-      return guardedAsync('followPath', async () => {
-        const o = checkKeys(options, ['points', 'gait', 'seed', 'fitTolerance', 'footLock'], '{ points: [[x, z], …], gait?, seed?, fitTolerance?, footLock? }');
+      return cancellable('followPath', options, async (signal) => {
+        const o = checkKeys(options, ['points', 'gait', 'seed', 'fitTolerance', 'footLock', 'signal'], '{ points: [[x, z], …], gait?, seed?, fitTolerance?, footLock?, signal? }');
         // Checked here too (the worker checks again), so bad input fails fast and without a worker prefix.
         const points = checkPathPoints(o.points);
         GroundPath.fromPoints(points);
@@ -367,15 +400,15 @@ export function createPlayground(app: App): Playground {
         const lockFeet = checkFootLock(o.footLock);
         await ready;
         const { client } = await app.generator.load();
-        const m = await client.followPath({ points, gait, seed, fitSigma, footLock: lockFeet });
+        const m = await client.followPath({ points, gait, seed, fitSigma, footLock: lockFeet }, { signal });
         const { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock } = m.stats;
         return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, stats: { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock } };
       });
     },
 
     simulateControl(options) {
-      return guardedAsync('simulateControl', async () => {
-        const o = checkKeys(options, ['seconds', 'schedule', 'seed', 'gait', 'footLock'], '{ seconds, schedule: [{ t, speed, heading }, …], seed?, gait?, footLock? }');
+      return cancellable('simulateControl', options, async (signal) => {
+        const o = checkKeys(options, ['seconds', 'schedule', 'seed', 'gait', 'footLock', 'signal'], '{ seconds, schedule: [{ t, speed, heading }, …], seed?, gait?, footLock?, signal? }');
         const lockFeet = checkFootLock(o.footLock);
         const seconds = checkSeconds(o.seconds);
         const schedule = checkSchedule(o.schedule);
@@ -383,7 +416,7 @@ export function createPlayground(app: App): Playground {
         const gait = o.gait === undefined ? undefined : checkGait(o.gait);
         await ready;
         const { client } = await app.generator.load();
-        const m = await client.simulateControl({ seconds, schedule, seed, footLock: lockFeet, ...(gait ? { gait } : {}) });
+        const m = await client.simulateControl({ seconds, schedule, seed, footLock: lockFeet, ...(gait ? { gait } : {}) }, { signal });
         return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, speed: m.speed, heading: m.heading, computeMs: m.computeMs };
       });
     },
