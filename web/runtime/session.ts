@@ -91,7 +91,8 @@ export abstract class SessionCore<Info extends SessionModelInfo> {
    * checkpoint first (cancellation.ts): throws CancelledError instead of running once it has aborted.
    */
   protected async run(feeds: Record<string, [Float32Array, number[]]>, signal?: AbortSignal): Promise<(name: string, size: number) => Float32Array> {
-    if (signal) await checkpoint(signal);
+    const look = signal && checkpoint(signal);
+    if (look) await look;
     const tensors: Record<string, Tensor> = {};
     for (const [name, [data, dims]] of Object.entries(feeds)) tensors[name] = new this.Tensor('float32', data, dims);
     const out = await this.session.run(tensors);
