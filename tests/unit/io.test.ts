@@ -64,6 +64,9 @@ describe('validateMotion', () => {
     invalid((m) => delete m.fps, /fps must be a positive number/);
     invalid((m) => (m.fps = -30), /fps must be a positive number/);
     invalid((m) => (m.frames = 2.5), /frames must be an integer from 1 to 1000000, got 2\.5/);
+    // A string shows as a string, NaN as NaN (String() would print 10 and JSON null).
+    invalid((m) => ((m as { frames: unknown }).frames = '10'), /frames must be an integer from 1 to 1000000, got "10"$/);
+    invalid((m) => (m.fps = NaN), /fps must be a positive number \(≤ 10000\), got NaN$/);
     invalid((m) => (m.frames = 3), /positions has 12 values, expected frames × joints × 3 = 3 × 2 × 3 = 18/);
     invalid((m) => (m.joints = []), /joints must be a non-empty array/);
     invalid((m) => (m.joints = ['hips', 'hips']), /duplicate joint name "hips"/);

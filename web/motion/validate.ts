@@ -1,6 +1,7 @@
 // Shape and value checks for Motion objects handed in by API users or produced by the parsers.
 import type { Motion } from './types';
 import { MAX_FRAMES, MAX_VALUES, quoteInput } from './text';
+import { describeValue } from './describe';
 
 export const MAX_JOINTS = 1024;
 /** Largest coordinate of a joint position, in metres (1000 km from the origin along any axis). */
@@ -25,10 +26,10 @@ export function validateMotion(m: unknown): Motion {
   const o = m as Record<string, unknown>;
 
   const fps = o.fps;
-  if (typeof fps !== 'number' || !Number.isFinite(fps) || fps <= 0 || fps > 10000) fail(`fps must be a positive number (≤ 10000), got ${String(fps)}`);
+  if (typeof fps !== 'number' || !Number.isFinite(fps) || fps <= 0 || fps > 10000) fail(`fps must be a positive number (≤ 10000), got ${describeValue(fps)}`);
   const frames = o.frames;
   if (typeof frames !== 'number' || !Number.isInteger(frames) || frames < 1 || frames > MAX_FRAMES) {
-    fail(`frames must be an integer from 1 to ${MAX_FRAMES}, got ${String(frames)}`);
+    fail(`frames must be an integer from 1 to ${MAX_FRAMES}, got ${describeValue(frames)}`);
   }
 
   const joints = o.joints;
@@ -74,7 +75,7 @@ export function validateMotion(m: unknown): Motion {
     if (contacts.length !== frames * 2) fail(`contacts has ${contacts.length} values, expected frames × 2 = ${frames * 2}`);
     for (let i = 0; i < contacts.length; i++) {
       const v = Array.isArray(c) ? c[i] : contacts[i];
-      if (v !== 0 && v !== 1) fail(`contacts[${i}] must be 0 or 1, got ${String(v)}`);
+      if (v !== 0 && v !== 1) fail(`contacts[${i}] must be 0 or 1, got ${describeValue(v)}`);
     }
     motion.contacts = contacts;
   }
