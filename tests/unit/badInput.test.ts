@@ -8,7 +8,8 @@ import { MotionFormatError } from '../../web/motion/types';
 import { readCorpus } from './corpus';
 import { MAX_JOINTS } from '../../web/motion/validate';
 import { generatedBVH } from './bvhText';
-import { generatedASF, hierarchyParents, parentLinks, seededRandom } from './fuzz';
+import { checkFuzzCase, generatedAMC, generatedASF, hierarchyParents, parentLinks, seededRandom } from './fuzz';
+import { MAX_VALUES } from '../../web/motion/text';
 
 /** Runs fn, expects a MotionFormatError of that format (and line), returns its message. */
 function formatError(fn: () => unknown, format: 'bvh' | 'amc' | 'asf', line?: number): string {
@@ -368,6 +369,16 @@ describe('bad AMC input', () => {
     // A frame missing a bone in the middle of the file.
     expect(formatError(() => parseAMC(amcWithLine(31, () => ''), ASF), 'amc', 4)).toBe('AMC line 4: frame 1 has no values for "ltibia"');
     expect(formatError(() => parseAMC('root 0 0 0 0 0 0\n', ASF), 'amc', 1)).toMatch(/expected a frame number before "root"/);
+  });
+
+  it('rejects frames whose positions would pass 100 million values while reading them, within the work budget', () => {
+    // 1024 joints whose bones have no dofs: 6 values per frame but 3072 position values.
+    const asf = generatedASF(MAX_JOINTS - 1, parentLinks(hierarchyParents(seededRandom(1), 'wide', MAX_JOINTS)), '');
+    const amc = generatedAMC(seededRandom(2), 0, 40_000);
+    const frames = Math.floor(MAX_VALUES / (MAX_JOINTS * 3)) + 1; // the first frame too many: 32553
+    const line = 3 + (frames - 1) * 2;
+    expect(checkFuzzCase('1024 dof-less joints × 40,000 frames', () => importMotion(amc, 'amc', asf), asf.length + amc.length, ['AMC'])).toBe('rejected');
+    expect(formatError(() => parseAMC(amc, asf), 'amc', line)).toBe(`AMC line ${line}: ${frames} frames × 1024 joints × 3 = ${frames * 1024 * 3} position values; at most 100000000 are supported`);
   });
 
   it('rejects more than a million frames', () => {

@@ -138,13 +138,14 @@ export function checkFuzzCase(label: string, parse: () => Motion, inputLength: n
 }
 
 /**
- * ASF text with bones b1 … b<n−1> (one inch long, pointing up, dofs rx ry rz) and a :hierarchy of the given
- * parent → child links (joint indices: 0 is the root, j is bone b<j>), one line per parent in first-seen order.
+ * ASF text with bones b1 … b<n−1> (one inch long, pointing up, with the given dofs: rx ry rz unless told) and a
+ * :hierarchy of the given parent → child links (joint indices: 0 is the root, j is bone b<j>), one line per
+ * parent in first-seen order. Each bone takes 7 lines, whatever its dofs.
  */
-export function generatedASF(bones: number, links: ReadonlyArray<readonly [number, number]>): string {
+export function generatedASF(bones: number, links: ReadonlyArray<readonly [number, number]>, dofs = 'rx ry rz'): string {
   const name = (j: number) => (j === 0 ? 'root' : `b${j}`);
   const boneData: string[] = [];
-  for (let j = 1; j <= bones; j++) boneData.push(`begin\nname b${j}\ndirection 0 1 0\nlength 1\naxis 0 0 0 XYZ\ndof rx ry rz\nend`);
+  for (let j = 1; j <= bones; j++) boneData.push(`begin\nname b${j}\ndirection 0 1 0\nlength 1\naxis 0 0 0 XYZ\ndof ${dofs}\nend`);
   const children = new Map<number, number[]>();
   for (const [parent, child] of links) {
     const list = children.get(parent);
@@ -162,7 +163,10 @@ export function parentLinks(parents: readonly number[]): Array<[number, number]>
   return links;
 }
 
-/** AMC text for generatedASF's skeleton with `bones` bones: `frames` frames of small rotations. */
+/**
+ * AMC text for generatedASF's skeleton with `bones` bones (0 for a skeleton whose bones have no dofs): `frames`
+ * frames of small rotations. Frame f's number is on line 3 + (f − 1) × (bones + 2).
+ */
 export function generatedAMC(random: Random, bones: number, frames: number): string {
   const angle = () => (random.next() * 60 - 30).toFixed(3);
   const lines = [':FULLY-SPECIFIED', ':DEGREES'];

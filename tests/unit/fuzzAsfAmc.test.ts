@@ -104,6 +104,17 @@ describe('fuzzed ASF/AMC import (seeded)', () => {
     for (const group of ['truncated', 'bits flipped', 'numbers replaced']) expect(tally.get(group)?.rejected, group).toBeGreaterThan(0);
   });
 
+  it('skeletons at the joint limit whose bones have no dofs, with frames past the position limit: rejected within the budget', () => {
+    const random = seededRandom(FIRST_SEED);
+    for (const shape of SHAPES) {
+      const asf = generatedASF(MAX_JOINTS - 1, parentLinks(hierarchyParents(random, shape, MAX_JOINTS)), '');
+      const frames = 33_000 + random.int(10_000);
+      const amc = generatedAMC(random, 0, frames);
+      const label = `seed ${FIRST_SEED}, dof-less ${shape} skeleton of ${MAX_JOINTS} joints × ${frames} frames`;
+      expect(checkFuzzCase(label, () => importMotion(amc, 'amc', asf), asf.length + amc.length, ['AMC']), label).toBe('rejected');
+    }
+  });
+
   it(`AMC: ${CASES_PER_FORMAT} damaged clips`, () => {
     const tally = runCases((seed) => {
       const random = seededRandom(seed);

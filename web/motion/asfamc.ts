@@ -13,7 +13,9 @@
 // bones are read but ignored.
 //
 // Limits: at most MAX_JOINTS joints (the root and MAX_JOINTS − 1 bones), checked while reading
-// :bonedata; finite values beyond the bounds below are rejected as absurd, so positions stay finite.
+// :bonedata; at most MAX_FRAMES frames and MAX_VALUES values (the file's, and the positions': frames × joints
+// × 3), checked at each frame number before the frame is read; finite values beyond the bounds below are
+// rejected as absurd, so positions stay finite.
 import { MotionFormatError, type Motion } from './types';
 import { DEG, eulerToQuat, quatConjugate, quatIdentity, quatMultiply, quatRotate, type Quat, type Vec3 } from './math';
 import { MAX_FRAMES, MAX_VALUES, checkText, parseBounded, parseNumber, parseWork, quoteInput, splitLines, tokens } from './text';
@@ -435,6 +437,10 @@ function readAMCFrames(
       closeFrame(false);
       if (frameValues.length >= MAX_FRAMES) throw new MotionFormatError('amc', `more than ${MAX_FRAMES} frames`, lineNo);
       if ((frameValues.length + 1) * valuesPerFrame > MAX_VALUES) throw new MotionFormatError('amc', `more than ${MAX_VALUES} values`, lineNo);
+      const positionValues = (frameValues.length + 1) * J * 3;
+      if (positionValues > MAX_VALUES) {
+        throw new MotionFormatError('amc', `${frameValues.length + 1} frames × ${J} joints × 3 = ${positionValues} position values; at most ${MAX_VALUES} are supported`, lineNo);
+      }
       expectedNumber = n + 1;
       current = new Float64Array(valuesPerFrame);
       seen.fill(0);
