@@ -73,6 +73,23 @@ export function hugeNumbers(random: Random, text: string): FuzzCase {
   return { what: `numbers replaced: ${done.join('; ')}`, text: t };
 }
 
+/** Pieces of the formats' structure and number syntax that junkTokens inserts. */
+export const JUNK_TOKENS = ['{', '}', '\n', ' ', 'JOINT', 'End Site', 'OFFSET', '-', '.', 'e', '9', 'NaN', '#', ':', 'root', '1'];
+
+/** A few JUNK_TOKENS inserted at random offsets. */
+export function junkTokens(random: Random, text: string): FuzzCase {
+  let t = text;
+  const done: string[] = [];
+  const count = 1 + random.int(4);
+  for (let k = 0; k < count; k++) {
+    const at = random.int(t.length + 1);
+    const junk = random.pick(JUNK_TOKENS);
+    t = t.slice(0, at) + junk + t.slice(at);
+    done.push(`${JSON.stringify(junk)} at ${at}`);
+  }
+  return { what: `junk inserted: ${done.join(', ')}`, text: t };
+}
+
 /** Line breaks a file may use, by name: each variant should read exactly as the \n original. */
 export const LINE_ENDINGS = { CRLF: '\r\n', CR: '\r', 'U+2028': '\u2028', 'U+2029': '\u2029' } as const;
 

@@ -1,5 +1,5 @@
-// Seeded fuzzing of the BVH importer (issue 21): real corpus clips truncated, bit-flipped, given huge and
-// non-finite numbers, other line endings and absurd frame counts, plus generated deep and wide skeletons.
+// Seeded fuzzing of the BVH importer (issue 21): real corpus clips truncated, bit-flipped, given junk tokens,
+// huge and non-finite numbers, other line endings and absurd frame counts, plus generated deep and wide skeletons.
 // Every case must be rejected with a short Error naming BVH or accepted with finite positions, within the
 // parse-work budget of checkFuzzCase (tests/unit/fuzz.ts): counted steps, not time.
 import { describe, expect, it } from 'vitest';
@@ -8,7 +8,7 @@ import { parseBVH } from '../../web/motion/bvh';
 import { readCorpus } from './corpus';
 import { generatedBVH } from './bvhText';
 import {
-  HIERARCHY_SIZES, HUGE_COUNTS, byteFlips, checkFuzzCase, hierarchyParents, hugeNumbers, lineEndings, seededRandom, truncated,
+  HIERARCHY_SIZES, HUGE_COUNTS, byteFlips, checkFuzzCase, hierarchyParents, hugeNumbers, junkTokens, lineEndings, seededRandom, truncated,
   type FuzzCase, type FuzzOutcome, type HierarchyShape, type Random,
 } from './fuzz';
 
@@ -54,6 +54,10 @@ describe('BVH fuzzing (seeded, reproducible)', () => {
 
   it('bit flips', () => {
     fuzzClips(2111, 60, byteFlips);
+  });
+
+  it('junk tokens inserted', () => {
+    fuzzClips(2151, 60, junkTokens);
   });
 
   it('huge, non-finite and non-decimal numbers anywhere in the file: rejected unless all are denormal', () => {
