@@ -341,6 +341,10 @@ describe('bad AMC input', () => {
     expect(formatError(() => parseAMC(amcWithLine(3, () => ':RADIANS').replace('lfemur -18.0782', 'lfemur -2e6'), ASF), 'amc', 30)).toBe('AMC line 30: expected an angle in radians of at most 1000000 in magnitude, found "-2e6"');
     expect(formatError(() => parseAMC(amcWithLine(5, () => 'root 1e300 17.5143 -32.75 -1.4536 -6.19748 1.72036'), ASF), 'amc', 5)).toBe('AMC line 5: expected a root translation in length units of at most 1000000 in magnitude, found "1e300"');
     expect(formatError(() => parseAMC(amcWithLine(4, () => '9007199254740993'), ASF), 'amc', 4)).toBe('AMC line 4: expected a frame number of at most 9007199254740991, found "9007199254740993"');
+    // Within the file bound, but 228,600 km out with a length unit of 1/0.0001 inch: named like BVH's (frame, joint, axis, bound).
+    const tinyUnits = ASF.replace('length 0.45', 'length 0.0001');
+    const far = amcWithLine(5, () => 'root 900000 17.5143 -32.75 -1.4536 -6.19748 1.72036');
+    expect(formatError(() => importMotion(far, 'amc', tinyUnits), 'amc', 4)).toBe('AMC line 4: frame 1 puts joint "root" at x = 228600000 m (at most ±1000000 m on each axis)');
   });
 
   it('rejects lines with the wrong number of values', () => {

@@ -78,6 +78,7 @@ describe('validateMotion', () => {
     invalid((m) => (m.positions = 'none'), /positions must be a Float32Array or an array of numbers/);
     invalid((m) => ((m.positions as Float32Array)[7] = NaN), /non-finite value \(NaN\) at frame 1, joint "hips"/);
     invalid((m) => ((m.positions as Float32Array)[4] = Infinity), /non-finite value \(Infinity\) at frame 0, joint "head"/);
+    invalid((m) => ((m.positions as Float32Array)[10] = -2e6), /^Invalid motion: frame 1 puts joint "head" at y = -2000000 m \(at most ±1000000 m on each axis\)$/);
     invalid((m) => (m.contacts = new Uint8Array(3)), /contacts has 3 values, expected frames × 2 = 4/);
     invalid((m) => (m.contacts = [0, 2, 0, 1]), /contacts\[1\] must be 0 or 1, got 2/);
   });

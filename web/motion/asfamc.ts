@@ -19,7 +19,7 @@
 import { MotionFormatError, type Motion } from './types';
 import { DEG, eulerToQuat, quatConjugate, quatIdentity, quatMultiply, quatRotate, type Quat, type Vec3 } from './math';
 import { MAX_FRAMES, MAX_VALUES, checkText, parseBounded, parseNumber, parseWork, quoteInput, splitLines, tokens } from './text';
-import { MAX_JOINTS } from './validate';
+import { MAX_JOINTS, positionOutOfBounds } from './validate';
 
 /** `:units length L` (one length unit is 1/L inch) must lie in [MIN_LENGTH_UNIT, MAX_LENGTH_UNIT]. */
 export const MIN_LENGTH_UNIT = 1e-4;
@@ -352,10 +352,10 @@ export function parseAMC(text: string, asf: AsfSkeleton | string, options: AMCOp
   if (!(fps > 0 && Number.isFinite(fps))) throw new Error(`parseAMC: fps must be a positive number, got ${fps}`);
 
   const { kin, valuesPerFrame } = jointKinematics(skeleton);
-  const { frameValues, angleUnit } = readAMCFrames(splitLines(text), skeleton, kin, valuesPerFrame);
+  const frames = readAMCFrames(splitLines(text), skeleton, kin, valuesPerFrame);
   setAxisRotations(skeleton, kin);
-  const positions = amcPositions(skeleton, kin, frameValues, angleScale(angleUnit));
-  return { fps, frames: frameValues.length, joints: skeleton.joints.slice(), parents: skeleton.parents.slice(), positions };
+  const positions = amcPositions(skeleton, kin, frames, angleScale(frames.angleUnit));
+  return { fps, frames: frames.frameValues.length, joints: skeleton.joints.slice(), parents: skeleton.parents.slice(), positions };
 }
 
 /** Per joint: where its values live in a frame vector and which rotation they make (C still identity). */
@@ -390,17 +390,25 @@ function jointKinematics(skeleton: AsfSkeleton): { kin: JointKinematics[]; value
   return { kin, valuesPerFrame };
 }
 
+/** An AMC file's frames: their value vectors, the file's number for the first one, the line of each one's number; its angle unit. */
+interface AMCFrames {
+  frameValues: Float64Array[];
+  firstNumber: number;
+  numberLines: number[];
+  angleUnit: 'deg' | 'rad';
+}
+
 /**
- * The frame vectors of an AMC file, and its angle unit. AMC lines: ":DEGREES" / ":RADIANS" / other
- * headers, "#" comments, frame numbers, "bone v1 v2 …".
+ * The frames of an AMC file, and its angle unit. AMC lines: ":DEGREES" / ":RADIANS" / other headers,
+ * "#" comments, frame numbers, "bone v1 v2 …".
  */
-function readAMCFrames(
-  lines: string[], skeleton: AsfSkeleton, kin: JointKinematics[], valuesPerFrame: number,
-): { frameValues: Float64Array[]; angleUnit: 'deg' | 'rad' } {
+function readAMCFrames(lines: string[], skeleton: AsfSkeleton, kin: JointKinematics[], valuesPerFrame: number): AMCFrames {
   const J = skeleton.joints.length;
   let angleUnit = skeleton.angleUnit;
   const jointIndex = new Map(skeleton.joints.map((n, j) => [n, j]));
   const frameValues: Float64Array[] = [];
+  const numberLines: number[] = [];
+  let firstNumber = 0;
   let current: Float64Array | undefined;
   const seen = new Uint8Array(J);
   let currentLine = 0;
@@ -441,7 +449,9 @@ function readAMCFrames(
       if (positionValues > MAX_VALUES) {
         throw new MotionFormatError('amc', `${frameValues.length + 1} frames × ${J} joints × 3 = ${positionValues} position values; at most ${MAX_VALUES} are supported`, lineNo);
       }
+      if (expectedNumber < 0) firstNumber = n;
       expectedNumber = n + 1;
+      numberLines.push(lineNo);
       current = new Float64Array(valuesPerFrame);
       seen.fill(0);
       currentLine = lineNo;
@@ -456,7 +466,7 @@ function readAMCFrames(
   }
   closeFrame(true);
   if (frameValues.length === 0) throw new MotionFormatError('amc', 'no frames found (expected a frame number followed by bone lines)');
-  return { frameValues, angleUnit };
+  return { frameValues, firstNumber, numberLines, angleUnit };
 }
 
 const AMC_ANGLE = { deg: `an angle in ${ANGLE_UNIT_NAMES.deg}`, rad: `an angle in ${ANGLE_UNIT_NAMES.rad}` } as const;
@@ -489,8 +499,11 @@ function setAxisRotations(skeleton: AsfSkeleton, kin: JointKinematics[]): void {
   });
 }
 
-/** Forward kinematics: frames × joints × 3 positions in metres (see the header comment). */
-function amcPositions(skeleton: AsfSkeleton, kin: JointKinematics[], frameValues: Float64Array[], motionAngle: number): Float32Array {
+/**
+ * Forward kinematics: frames × joints × 3 positions in metres (see the header comment); a position beyond
+ * ±MAX_POSITION on an axis is rejected, naming the frame (by its number in the file) and the line of that number.
+ */
+function amcPositions(skeleton: AsfSkeleton, kin: JointKinematics[], { frameValues, firstNumber, numberLines }: AMCFrames, motionAngle: number): Float32Array {
   const J = skeleton.joints.length;
   const frames = frameValues.length;
   const positions = new Float32Array(frames * J * 3);
@@ -520,11 +533,12 @@ function amcPositions(skeleton: AsfSkeleton, kin: JointKinematics[], frameValues
         const o = quatRotate(globals[j], k.offset);
         ends[j] = [ends[p][0] + o[0], ends[p][1] + o[1], ends[p][2] + o[2]];
       }
+      for (let axis = 0; axis < 3; axis++) {
+        const far = positionOutOfBounds(ends[j][axis], firstNumber + f, skeleton.joints[j], axis);
+        if (far) throw new MotionFormatError('amc', far, numberLines[f]);
+      }
       positions.set(ends[j], (f * J + j) * 3);
     }
-  }
-  for (let v = 0; v < positions.length; v++) {
-    if (!Number.isFinite(positions[v])) throw new MotionFormatError('amc', 'joint positions overflow (values too large)');
   }
   return positions;
 }

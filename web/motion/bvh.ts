@@ -34,7 +34,7 @@ import {
   rotationFromTwoVectors, swingRotation, cross, length, normalize, type Axis, type Quat, type Vec3,
 } from './math';
 import { MAX_FRAMES, MAX_VALUES, checkText, parseBounded, parseNumber, parseWork, quoteInput, splitLines, tokens } from './text';
-import { MAX_JOINTS, MAX_POSITION, validateMotion } from './validate';
+import { MAX_JOINTS, positionOutOfBounds, validateMotion } from './validate';
 
 export interface BVHOptions {
   /** Metres per file unit; detected from the skeleton's rest height when omitted. */
@@ -367,9 +367,8 @@ export function parseBVH(text: string, options: BVHOptions = {}): Motion {
       const w = world[keptNodes[j]];
       for (let axis = 0; axis < 3; axis++) {
         const v = w[axis] * unitScale;
-        if (!(Math.abs(v) <= MAX_POSITION)) {
-          throw new MotionFormatError('bvh', `frame ${frame + 1} puts joint ${quoteInput(joints[j])} at ${AXIS_NAMES[axis]} = ${v} m (at most ±${MAX_POSITION} m on each axis)`, i + 1);
-        }
+        const far = positionOutOfBounds(v, frame + 1, joints[j], axis);
+        if (far) throw new MotionFormatError('bvh', far, i + 1);
         positions[base + j * 3 + axis] = v;
       }
     }

@@ -7,6 +7,18 @@ export const MAX_JOINTS = 1024;
 /** Largest coordinate of a joint position, in metres (1000 km from the origin along any axis). */
 export const MAX_POSITION = 1e6;
 
+const AXIS_NAMES = ['x', 'y', 'z'];
+
+/**
+ * Why a joint position is out of bounds, or undefined when `value` (metres, on `axis` 0…2) lies within
+ * ±MAX_POSITION: `frame` is the frame's number as the caller counts it. Shared by the parsers and
+ * validateMotion, so every format names the bound alike. The value is shown to 7 digits, as a position keeps it.
+ */
+export function positionOutOfBounds(value: number, frame: number, joint: string, axis: number): string | undefined {
+  if (Math.abs(value) <= MAX_POSITION) return undefined;
+  return `frame ${frame} puts joint ${quoteInput(joint)} at ${AXIS_NAMES[axis]} = ${Number(value.toPrecision(7))} m (at most ±${MAX_POSITION} m on each axis)`;
+}
+
 function fail(message: string): never {
   throw new Error(`Invalid motion: ${message}`);
 }
@@ -59,12 +71,11 @@ export function validateMotion(m: unknown): Motion {
     fail(`positions has ${positions.length} values, expected frames × joints × 3 = ${frames} × ${joints.length} × 3 = ${expected}`);
   }
   for (let i = 0; i < positions.length; i++) {
-    if (!Number.isFinite(positions[i])) {
-      const frame = Math.floor(i / (joints.length * 3));
-      const joint = Math.floor(i / 3) % joints.length;
-      fail(`positions contain a non-finite value (${positions[i]}) at frame ${frame}, joint ${quoteInput(joints[joint])}`);
-    }
-    if (Math.abs(positions[i]) > MAX_POSITION) fail(`position value ${positions[i]} at index ${i} is implausibly large (metres expected)`);
+    if (Math.abs(positions[i]) <= MAX_POSITION) continue; // NaN and ±Infinity are not
+    const frame = Math.floor(i / (joints.length * 3));
+    const joint = joints[Math.floor(i / 3) % joints.length];
+    if (!Number.isFinite(positions[i])) fail(`positions contain a non-finite value (${positions[i]}) at frame ${frame}, joint ${quoteInput(joint)}`);
+    fail(positionOutOfBounds(positions[i], frame, joint, i % 3)!);
   }
 
   const motion: Motion = { fps, frames, joints: joints.slice(), parents: parents.slice(), positions };
