@@ -1,7 +1,7 @@
 // Reading dropped or picked files (web/runtime/motionFiles.ts): the kind from the name or the contents, gzip.
 import { gzipSync } from 'node:zlib';
 import { describe, expect, it } from 'vitest';
-import { baseName, FileImporter, kindFromName, kindFromText, readTextFile, type ImportProgress } from '../../web/runtime/motionFiles';
+import { baseName, FileImporter, kindFromName, kindFromText, MAX_FILE_BYTES, readTextFile, type ImportProgress } from '../../web/runtime/motionFiles';
 import { readCorpus } from './corpus';
 
 describe('file kinds', () => {
@@ -31,6 +31,13 @@ describe('readTextFile', () => {
     expect(await readTextFile(new File([BVH], 'walk.bvh'))).toEqual({ name: 'walk.bvh', kind: 'bvh', text: BVH });
     expect(await readTextFile(new File([gzipSync(BVH)], 'unnamed'))).toEqual({ name: 'unnamed', kind: 'bvh', text: BVH });
     expect(await readTextFile(new File([gzipSync(BVH)], 'walk.bvh.gz'))).toEqual({ name: 'walk.bvh', kind: 'bvh', text: BVH });
+  });
+
+  it('refuses a file over 256 MiB, before or once decompressed, naming the limit', async () => {
+    const huge = Object.defineProperty(new File([BVH], 'huge.bvh'), 'size', { value: 300 * 2 ** 20 });
+    await expect(readTextFile(huge)).rejects.toThrow(/^huge\.bvh: file too large \(300\.0 MiB; at most 256 MiB\)$/);
+    const bomb = new File([gzipSync(Buffer.alloc(MAX_FILE_BYTES + 1, 'x'))], 'bomb.bvh.gz'); // about 260 KB of gzip
+    await expect(readTextFile(bomb)).rejects.toThrow(/^bomb\.bvh\.gz: file too large once decompressed \(more than 256 MiB\)$/);
   });
 
   it('refuses a .gz file that is not gzip', async () => {

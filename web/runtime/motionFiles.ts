@@ -15,6 +15,7 @@ export interface TextFile {
 
 /** Largest file read (after decompression); bigger ones are refused before parsing. */
 export const MAX_FILE_BYTES = 256 * 1024 * 1024;
+const MIB = 1024 * 1024;
 
 /** How far an import has got: reading (or decompressing) a file, with the share of its bytes read; then parsing it. */
 export interface ImportProgress {
@@ -59,7 +60,7 @@ export function baseName(name: string): string {
  * bytes read (stage "decompress" for gzip), and a gzip file stops as soon as it decompresses past MAX_FILE_BYTES.
  */
 export async function readTextFile(file: File, onProgress?: ProgressListener): Promise<TextFile> {
-  if (file.size > MAX_FILE_BYTES) throw new Error(`${file.name}: file too large (${(file.size / 1e6).toFixed(0)} MB)`);
+  if (file.size > MAX_FILE_BYTES) throw new Error(`${file.name}: file too large (${(file.size / MIB).toFixed(1)} MiB; at most ${MAX_FILE_BYTES / MIB} MiB)`);
   const gz = isGzip(new Uint8Array(await file.slice(0, 2).arrayBuffer())) || /\.gz$/i.test(file.name);
   if (gz && typeof DecompressionStream === 'undefined') throw new Error(`${file.name}: this browser cannot decompress gzip files`);
   const stage = gz ? 'decompress' : 'read';
@@ -93,7 +94,7 @@ export async function readTextFile(file: File, onProgress?: ProgressListener): P
     size += chunk.value.length;
     if (size > MAX_FILE_BYTES) {
       void reader.cancel();
-      throw new Error(`${file.name}: file too large once decompressed`);
+      throw new Error(`${file.name}: file too large once decompressed (more than ${MAX_FILE_BYTES / MIB} MiB)`);
     }
     parts.push(decoder.decode(chunk.value, { stream: true }));
   }
