@@ -19,6 +19,13 @@ describe('file kinds', () => {
     expect(kindFromText('hello')).toBeNull();
   });
 
+  it('from contents whose lines end in U+2028 or U+2029, as the parsers read them', () => {
+    for (const separator of ['\u2028', '\u2029']) {
+      expect(kindFromText(['# exported', 'HIERARCHY', 'ROOT Hips'].join(separator))).toBe('bvh');
+      expect(kindFromText(['# comment', ':version 1.10', ':units'].join(separator))).toBe('asf');
+    }
+  });
+
   it('base names drop the folder, .gz and the extension', () => {
     expect(baseName('dir/16_11.amc.gz')).toBe('16_11');
   });

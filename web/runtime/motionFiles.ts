@@ -2,6 +2,7 @@
 // gzip by magic number or .gz suffix, kind by extension or content, the .amc's skeleton chosen among the
 // files given (or remembered from an earlier drop), then parsed with motion/io importMotion.
 import { importMotion } from '../motion/io';
+import { splitLines } from '../motion/text';
 import type { Motion } from '../motion/types';
 
 export type FileKind = 'bvh' | 'amc' | 'asf';
@@ -40,9 +41,9 @@ export function kindFromName(name: string): FileKind | null {
   return m ? (m[1].toLowerCase() as FileKind) : null;
 }
 
-/** Guesses the kind from the first non-comment line when the name does not tell. */
+/** Guesses the kind from the first non-comment lines (broken as the parsers break them) when the name does not tell. */
 export function kindFromText(text: string): FileKind | null {
-  const head = text.slice(0, 4096).split(/\r\n|\n|\r/).map((l) => l.trim()).filter((l) => l && !l.startsWith('#'));
+  const head = splitLines(text.slice(0, 4096)).map((l) => l.trim()).filter((l) => l && !l.startsWith('#'));
   const first = head[0] ?? '';
   if (/^HIERARCHY\b/i.test(first)) return 'bvh';
   if (head.some((l) => /^:(FULLY-SPECIFIED|DEGREES|RADIANS)\b/i.test(l)) && !head.some((l) => /^:(root|bonedata)\b/i.test(l))) return 'amc';
