@@ -245,7 +245,7 @@ describe('motion playground page', { timeout: 150_000 }, () => {
     assert.ok(same, 'download equals exportBVH(current())');
   });
 
-  test('importMotion parses in the import worker: the motion comes back whole, a parser error keeps its name', async () => {
+  test('importMotion parses in the import worker: the motion comes back whole, a parser error keeps its name, format and line', async () => {
     const r = await page.evaluate(async ({ bvh, SUMMARY }) => {
       const posted = [];
       const native = Worker.prototype.postMessage;
@@ -260,7 +260,7 @@ describe('motion playground page', { timeout: 150_000 }, () => {
           posted,
           motion: eval(SUMMARY)(m),
           typed: m.positions instanceof Float32Array && m.contacts instanceof Uint8Array,
-          error: { name: error.name, message: error.message, cause: error.cause?.name },
+          error: { name: error.name, message: error.message, cause: { name: error.cause?.name, format: error.cause?.format, line: error.cause?.line } },
         };
       } finally {
         Worker.prototype.postMessage = native;
@@ -268,7 +268,7 @@ describe('motion playground page', { timeout: 150_000 }, () => {
     }, { bvh: text.bvh, SUMMARY });
     assert.deepEqual(r.posted, ['text', 'text']);
     assert.deepEqual([r.motion.frames, r.motion.joints[0], r.motion.n, r.typed], [450, 'Hips', 450 * r.motion.joints.length * 3, true]);
-    assert.deepEqual([r.error.name, r.error.cause], ['MotionFormatError', 'MotionFormatError']);
+    assert.deepEqual([r.error.name, r.error.cause], ['MotionFormatError', { name: 'MotionFormatError', format: 'bvh', line: 187 }]);
     assert.match(r.error.message, /^importMotion: BVH line 187: .*"fast"/);
   });
 

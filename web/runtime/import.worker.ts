@@ -4,8 +4,8 @@
 // dropped one after another are shown in that order and an .asf dropped first is remembered for the
 // .amc after it. A result's typed arrays are transferred to the page, not copied.
 import { importMotion } from '../motion/io';
-import type { Motion } from '../motion/types';
-import type { ImportReply, ImportRequest, ImportResult } from './importProtocol';
+import { MotionFormatError, type Motion } from '../motion/types';
+import type { ImportError, ImportReply, ImportRequest, ImportResult } from './importProtocol';
 import { FileImporter } from './motionFiles';
 
 declare const self: DedicatedWorkerGlobalScope;
@@ -15,6 +15,17 @@ let queue: Promise<void> = Promise.resolve();
 
 function reply(message: ImportReply, transfer: Transferable[] = []): void {
   self.postMessage(message, transfer);
+}
+
+/** An error as the reply carries it (structured cloning would drop a MotionFormatError's name, format and line). */
+function importError(e: unknown): ImportError {
+  if (!(e instanceof Error)) return { name: 'Error', message: String(e) };
+  const error: ImportError = { name: e.name, message: e.message || e.name };
+  if (e instanceof MotionFormatError) {
+    error.format = e.format;
+    if (e.line !== undefined) error.line = e.line;
+  }
+  return error;
 }
 
 /** The buffers of a result's motion: its positions and contacts. */
@@ -33,8 +44,7 @@ async function handle(request: ImportRequest): Promise<void> {
         : importMotion(request.text, request.format, request.asfText);
     reply({ id, ok: true, result }, buffersOf(result));
   } catch (e) {
-    const error = e instanceof Error ? { name: e.name, message: e.message || e.name } : { name: 'Error', message: String(e) };
-    reply({ id, ok: false, error });
+    reply({ id, ok: false, error: importError(e) });
   }
 }
 

@@ -1,9 +1,21 @@
 // The page's side of the import worker (import.worker.ts): motion files and texts are parsed there, so a
 // large import leaves the page thread free; the parsed Motion's arrays come back transferred. The worker
 // starts on first use; one that fails rejects what it was doing, and the next call starts a fresh one.
-import type { Motion } from '../motion/types';
-import type { ImportReply, ImportRequest, ImportRequestBody, ImportResult } from './importProtocol';
+import { MotionFormatError, type Motion } from '../motion/types';
+import type { ImportError, ImportReply, ImportRequest, ImportRequestBody, ImportResult } from './importProtocol';
 import type { FileImportOutcome, ProgressListener } from './motionFiles';
+
+/** The worker's error rebuilt on the page: a MotionFormatError again (format and line kept) when it was one, else an Error of its name. */
+function rebuiltError({ name, message, format, line }: ImportError): Error {
+  if (format !== undefined) {
+    const error = new MotionFormatError(format, '', line);
+    error.message = message; // the worker's message as it was, "BVH line 187: …"
+    return error;
+  }
+  const error = new Error(message);
+  error.name = name;
+  return error;
+}
 
 interface Pending {
   resolve: (result: ImportResult) => void;
@@ -21,7 +33,7 @@ export class ImportClient {
     return this.request({ type: 'files', files }, onProgress) as Promise<FileImportOutcome>;
   }
 
-  /** motion/io importMotion in the worker: rejects with the parser's error name and message. */
+  /** motion/io importMotion in the worker: rejects with the parser's error (a MotionFormatError with its format, line and message). */
   importText(text: string, format: 'bvh' | 'amc', asfText?: string): Promise<Motion> {
     return this.request({ type: 'text', text, format, ...(asfText === undefined ? {} : { asfText }) }) as Promise<Motion>;
   }
@@ -69,9 +81,7 @@ export class ImportClient {
       entry.resolve(message.result);
       return;
     }
-    const error = new Error(message.error.message);
-    error.name = message.error.name;
-    entry.reject(error);
+    entry.reject(rebuiltError(message.error));
   }
 
   /** Rejects everything pending and stops the worker; the next request starts a new one. */

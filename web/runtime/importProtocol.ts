@@ -1,7 +1,7 @@
 // Messages between ImportClient (page thread) and import.worker.ts. Every request carries an id; the worker
 // answers it with any number of progress messages and then exactly one reply with the same id. An error
-// reply carries the error's name and message, so a MotionFormatError stays one on the page.
-import type { Motion } from '../motion/types';
+// reply carries the error's name and message, and a MotionFormatError's format and line, so it stays one on the page.
+import type { Motion, MotionFormat } from '../motion/types';
 import type { FileImportOutcome, ImportProgress } from './motionFiles';
 
 export type ImportRequestBody =
@@ -14,7 +14,15 @@ export type ImportRequest = ImportRequestBody & { id: number };
 
 export type ImportResult = FileImportOutcome | Motion;
 
+/** A failed request's error as it crosses to the page: `format` (and `line`, when known) only for a MotionFormatError. */
+export interface ImportError {
+  name: string;
+  message: string;
+  format?: MotionFormat;
+  line?: number;
+}
+
 export type ImportReply =
   | { id: number; ok: true; result: ImportResult }
-  | { id: number; ok: false; error: { name: string; message: string } }
+  | { id: number; ok: false; error: ImportError }
   | { id: number; progress: ImportProgress };
