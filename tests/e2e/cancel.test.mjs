@@ -6,7 +6,7 @@
 // time. Run with `node --test tests/e2e/cancel.test.mjs`.
 import assert from 'node:assert/strict';
 import { before, describe, test } from 'node:test';
-import { nextFrames, usePlayground, waitUntil } from './harness.mjs';
+import { drawStroke, usePlayground, waitUntil } from './harness.mjs';
 
 /**
  * Logs every model worker's traffic in `window.workerLog`: requests sent (`sent`: worker, id, type;
@@ -45,16 +45,6 @@ const ZIGZAG = Array.from({ length: 121 }, (_, i) => {
   return [leg % 2 ? 0.85 - 0.7 * t : 0.15 + 0.7 * t, 0.3 + 0.07 * leg + 0.07 * t];
 });
 
-async function drawStroke(page, points) {
-  const box = await page.locator('canvas.viewer-canvas').boundingBox();
-  const at = ([fx, fy]) => [box.x + fx * box.width, box.y + fy * box.height];
-  await page.mouse.move(...at(points[0]));
-  await page.mouse.down();
-  for (const p of points.slice(1)) await page.mouse.move(...at(p), { steps: 2 });
-  await page.mouse.up();
-  await nextFrames(page, 2);
-}
-
 const pathState = (page) => page.evaluate(() => ({ state: document.getElementById('path-status').dataset.state, text: document.getElementById('path-status').textContent }));
 
 /** Waits until the generator worker has answered request `type` number `nth` (0-based) and returns the reply. */
@@ -66,7 +56,7 @@ function replyTo(page, type, nth, what) {
 async function optimiseZigzag(page) {
   await page.click('#mode-path');
   if (await page.locator('#path-clear').isEnabled()) await page.click('#path-clear');
-  await drawStroke(page, ZIGZAG);
+  await drawStroke(page, ZIGZAG, 2);
   const drawn = await pathState(page);
   assert.equal(drawn.state, 'drawn', drawn.text);
   const before = await page.evaluate(() => window.workerLog.progress.length);
@@ -150,7 +140,7 @@ describe('cancelling requests', { timeout: 600_000 }, () => {
     assert.equal(await page.locator('#path-go').isEnabled(), true, 'Go walks it again');
 
     await optimiseZigzag(page);
-    await drawStroke(page, [[0.3, 0.5], [0.5, 0.5], [0.7, 0.55]]);
+    await drawStroke(page, [[0.3, 0.5], [0.5, 0.5], [0.7, 0.55]], 2);
     const redrawn = await replyTo(page, 'followPath', n + 1, 'the worker answers the path follower');
     assert.deepEqual([redrawn.ok, redrawn.name], [false, 'AbortError'], 'a new path cancelled the optimisation of the old one');
     const state = await pathState(page);

@@ -143,3 +143,17 @@ export function usePlayground(options) {
   });
   return suite;
 }
+
+/**
+ * Drags the mouse along `points` (fractions of the page's canvas, [x, y]) with the left button, `steps`
+ * mouse moves per segment, then lets the page draw twice.
+ */
+export async function drawStroke(page, points, steps = 3) {
+  const box = await page.locator('canvas.viewer-canvas').boundingBox();
+  const at = ([fx, fy]) => [box.x + fx * box.width, box.y + fy * box.height];
+  await page.mouse.move(...at(points[0]));
+  await page.mouse.down();
+  for (const p of points.slice(1)) await page.mouse.move(...at(p), { steps });
+  await page.mouse.up();
+  await nextFrames(page, 2);
+}

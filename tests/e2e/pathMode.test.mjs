@@ -5,20 +5,9 @@
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { describe, test } from 'node:test';
-import { nextFrames, usePlayground, waitUntil } from './harness.mjs';
+import { drawStroke, nextFrames, usePlayground, waitUntil } from './harness.mjs';
 
 const STATS = /error mean (\d+\.\d) cm · max (\d+\.\d) cm · (\d+) % of the path · (\d+\.\d) s for (\d+\.\d) s of motion/;
-
-/** Drags the mouse along `points` (fractions of the canvas, [x, y]) with the left button. */
-async function drawStroke(page, points) {
-  const box = await page.locator('canvas.viewer-canvas').boundingBox();
-  const at = ([fx, fy]) => [box.x + fx * box.width, box.y + fy * box.height];
-  await page.mouse.move(...at(points[0]));
-  await page.mouse.down();
-  for (const p of points.slice(1)) await page.mouse.move(...at(p), { steps: 3 });
-  await page.mouse.up();
-  await nextFrames(page, 2);
-}
 
 /** A straight stroke across the middle of the view, `n` + 1 points. */
 function line(x0, x1, y, n = 30) {
