@@ -1,6 +1,6 @@
 // End-to-end tests of cancelling requests (docs/api.md "Cancelling requests"): an API call's `signal`
 // (a generate issued behind a long simulateControl resolves once that is aborted; the aborted call
-// rejects with an AbortError), and the modes' own cancels (leaving Path mode or drawing a new path
+// rejects with an AbortError; an importMotion queued behind a large one and aborted is never parsed), and the modes' own cancels (leaving Path mode or drawing a new path
 // cancels the walk being optimised; a new Random walk seed drops the stream start it replaces). The
 // page's worker traffic is logged by an init script, so the tests wait on what the worker did, not on
 // time. Run with `node --test tests/e2e/cancel.test.mjs`.
@@ -106,6 +106,32 @@ describe('cancelling requests', { timeout: 600_000 }, () => {
     assert.equal(short, 12);
   });
 
+  test('an importMotion queued behind a large one and aborted rejects with an AbortError and is never parsed; the next import works', async () => {
+    const page = suite.page;
+    const errorBefore = await page.evaluate(() => window.playground.lastError());
+    const r = await page.evaluate(async () => {
+      const bvh = (frames) =>
+        ['HIERARCHY', 'ROOT Hips', '{', 'OFFSET 0 0 0', 'CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation', 'End Site', '{', 'OFFSET 0 10 0', '}', '}', 'MOTION', `Frames: ${frames}`, 'Frame Time: 0.0333333', ...Array(frames).fill('0 90 0 0 0 0')].join('\n');
+      const outcome = (p) => p.then((m) => ({ frames: m.frames }), (e) => ({ name: e.name, message: e.message }));
+      const sent = window.workerLog.sent.length;
+      const large = outcome(window.playground.importMotion(bvh(400_000), 'bvh'));
+      const cancel = new AbortController();
+      const queued = outcome(window.playground.importMotion(bvh(2), 'bvh', undefined, { signal: cancel.signal }));
+      cancel.abort();
+      const queuedOutcome = await queued;
+      const next = await outcome(window.playground.importMotion(bvh(3), 'bvh'));
+      const imports = window.workerLog.sent.slice(sent).filter((s) => s.worker === 'import');
+      const queuedReply = window.workerLog.replies.find((reply) => reply.worker === 'import' && reply.id === imports[1].id);
+      return { large: await large, queued: queuedOutcome, next, imports: imports.map((s) => s.type), queuedReply };
+    });
+    assert.deepEqual(r.queued, { name: 'AbortError', message: 'importMotion: cancelled' });
+    assert.deepEqual(r.large, { frames: 400_000 });
+    assert.deepEqual(r.next, { frames: 3 });
+    assert.deepEqual(r.imports, ['text', 'text', 'cancel', 'text']);
+    assert.deepEqual([r.queuedReply.ok, r.queuedReply.error], [false, { name: 'AbortError', message: 'cancelled' }], 'the worker dropped the queued import without parsing it');
+    assert.equal(await page.evaluate(() => window.playground.lastError()), errorBefore, 'a cancel is not an error shown on the page');
+  });
+
   test('a signal that has already aborted rejects at once without reaching the worker; a signal that is not one is refused', async () => {
     const page = suite.page;
     const r = await page.evaluate(async () => {
@@ -113,11 +139,15 @@ describe('cancelling requests', { timeout: 600_000 }, () => {
       const outcome = (p) => p.then(() => 'resolved', (e) => ({ name: e.name, message: e.message }));
       const followed = await outcome(window.playground.followPath({ points: [[0, 0], [0, 3]], signal: AbortSignal.abort() }));
       const generated = await outcome(window.playground.generate({ model: 'aclstm', style: 'salsa', frames: 5, seed: 0, signal: AbortSignal.abort() }));
+      const imported = await outcome(window.playground.importMotion('HIERARCHY', 'bvh', undefined, { signal: AbortSignal.abort() }));
+      const badImport = await outcome(window.playground.importMotion('HIERARCHY', 'bvh', undefined, { signal: 'stop' }));
       const bad = await outcome(window.playground.generate({ model: 'generator', frames: 5, seed: 0, signal: 'stop' }));
-      return { followed, generated, bad, sent: window.workerLog.sent.length - sent, lastError: window.playground.lastError() };
+      return { followed, generated, imported, badImport, bad, sent: window.workerLog.sent.length - sent, lastError: window.playground.lastError() };
     });
     assert.deepEqual(r.followed, { name: 'AbortError', message: 'followPath: cancelled' });
     assert.deepEqual(r.generated, { name: 'AbortError', message: 'generate: cancelled' });
+    assert.deepEqual(r.imported, { name: 'AbortError', message: 'importMotion: cancelled' });
+    assert.deepEqual(r.badImport, { name: 'TypeError', message: 'importMotion: signal must be an AbortSignal (an AbortController\'s signal), got "stop"' });
     assert.equal(r.bad.name, 'TypeError');
     assert.match(r.bad.message, /^generate: signal must be an AbortSignal \(an AbortController's signal\), got "stop"$/);
     assert.equal(r.lastError, r.bad.message, 'the refused signal is reported like any bad option');

@@ -106,6 +106,20 @@ describe('the request loop and WorkerClient', () => {
     w.close();
   });
 
+  it('drops a request cancelled while queued behind one that runs without pausing (as a parse does)', async () => {
+    const w = connect();
+    const first = w.client.call<number>('echo', { value: 1 }); // id 1: runs in one go, never passing a checkpoint
+    const cancel = new AbortController();
+    const queued = w.client.call<number>('echo', { value: 2 }, { signal: cancel.signal }); // id 2
+    cancel.abort(); // the cancel reaches the worker after both requests
+    expect((await rejection(queued)).name).toBe('AbortError');
+    expect(await first).toBe(1);
+    expect(await w.replyTo(2)).toEqual({ id: 2, ok: false, error: 'echo: cancelled', name: 'AbortError' });
+    expect(await w.client.call<number>('echo', { value: 3 })).toBe(3);
+    expect(w.handled).toEqual(['echo 1', 'echo 3']);
+    w.close();
+  });
+
   it('stops a running request at its next checkpoint; the next request runs normally', async () => {
     const w = connect();
     const cancel = new AbortController();

@@ -35,7 +35,8 @@ export interface ViewOptions {
 export interface CancellableOptions {
   /**
    * Cancels the call when it aborts (an AbortController's signal): the call rejects at once with an Error
-   * named "AbortError", and the model worker stops the work between two model steps.
+   * named "AbortError", and the worker stops the work (a model between two model steps; an import before
+   * its parse, or at the next chunk of a file being read).
    */
   signal?: AbortSignal;
 }
@@ -121,8 +122,8 @@ export interface Playground {
   readonly ready: Promise<void>;
   /** Models from the manifest (empty until models ship). */
   models(): ModelInfo[];
-  /** Parses a BVH, or an AMC with its ASF skeleton text. Does not show it. */
-  importMotion(text: string, format: ImportFormat, asfText?: string): Promise<Motion>;
+  /** Parses a BVH, or an AMC with its ASF skeleton text. Does not show it. `signal` cancels it. */
+  importMotion(text: string, format: ImportFormat, asfText?: string, options?: CancellableOptions): Promise<Motion>;
   /** BVH text of a motion (centimetres, y up, ZYX Euler channels, Frame Time = 1/fps). */
   exportBVH(motion: Motion): string;
   /** Shows a motion in the viewer from its first frame, playing. `name` labels it on the page. */
@@ -326,12 +327,13 @@ export function createPlayground(app: App): Playground {
     ready,
     models: () => models.map((m) => ({ ...m, ...(m.styles ? { styles: [...m.styles] } : {}) })),
 
-    importMotion(text, format, asfText) {
-      return guardedAsync('importMotion', async () => {
+    importMotion(text, format, asfText, options) {
+      return cancellable('importMotion', options, async (signal) => {
+        if (options !== undefined) checkKeys(options, ['signal'], '{ signal? }');
         if (typeof text !== 'string') throw new TypeError(`text must be a string, got ${describeValue(text)}`);
         if (format !== 'bvh' && format !== 'amc') throw new TypeError(`format must be "bvh" or "amc", got ${describeValue(format)}`);
         if (format === 'amc' && typeof asfText !== 'string') throw new TypeError('an AMC motion needs its skeleton: pass the ASF file text as asfText');
-        return app.importer.importText(text, format, format === 'amc' ? asfText : undefined); // parsed in the import worker
+        return app.importer.importText(text, format, format === 'amc' ? asfText : undefined, { signal }); // parsed in the import worker
       });
     },
 

@@ -21,7 +21,7 @@ const WORK_BETWEEN_LOOKS_MS = 20;
 let lastLook = 0;
 
 /** Resolves after the event loop has run the tasks already queued (a message-channel round trip, not a timer). */
-function nextTask(): Promise<void> {
+export function nextTask(): Promise<void> {
   return new Promise((resolve) => {
     const channel = new MessageChannel();
     channel.port1.onmessage = () => {
@@ -32,7 +32,7 @@ function nextTask(): Promise<void> {
   });
 }
 
-function throwIfCancelled(signal: AbortSignal): void {
+export function throwIfCancelled(signal: AbortSignal): void {
   if (signal.aborted) throw new CancelledError('cancelled');
 }
 

@@ -2,20 +2,18 @@
 // Parses imported motion capture off the page thread: dropped or picked files (read, gunzipped, parsed:
 // motionFiles.ts) and playground.importMotion's text. Requests run one at a time, in order, so files
 // dropped one after another are shown in that order and an .asf dropped first is remembered for the
-// .amc after it. A result's typed arrays are transferred to the page, not copied.
+// .amc after it. A result's typed arrays are transferred to the page, not copied. The request loop is the
+// model workers' (requestLoop.ts): a cancelled request that has not started is dropped; a File being read
+// stops at its next chunk; a parse, once started, runs to its end (the page drops its result).
 import { importMotion } from '../motion/io';
-import { MotionFormatError, type Motion } from '../motion/types';
-import type { ImportError, ImportReply, ImportRequest, ImportResult } from './importProtocol';
-import { FileImporter } from './motionFiles';
+import { MotionFormatError } from '../motion/types';
+import type { ImportError, ImportRequest } from './importProtocol';
+import { FileImporter, type ImportProgress } from './motionFiles';
+import { serveRequests } from './requestLoop';
 
 declare const self: DedicatedWorkerGlobalScope;
 
 const importer = new FileImporter();
-let queue: Promise<void> = Promise.resolve();
-
-function reply(message: ImportReply, transfer: Transferable[] = []): void {
-  self.postMessage(message, transfer);
-}
 
 /** An error as the reply carries it (structured cloning would drop a MotionFormatError's name, format and line). */
 function importError(e: unknown): ImportError {
@@ -28,27 +26,9 @@ function importError(e: unknown): ImportError {
   return error;
 }
 
-/** The buffers of a result's motion: its positions and contacts. */
-function buffersOf(result: ImportResult): Transferable[] {
-  const motion: Motion | null = 'positions' in result ? result : result.kind === 'motion' ? result.motion : null;
-  if (!motion) return [];
-  return [...new Set([motion.positions.buffer, motion.contacts?.buffer].filter((b): b is ArrayBuffer => b instanceof ArrayBuffer))];
-}
-
-async function handle(request: ImportRequest): Promise<void> {
-  const { id } = request;
-  try {
-    const result: ImportResult =
-      request.type === 'files'
-        ? await importer.importFiles(request.files, (progress) => reply({ id, progress }))
-        : importMotion(request.text, request.format, request.asfText);
-    reply({ id, ok: true, result }, buffersOf(result));
-  } catch (e) {
-    reply({ id, ok: false, error: importError(e) });
-  }
-}
-
-self.addEventListener('message', (event: MessageEvent<ImportRequest>) => {
-  const request = event.data;
-  queue = queue.then(() => handle(request));
-});
+serveRequests<ImportRequest, ImportProgress>(
+  self,
+  async (request, progress, signal) =>
+    request.type === 'files' ? importer.importFiles(request.files, progress, signal) : importMotion(request.text, request.format, request.asfText),
+  (_request, e) => ({ error: importError(e) }),
+);

@@ -1,6 +1,8 @@
-// Messages between ImportClient (page thread) and import.worker.ts. Every request carries an id; the worker
-// answers it with any number of progress messages and then exactly one reply with the same id. An error
-// reply carries the error's name and message, and a MotionFormatError's format and line, so it stays one on the page.
+// Messages between ImportClient (page thread) and import.worker.ts (served by requestLoop.ts). Every request
+// carries an id; the worker answers it with any number of progress messages and then exactly one reply with
+// the same id. An error reply carries the error's name and message, and a MotionFormatError's format and
+// line, so it stays one on the page. A CancelMessage (protocol.ts) cancels a request: dropped if queued
+// (answered with an AbortError error), or, while a File is read, stopped at its next chunk.
 import type { Motion, MotionFormat } from '../motion/types';
 import type { FileImportOutcome, ImportProgress } from './motionFiles';
 

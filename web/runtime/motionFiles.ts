@@ -4,6 +4,7 @@
 import { importMotion } from '../motion/io';
 import { splitLines } from '../motion/text';
 import type { Motion } from '../motion/types';
+import { throwIfCancelled } from './cancellation';
 
 export type FileKind = 'bvh' | 'amc' | 'asf';
 
@@ -58,9 +59,10 @@ export function baseName(name: string): string {
 
 /**
  * A file's text, gunzipped when it is gzip, read as a stream: `onProgress` hears the share of the file's
- * bytes read (stage "decompress" for gzip), and a gzip file stops as soon as it decompresses past MAX_FILE_BYTES.
+ * bytes read (stage "decompress" for gzip), and a gzip file stops as soon as it decompresses past
+ * MAX_FILE_BYTES. When `signal` aborts, reading stops at the next chunk with a CancelledError.
  */
-export async function readTextFile(file: File, onProgress?: ProgressListener): Promise<TextFile> {
+export async function readTextFile(file: File, onProgress?: ProgressListener, signal?: AbortSignal): Promise<TextFile> {
   if (file.size > MAX_FILE_BYTES) throw new Error(`${file.name}: file too large (${(file.size / MIB).toFixed(1)} MiB; at most ${MAX_FILE_BYTES / MIB} MiB)`);
   const gz = isGzip(new Uint8Array(await file.slice(0, 2).arrayBuffer())) || /\.gz$/i.test(file.name);
   if (gz && typeof DecompressionStream === 'undefined') throw new Error(`${file.name}: this browser cannot decompress gzip files`);
@@ -93,9 +95,12 @@ export async function readTextFile(file: File, onProgress?: ProgressListener): P
     }
     if (chunk.done) break;
     size += chunk.value.length;
-    if (size > MAX_FILE_BYTES) {
+    try {
+      if (signal) throwIfCancelled(signal);
+      if (size > MAX_FILE_BYTES) throw new Error(`${file.name}: file too large once decompressed (more than ${MAX_FILE_BYTES / MIB} MiB)`);
+    } catch (e) {
       void reader.cancel();
-      throw new Error(`${file.name}: file too large once decompressed (more than ${MAX_FILE_BYTES / MIB} MiB)`);
+      throw e;
     }
     parts.push(decoder.decode(chunk.value, { stream: true }));
   }
@@ -108,14 +113,16 @@ export async function readTextFile(file: File, onProgress?: ProgressListener): P
 /**
  * Imports dropped or picked files: one .bvh, or an .amc with its .asf (given together, or the .asf in an
  * earlier call: the last skeleton given is remembered). Failures throw an Error whose message is meant
- * for the page as it is.
+ * for the page as it is. `signal` stops the reading (readTextFile) and, once all is read, the import
+ * before its parse; a cancelled import leaves the remembered skeleton as it was.
  */
 export class FileImporter {
   private lastAsf: TextFile | null = null;
 
-  async importFiles(files: File[], onProgress?: ProgressListener): Promise<FileImportOutcome> {
+  async importFiles(files: File[], onProgress?: ProgressListener, signal?: AbortSignal): Promise<FileImportOutcome> {
     const read: TextFile[] = [];
-    for (const f of files) read.push(await readTextFile(f, onProgress));
+    for (const f of files) read.push(await readTextFile(f, onProgress, signal));
+    if (signal) throwIfCancelled(signal);
     const unknown = read.filter((f) => f.kind === null);
     const asfs = read.filter((f) => f.kind === 'asf');
     const motions = read.filter((f) => f.kind === 'bvh' || f.kind === 'amc');

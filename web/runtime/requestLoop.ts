@@ -1,8 +1,9 @@
 // A model worker's message loop, apart from onnxruntime so unit tests can run it over a MessageChannel:
 // requests run one at a time, in order, each answered by exactly one reply carrying its id; a cancel
-// message drops a queued request without running it, or aborts the running one's signal.
-import { CANCELLED_ERROR_NAME, CancelledError, isCancelled } from './cancellation';
-import type { CancelMessage, WorkerMessage } from './protocol';
+// message drops a queued request without running it, or aborts the running one's signal. The import
+// worker (import.worker.ts) is served by it too, with its own error replies and progress reports.
+import { CANCELLED_ERROR_NAME, CancelledError, isCancelled, nextTask } from './cancellation';
+import type { CancelMessage, WorkerReply } from './protocol';
 
 /** Reports the share done of the request being handled (0…1). */
 export type Progress = (fraction: number) => void;
@@ -10,7 +11,17 @@ export type Progress = (fraction: number) => void;
 /** Where requests arrive and replies go: the worker's global scope, or a MessagePort in tests. */
 export interface RequestPort {
   addEventListener(type: 'message', listener: (event: MessageEvent) => void): void;
-  postMessage(message: WorkerMessage, transfer: Transferable[]): void;
+  postMessage(message: object, transfer: Transferable[]): void;
+}
+
+/**
+ * What an error reply carries besides its id and `ok: false`: by default WorkerReply's
+ * `error: "<type>: <message>"` (and `name: "AbortError"` when `cancelled`: its signal aborted).
+ */
+export type FailureReply<Request> = (request: Request, err: unknown, cancelled: boolean) => object;
+
+function workerFailure(request: { type: string }, err: unknown, cancelled: boolean): Omit<Extract<WorkerReply, { ok: false }>, 'id' | 'ok'> {
+  return cancelled ? { error: `${request.type}: cancelled`, name: CANCELLED_ERROR_NAME } : { error: `${request.type}: ${describe(err)}` };
 }
 
 export function describe(err: unknown): string {
@@ -33,29 +44,42 @@ type Queued<Request> = { id: number; request: Request; cancel: AbortController }
 
 /**
  * Serves requests from `port` with `handle`, one at a time, in order. Each gets exactly one reply with
- * its id: its result, or an error reply (`<type>: <message>`) if `handle` throws. `handle` gets the
- * request's signal: a cancelled request (CancelMessage) that has not started is answered with an
- * AbortError reply and never handled; one that is running has its signal aborted, and is answered with an
- * AbortError reply if it stops for it (cancellation.ts checkpoint), or as usual if it finishes anyway.
+ * its id: its result, or an error reply (`failure`; by default `<type>: <message>`) if `handle` throws.
+ * `handle` gets the request's signal: a cancelled request (CancelMessage) that has not started is
+ * answered with an AbortError reply and never handled (before starting each request the loop reads the
+ * messages already sent, so a cancel sent while an earlier request ran synchronously is seen); one that
+ * is running has its signal aborted, and is answered with an AbortError reply if it stops for it
+ * (cancellation.ts checkpoint), or as usual if it finishes anyway. `progress` reports (a share done, 0…1,
+ * unless `Report` says otherwise) go out as `{ id, progress }`.
  */
-export function serveRequests<Request extends { type: string }>(port: RequestPort, handle: (request: Request, progress: Progress, signal: AbortSignal) => Promise<unknown>): void {
-  const reply = (message: WorkerMessage, transfer: Transferable[] = []) => port.postMessage(message, transfer);
-  const cancelledReply = (q: Queued<Request>) => reply({ id: q.id, ok: false, error: `${q.request.type}: cancelled`, name: CANCELLED_ERROR_NAME });
+export function serveRequests<Request extends { type: string }, Report = number>(
+  port: RequestPort,
+  handle: (request: Request, progress: (report: Report) => void, signal: AbortSignal) => Promise<unknown>,
+  failure: FailureReply<Request> = workerFailure,
+): void {
+  const reply = (message: object, transfer: Transferable[] = []) => port.postMessage(message, transfer);
+  const failed = (q: Queued<Request>, err: unknown, cancelled: boolean) => reply({ id: q.id, ok: false, ...failure(q.request, err, cancelled) });
+  const cancelledReply = (q: Queued<Request>) => failed(q, new CancelledError('cancelled'), true);
   const queue: Queued<Request>[] = [];
   let running: Queued<Request> | undefined;
+  let serving = false;
 
   async function runQueue(): Promise<void> {
-    while (queue.length) {
-      const q = (running = queue.shift()!);
+    serving = true;
+    for (;;) {
+      await nextTask(); // reads cancels sent meanwhile, so a cancelled request is dropped, not started
+      const q = queue.shift();
+      if (!q) break;
+      running = q;
       try {
-        const result = await handle(q.request, (fraction) => reply({ id: q.id, progress: fraction }), q.cancel.signal);
+        const result = await handle(q.request, (report) => reply({ id: q.id, progress: report }), q.cancel.signal);
         reply({ id: q.id, ok: true, result }, transferables(result));
       } catch (err) {
-        if (isCancelled(err) && q.cancel.signal.aborted) cancelledReply(q);
-        else reply({ id: q.id, ok: false, error: `${q.request.type}: ${describe(err)}` });
+        failed(q, err, isCancelled(err) && q.cancel.signal.aborted);
       }
+      running = undefined;
     }
-    running = undefined;
+    serving = false;
   }
 
   port.addEventListener('message', (event: MessageEvent<({ id: number } & Request) | CancelMessage>) => {
@@ -72,6 +96,6 @@ export function serveRequests<Request extends { type: string }>(port: RequestPor
     }
     const { id } = message as { id: number } & Request;
     queue.push({ id, request: message as Request, cancel: new AbortController() });
-    if (!running) void runQueue();
+    if (!serving) void runQueue();
   });
 }
