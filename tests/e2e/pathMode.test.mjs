@@ -86,18 +86,28 @@ async function holdUntil(page, key, until, arg, what) {
   return freshReadout(page);
 }
 
-/**
- * Path mode with a walk along a stroke done: a 60-frame clip shown first (to come back to), then Path
- * mode from empty, the stroke drawn, Go, and the optimiser finished. Returns the drawn path's length (m).
- */
-async function walkAStroke(page, points) {
+/** A 60-frame generated clip shown in Clip mode: what leaving a live mode must come back to. */
+async function showClipToComeBackTo(page) {
   await page.click('#mode-clip');
   await page.evaluate(async () => {
     const m = await window.playground.generate({ model: 'generator', frames: 60, seed: 1 });
     window.playground.show(m, 'clip');
   });
+}
+
+/** Path mode from an empty stage (Path mode keeps its path and walk while away). */
+async function enterEmptyPathMode(page) {
   await page.click('#mode-path');
   if (await page.locator('#path-clear').isEnabled()) await page.click('#path-clear');
+}
+
+/**
+ * Path mode with a walk along a stroke done: a 60-frame clip shown first (to come back to), then Path
+ * mode from empty, the stroke drawn, Go, and the optimiser finished. Returns the drawn path's length (m).
+ */
+async function walkAStroke(page, points) {
+  await showClipToComeBackTo(page);
+  await enterEmptyPathMode(page);
   await drawStroke(page, points);
   const drawn = await pathState(page);
   assert.equal(drawn.state, 'drawn', `the stroke is a path (${drawn.text})`);
@@ -113,15 +123,8 @@ describe('Path and Steer modes', { timeout: 400_000 }, () => {
 
   test('Path mode: a drawn stroke is walked; stats, the result plays, Export BVH saves it', async () => {
     const page = suite.page;
-    // A clip to come back to, in Clip mode.
-    await page.click('#mode-clip');
-    await page.evaluate(async () => {
-      const m = await window.playground.generate({ model: 'generator', frames: 60, seed: 1 });
-      window.playground.show(m, 'clip');
-    });
-    await page.click('#mode-path');
-    // From an empty stage (Path mode keeps its path and walk while away).
-    if (await page.locator('#path-clear').isEnabled()) await page.click('#path-clear');
+    await showClipToComeBackTo(page);
+    await enterEmptyPathMode(page);
     const ui = await page.evaluate(() => ({
       path: document.body.classList.contains('path-mode'),
       pressed: document.getElementById('mode-path').getAttribute('aria-pressed'),
@@ -234,12 +237,7 @@ describe('Path and Steer modes', { timeout: 400_000 }, () => {
 
   test('Steer mode: keys, a gamepad and the on-screen stick set the target; the character follows', async () => {
     const page = suite.page;
-    // A clip to come back to, in Clip mode.
-    await page.click('#mode-clip');
-    await page.evaluate(async () => {
-      const m = await window.playground.generate({ model: 'generator', frames: 60, seed: 1 });
-      window.playground.show(m, 'clip');
-    });
+    await showClipToComeBackTo(page);
     await page.click('#mode-steer');
     await waitUntil(page, () => Number(document.getElementById('steer-status').dataset.frame) > 15, null, { timeout: 120_000, message: 'the steered stream starts' });
     const start = await readout(page);
