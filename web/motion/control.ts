@@ -1,0 +1,215 @@
+// The latent ERD's low-dimensional control signal (Yearsley §3.2.1, Ch. 6): per frame the root's forward
+// and sideways velocity (m/s, in its own ground-projected facing frame; sideways positive to the walker's
+// left, +x at heading 0) and turning speed (rad/s, positive turns from +z towards +x). Heading 0 faces +z,
+// π/2 faces +x. Frame t's signal is the motion from frame t to frame t+1.
+//
+// The same rules are in training/control.py, and tests/fixtures/control_signal.json
+// (python -m training.fixtures.control_signal) checks the two against each other: every function here
+// does the float64 arithmetic in the same order as its Python twin.
+
+/** One frame's signal: [forward m/s, sideways m/s, turn rad/s]. */
+export type Control = [number, number, number];
+/** A walker's ground root: position (m) and heading (rad). */
+export interface Root {
+  x: number;
+  z: number;
+  heading: number;
+}
+
+/** The stick and the path follower close a heading error in TURN_TIME s, at most MAX_TURN_RATE rad/s. */
+export const TURN_TIME = 0.5;
+export const MAX_TURN_RATE = 2.5;
+/** Pure pursuit looks LOOKAHEAD_SECONDS of travel ahead along the path, and at least MIN_LOOKAHEAD m. */
+export const LOOKAHEAD_SECONDS = 0.6;
+export const MIN_LOOKAHEAD = 0.5;
+/** The follower searches for itself from PROGRESS_BACK behind to PROGRESS_AHEAD ahead of its last arc length (m). */
+export const PROGRESS_BACK = 0.3;
+export const PROGRESS_AHEAD = 1.2;
+/** It slows down over the last STOP_SECONDS of travel so it stops at the end. */
+export const STOP_SECONDS = 0.5;
+/** Random control: a new target speed and turn every RANDOM_SEGMENT s, eased towards with time constant RANDOM_EASE s. */
+export const RANDOM_SEGMENT = 2.0;
+export const RANDOM_EASE = 0.5;
+/** Target forward speeds are drawn from [RANDOM_SPEED[0], RANDOM_SPEED[1]) m/s, turns from ±RANDOM_TURN rad/s. */
+export const RANDOM_SPEED: readonly [number, number] = [0.4, 2.0];
+export const RANDOM_TURN = 1.2;
+
+const TWO_PI = 2 * Math.PI;
+
+/**
+ * Angle wrapped to [−π, π), as Python's ((a + π) % 2π) − π: its float modulo takes the sign of the divisor
+ * (JavaScript's % takes the dividend's), so a negative remainder moves up by 2π and a zero one is +0.
+ */
+export function wrap(a: number): number {
+  let m = (a + Math.PI) % TWO_PI;
+  if (m === 0) m = 0;
+  else if (m < 0) m += TWO_PI;
+  return m - Math.PI;
+}
+
+/** World ground displacement (dx, dz) in the frame of a walker facing `heading`: [sideways, forward]. */
+export function rotateToLocal(dx: number, dz: number, heading: number): [number, number] {
+  const c = Math.cos(heading), s = Math.sin(heading);
+  return [c * dx - s * dz, s * dx + c * dz];
+}
+
+/**
+ * The signal (frames × 3: forward, sideways, turn) of a ground trajectory: `xz` frames × 2 (x, z), `heading`
+ * per frame. The last frame repeats the one before it; one frame gives zeros.
+ */
+export function controlFromTrajectory(xz: ArrayLike<number>, heading: ArrayLike<number>, fps: number): Float64Array {
+  const n = heading.length;
+  const out = new Float64Array(n * 3);
+  for (let t = 0; t + 1 < n; t++) {
+    const [side, fwd] = rotateToLocal(xz[2 * t + 2] - xz[2 * t], xz[2 * t + 3] - xz[2 * t + 1], heading[t]);
+    out[3 * t] = fwd * fps;
+    out[3 * t + 1] = side * fps;
+    out[3 * t + 2] = wrap(heading[t + 1] - heading[t]) * fps;
+  }
+  if (n > 1) out.copyWithin(3 * (n - 1), 3 * (n - 2), 3 * (n - 1));
+  return out;
+}
+
+/** The root one frame later: `root` moved by one frame of `control` (root + R(heading)·[side, fwd] / fps). */
+export function stepRoot(root: Root, control: ArrayLike<number>, fps: number): Root {
+  const fwd = control[0] / fps, side = control[1] / fps, turn = control[2] / fps;
+  const c = Math.cos(root.heading), s = Math.sin(root.heading);
+  return { x: root.x + (c * side + s * fwd), z: root.z + (-s * side + c * fwd), heading: wrap(root.heading + turn) };
+}
+
+/**
+ * The ground trajectory (`xz` frames × 2) and headings a signal (frames × 3) traces from `start`: frame 0 is
+ * the start, frame t+1 applies frame t's signal (so the last frame's signal is not used).
+ */
+export function integrateControl(control: ArrayLike<number>, fps: number, start: Root = { x: 0, z: 0, heading: 0 }): { xz: Float64Array; heading: Float64Array } {
+  const n = Math.floor(control.length / 3);
+  const xz = new Float64Array(n * 2);
+  const heading = new Float64Array(n);
+  let root: Root = { x: start.x, z: start.z, heading: start.heading };
+  for (let t = 0; t < n; t++) {
+    xz[2 * t] = root.x;
+    xz[2 * t + 1] = root.z;
+    heading[t] = root.heading;
+    root = stepRoot(root, [control[3 * t], control[3 * t + 1], control[3 * t + 2]], fps);
+  }
+  return { xz, heading };
+}
+
+/** A stick's signal: walk forward at `speed`, turning towards `targetHeading` (error / TURN_TIME, at most MAX_TURN_RATE). */
+export function controlTowardHeading(heading: number, targetHeading: number, speed: number): Control {
+  const turn = Math.min(Math.max(wrap(targetHeading - heading) / TURN_TIME, -MAX_TURN_RATE), MAX_TURN_RATE);
+  return [speed, 0, turn];
+}
+
+/** A ground path through `points` ([x, z] pairs, at least 2) with arc lengths, as the follower walks it. */
+export class PolylinePath {
+  readonly points: [number, number][];
+  /** Arc length at each point (m), from 0. */
+  readonly arc: Float64Array;
+  readonly length: number;
+
+  constructor(points: ArrayLike<number>[]) {
+    if (points.length < 2) throw new RangeError(`a PolylinePath needs at least 2 points, got ${points.length}`);
+    this.points = Array.from(points, (p) => [p[0], p[1]]);
+    this.arc = new Float64Array(points.length);
+    for (let i = 1; i < this.points.length; i++) {
+      const dx = this.points[i][0] - this.points[i - 1][0], dz = this.points[i][1] - this.points[i - 1][1];
+      this.arc[i] = this.arc[i - 1] + Math.sqrt(dx * dx + dz * dz); // as numpy's norm and cumsum
+    }
+    this.length = this.arc[this.arc.length - 1];
+  }
+
+  /** The point at arc length s (clamped to the path). */
+  pointAt(s: number): [number, number] {
+    s = Math.min(Math.max(s, 0), this.length);
+    // The last point whose arc length is ≤ s (numpy searchsorted side="right" − 1), kept on a segment.
+    let lo = 0, hi = this.arc.length;
+    while (lo < hi) {
+      const mid = (lo + hi) >>> 1;
+      if (this.arc[mid] <= s) lo = mid + 1;
+      else hi = mid;
+    }
+    const i = Math.min(Math.max(lo - 1, 0), this.points.length - 2);
+    const span = this.arc[i + 1] - this.arc[i];
+    const t = span > 0 ? (s - this.arc[i]) / span : 0;
+    const a = this.points[i], b = this.points[i + 1];
+    return [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t];
+  }
+
+  /** Arc length of the nearest point to (x, z) on the segments overlapping [from, to] (0 if none does). */
+  project(x: number, z: number, from: number, to: number): number {
+    let best = Infinity, bestS = 0;
+    for (let i = 0; i + 1 < this.points.length; i++) {
+      if (this.arc[i + 1] < from || this.arc[i] > to) continue;
+      const a = this.points[i], b = this.points[i + 1];
+      const dx = b[0] - a[0], dz = b[1] - a[1];
+      const len2 = dx * dx + dz * dz;
+      const t = len2 > 0 ? Math.min(Math.max(((x - a[0]) * dx + (z - a[1]) * dz) / len2, 0), 1) : 0;
+      const ex = a[0] + dx * t - x, ez = a[1] + dz * t - z;
+      const d2 = ex * ex + ez * ez;
+      if (d2 < best) {
+        best = d2;
+        bestS = this.arc[i] + t * (this.arc[i + 1] - this.arc[i]);
+      }
+    }
+    return bestS;
+  }
+}
+
+/**
+ * The signal that steers a walker at (x, z) facing `heading` along `path` at `speed` (pure pursuit towards
+ * the point max(MIN_LOOKAHEAD, speed · LOOKAHEAD_SECONDS) further along), slowing over the last STOP_SECONDS
+ * and zero at the end; and its new progress (arc length), searched near the last one.
+ */
+export function controlAlongPath(path: PolylinePath, x: number, z: number, heading: number, progress: number, speed: number): { control: Control; progress: number } {
+  const s = path.project(x, z, progress - PROGRESS_BACK, progress + PROGRESS_AHEAD);
+  const remaining = path.length - s;
+  if (remaining <= 1e-6) return { control: [0, 0, 0], progress: s };
+  const target = path.pointAt(s + Math.max(MIN_LOOKAHEAD, speed * LOOKAHEAD_SECONDS));
+  const want = Math.atan2(target[0] - x, target[1] - z);
+  const fwd = Math.min(speed, remaining / STOP_SECONDS);
+  return { control: controlTowardHeading(heading, want, fwd), progress: s };
+}
+
+/** mulberry32's uniform in [0, 1), bit for bit as web/model/sampler.ts Rng and training/control.py Rng (web/motion may not import web/model). */
+class Mulberry32 {
+  private state: number;
+
+  constructor(seed: number) {
+    this.state = seed >>> 0;
+  }
+
+  uniform(): number {
+    this.state = (this.state + 0x6d2b79f5) | 0;
+    let t = Math.imul(this.state ^ (this.state >>> 15), 1 | this.state);
+    t = (t + Math.imul(t ^ (t >>> 7), 61 | t)) ^ t;
+    return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
+  }
+}
+
+/** Python's round(): to the nearest integer, halves to the even one. */
+function roundHalfEven(v: number): number {
+  const r = Math.round(v);
+  return r - v === 0.5 && r % 2 !== 0 ? r - 1 : r;
+}
+
+/** A smooth random [forward, 0, turn] signal (frames × 3) drawn from `seed`. */
+export function randomControl(seed: number, frames: number, fps: number): Float64Array {
+  const rng = new Mulberry32(seed);
+  const segment = Math.max(1, roundHalfEven(RANDOM_SEGMENT * fps));
+  const ease = 1 - Math.exp(-1 / (RANDOM_EASE * fps));
+  let fwd = 1, turn = 0;
+  let targetFwd = fwd, targetTurn = turn;
+  const out = new Float64Array(frames * 3);
+  for (let t = 0; t < frames; t++) {
+    if (t % segment === 0) {
+      targetFwd = RANDOM_SPEED[0] + (RANDOM_SPEED[1] - RANDOM_SPEED[0]) * rng.uniform();
+      targetTurn = RANDOM_TURN * (2 * rng.uniform() - 1);
+    }
+    fwd += (targetFwd - fwd) * ease;
+    turn += (targetTurn - turn) * ease;
+    out[3 * t] = fwd;
+    out[3 * t + 2] = turn;
+  }
+  return out;
+}
