@@ -1,0 +1,172 @@
+"""The low-dimensional control signal of the latent ERD (Yearsley §3.2.1, Ch. 6): per frame, the root's
+forward velocity, sideways velocity (m/s, in its own ground-projected facing frame) and turning speed
+(rad/s, positive turns from +z towards +x).
+
+The same rules run in the browser (web/motion/control.ts); tests/fixtures/control_signal.json checks the
+two against each other (python -m training.fixtures.control_signal).
+
+- `control_from_trajectory`: the signal of a ground trajectory (real clips, for training and evaluation).
+- `integrate_control`: back from the signal to a trajectory (what the page does with the decoded signal).
+- `control_toward_heading`: a stick (direction and speed) as a signal.
+- `control_along_path`: closed-loop path following by pure pursuit: the signal that turns the character
+  from where it is now towards a point a little further along the path.
+
+Frame t's signal is the motion from frame t to frame t+1: root_{t+1} = root_t + R(heading_t)·[side, fwd]/fps.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+# How sharply the stick and the path follower turn: the heading error is closed in TURN_TIME seconds,
+# at most MAX_TURN_RATE rad/s (the corpus's turns reach about 3 rad/s; 2.5 keeps inside its range).
+TURN_TIME = 0.5
+MAX_TURN_RATE = 2.5
+# Pure pursuit looks LOOKAHEAD_SECONDS of travel ahead along the path, and at least MIN_LOOKAHEAD metres.
+LOOKAHEAD_SECONDS = 0.6
+MIN_LOOKAHEAD = 0.5
+# The follower searches for itself along the path from PROGRESS_BACK behind to PROGRESS_AHEAD ahead of
+# its last arc length, so a path that crosses itself is not short-cut (as web/optimizer trackArc).
+PROGRESS_BACK = 0.3
+PROGRESS_AHEAD = 1.2
+# It slows down over the last STOP_SECONDS of travel so it stops at the end instead of overshooting.
+STOP_SECONDS = 0.5
+
+
+def wrap(a):
+    """Angle wrapped to [-pi, pi)."""
+    return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
+
+
+def rotate_to_local(dx, dz, heading):
+    """World ground displacement (dx, dz) in the frame of a walker facing `heading`: (sideways, forward)."""
+    c, s = np.cos(heading), np.sin(heading)
+    return c * dx - s * dz, s * dx + c * dz
+
+
+def control_from_trajectory(xz: np.ndarray, heading: np.ndarray, fps: float) -> np.ndarray:
+    """(frames, 3) [forward, sideways, turn] of a ground trajectory xz (frames, 2) with headings (frames,).
+    The last frame repeats the one before it."""
+    d = np.diff(xz, axis=0)
+    side, fwd = rotate_to_local(d[:, 0], d[:, 1], heading[:-1])
+    turn = wrap(np.diff(heading))
+    out = np.stack([fwd, side, turn], axis=1) * fps
+    return np.concatenate([out, out[-1:]], axis=0) if len(out) else np.zeros((len(xz), 3))
+
+
+def integrate_control(control: np.ndarray, fps: float, start_xz=(0.0, 0.0), start_heading: float = 0.0):
+    """The ground trajectory (frames, 2) and headings (frames,) a signal (frames, 3) traces from a start:
+    frame 0 is the start, frame t+1 applies frame t's signal."""
+    n = len(control)
+    xz = np.zeros((n, 2))
+    heading = np.zeros(n)
+    x, z, h = float(start_xz[0]), float(start_xz[1]), float(start_heading)
+    for t in range(n):
+        xz[t] = x, z
+        heading[t] = h
+        fwd, side, turn = (float(v) / fps for v in control[t])
+        c, s = math.cos(h), math.sin(h)
+        x += c * side + s * fwd
+        z += -s * side + c * fwd
+        h = float(wrap(h + turn))
+    return xz, heading
+
+
+def control_toward_heading(heading: float, target_heading: float, speed: float) -> np.ndarray:
+    """A stick's signal: walk forward at `speed`, turning towards `target_heading`."""
+    turn = float(np.clip(wrap(target_heading - heading) / TURN_TIME, -MAX_TURN_RATE, MAX_TURN_RATE))
+    return np.array([speed, 0.0, turn])
+
+
+class PolylinePath:
+    """A ground path (points, 2) with arc lengths, as the follower walks it."""
+
+    def __init__(self, points: np.ndarray):
+        self.points = np.asarray(points, dtype=np.float64)
+        seg = np.linalg.norm(np.diff(self.points, axis=0), axis=1)
+        self.arc = np.concatenate([[0.0], np.cumsum(seg)])
+        self.length = float(self.arc[-1])
+
+    def point_at(self, s: float) -> np.ndarray:
+        s = min(max(s, 0.0), self.length)
+        i = int(np.clip(np.searchsorted(self.arc, s, side="right") - 1, 0, len(self.points) - 2))
+        span = self.arc[i + 1] - self.arc[i]
+        t = (s - self.arc[i]) / span if span > 0 else 0.0
+        return self.points[i] + (self.points[i + 1] - self.points[i]) * t
+
+    def project(self, x: float, z: float, s_from: float, s_to: float) -> float:
+        """Arc length of the nearest point to (x, z) on the segments overlapping [s_from, s_to]."""
+        best, best_s = math.inf, 0.0
+        for i in range(len(self.points) - 1):
+            if self.arc[i + 1] < s_from or self.arc[i] > s_to:
+                continue
+            a, b = self.points[i], self.points[i + 1]
+            d = b - a
+            len2 = float(d @ d)
+            t = min(max(((x - a[0]) * d[0] + (z - a[1]) * d[1]) / len2, 0.0), 1.0) if len2 > 0 else 0.0
+            e = a + d * t - (x, z)
+            if float(e @ e) < best:
+                best, best_s = float(e @ e), float(self.arc[i] + t * (self.arc[i + 1] - self.arc[i]))
+        return best_s
+
+
+def control_along_path(path: PolylinePath, x: float, z: float, heading: float, progress: float, speed: float):
+    """The signal that steers a walker at (x, z) facing `heading` along `path` at `speed` (pure pursuit),
+    and its new progress (arc length) along the path, searched near the last one."""
+    s = path.project(x, z, progress - PROGRESS_BACK, progress + PROGRESS_AHEAD)
+    remaining = path.length - s
+    target = path.point_at(s + max(MIN_LOOKAHEAD, speed * LOOKAHEAD_SECONDS))
+    if remaining <= 1e-6:
+        return np.array([0.0, 0.0, 0.0]), s
+    want = math.atan2(target[0] - x, target[1] - z)
+    fwd = min(speed, remaining / STOP_SECONDS)
+    out = control_toward_heading(heading, want, fwd)
+    return out, s
+
+
+class Rng:
+    """The page's random source (web/model/sampler.ts Rng: mulberry32 and Box–Muller), bit for bit, so a seed
+    gives the same random control on both sides."""
+
+    def __init__(self, seed: int):
+        self.state = seed & 0xFFFFFFFF
+
+    def uniform(self) -> float:
+        m = 0xFFFFFFFF
+        self.state = (self.state + 0x6D2B79F5) & m
+        s = self.state
+        t = _imul(s ^ (s >> 15), 1 | s)
+        t = ((t + _imul(t ^ (t >> 7), 61 | t)) & m) ^ t
+        return ((t ^ (t >> 14)) & m) / 4294967296
+
+
+def _imul(a: int, b: int) -> int:
+    return (a * b) & 0xFFFFFFFF
+
+
+# Random control (generate without `control`): every RANDOM_SEGMENT seconds a new target speed and turn rate
+# are drawn, and the signal eases towards them with time constant RANDOM_EASE, so it is smooth. The ranges
+# sit inside the corpus's (forward 1st–99th percentile -0.2…3.2 m/s, turn ±2.8 rad/s).
+RANDOM_SEGMENT = 2.0
+RANDOM_EASE = 0.5
+RANDOM_SPEED = (0.4, 2.0)
+RANDOM_TURN = 1.2
+
+
+def random_control(seed: int, frames: int, fps: float) -> np.ndarray:
+    """(frames, 3) a smooth random [forward, 0, turn] signal drawn from `seed`."""
+    rng = Rng(seed)
+    segment = max(1, round(RANDOM_SEGMENT * fps))
+    ease = 1 - math.exp(-1 / (RANDOM_EASE * fps))
+    fwd, turn = 1.0, 0.0
+    target_fwd, target_turn = fwd, turn
+    out = np.zeros((frames, 3))
+    for t in range(frames):
+        if t % segment == 0:
+            target_fwd = RANDOM_SPEED[0] + (RANDOM_SPEED[1] - RANDOM_SPEED[0]) * rng.uniform()
+            target_turn = RANDOM_TURN * (2 * rng.uniform() - 1)
+        fwd += (target_fwd - fwd) * ease
+        turn += (target_turn - turn) * ease
+        out[t] = fwd, 0.0, turn
+    return out
