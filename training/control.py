@@ -30,8 +30,10 @@ MIN_LOOKAHEAD = 0.5
 # its last arc length, so a path that crosses itself is not short-cut (as web/optimizer trackArc).
 PROGRESS_BACK = 0.3
 PROGRESS_AHEAD = 1.2
-# It slows down over the last STOP_SECONDS of travel so it stops at the end instead of overshooting.
+# It slows down over the last STOP_SECONDS of travel so it stops at the end instead of overshooting, and
+# stands still once it is within ARRIVED metres of the end (else the slow-down never quite finishes).
 STOP_SECONDS = 0.5
+ARRIVED = 0.05
 
 
 def wrap(a):
@@ -84,6 +86,8 @@ class PolylinePath:
 
     def __init__(self, points: np.ndarray):
         self.points = np.asarray(points, dtype=np.float64)
+        if len(self.points) < 2:
+            raise ValueError(f"a PolylinePath needs at least 2 points, got {len(self.points)}")
         seg = np.linalg.norm(np.diff(self.points, axis=0), axis=1)
         self.arc = np.concatenate([[0.0], np.cumsum(seg)])
         self.length = float(self.arc[-1])
@@ -117,7 +121,7 @@ def control_along_path(path: PolylinePath, x: float, z: float, heading: float, p
     s = path.project(x, z, progress - PROGRESS_BACK, progress + PROGRESS_AHEAD)
     remaining = path.length - s
     target = path.point_at(s + max(MIN_LOOKAHEAD, speed * LOOKAHEAD_SECONDS))
-    if remaining <= 1e-6:
+    if remaining <= ARRIVED:
         return np.array([0.0, 0.0, 0.0]), s
     want = math.atan2(target[0] - x, target[1] - z)
     fwd = min(speed, remaining / STOP_SECONDS)

@@ -100,13 +100,16 @@ MAY_IMPORT = {
     "mocap": {"paths"},
     "metrics": {"mocap"},
     "footlock": {"mocap"},
+    "control": set(),
     "onnx": {"paths"},
-    "data": {"mocap", "paths", "metrics"},
+    "data": {"mocap", "paths", "metrics", "control"},
     "models": {"mocap", "data"},
     "generator": {"mocap", "data", "models"} | SHARED,
     "aclstm": {"mocap", "data", "models"} | SHARED,
     "refiner": {"mocap", "data", "models", "generator"} | SHARED,
-    "fixtures": {"mocap", "data", "models", "generator", "refiner", "aclstm"} | SHARED,
+    "autoencoder": {"mocap", "data", "models"} | SHARED,
+    "latent_erd": {"mocap", "data", "models", "autoencoder", "control"} | SHARED,
+    "fixtures": {"mocap", "data", "models", "generator", "refiner", "aclstm", "control", "autoencoder", "latent_erd"} | SHARED,
 }
 
 

@@ -6,6 +6,7 @@
 import { describe, expect, it } from 'vitest';
 import * as control from '../../web/motion/control';
 import {
+  ARRIVED,
   controlAlongPath,
   controlFromTrajectory,
   controlTowardHeading,
@@ -145,11 +146,11 @@ describe('the control signal matches training/control.py', () => {
     expect(run.progress[run.progress.length - 1]).toBeGreaterThan(8.5); // past the crossing at arc 8.5
   });
 
-  it('the ending run reaches the end of its path and stops there: a zero signal, progress = length', () => {
+  it('the ending run reaches the end of its path and stops there: a zero signal within ARRIVED of the end', () => {
     const c = fixture.paths.find((p) => p.name.includes('stops'))!;
     const path = new PolylinePath(c.points);
     const run = follow(path, { x: c.start[0], z: c.start[1], heading: c.start[2] }, c.speed, c.frames);
-    const stopped = run.progress.findIndex((p) => path.length - p <= 1e-6);
+    const stopped = run.progress.findIndex((p) => path.length - p <= ARRIVED);
     expect(stopped).toBeGreaterThan(0);
     expect(stopped).toBeLessThan(c.frames - 10);
     expect(run.signals.slice(3 * stopped).every((v) => v === 0)).toBe(true);

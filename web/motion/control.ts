@@ -25,8 +25,9 @@ export const MIN_LOOKAHEAD = 0.5;
 /** The follower searches for itself from PROGRESS_BACK behind to PROGRESS_AHEAD ahead of its last arc length (m). */
 export const PROGRESS_BACK = 0.3;
 export const PROGRESS_AHEAD = 1.2;
-/** It slows down over the last STOP_SECONDS of travel so it stops at the end. */
+/** It slows down over the last STOP_SECONDS of travel so it stops at the end, and stands still within ARRIVED metres of it. */
 export const STOP_SECONDS = 0.5;
+export const ARRIVED = 0.05;
 /** Random control: a new target speed and turn every RANDOM_SEGMENT s, eased towards with time constant RANDOM_EASE s. */
 export const RANDOM_SEGMENT = 2.0;
 export const RANDOM_EASE = 0.5;
@@ -164,7 +165,7 @@ export class PolylinePath {
 export function controlAlongPath(path: PolylinePath, x: number, z: number, heading: number, progress: number, speed: number): { control: Control; progress: number } {
   const s = path.project(x, z, progress - PROGRESS_BACK, progress + PROGRESS_AHEAD);
   const remaining = path.length - s;
-  if (remaining <= 1e-6) return { control: [0, 0, 0], progress: s };
+  if (remaining <= ARRIVED) return { control: [0, 0, 0], progress: s };
   const target = path.pointAt(s + Math.max(MIN_LOOKAHEAD, speed * LOOKAHEAD_SECONDS));
   const want = Math.atan2(target[0] - x, target[1] - z);
   const fwd = Math.min(speed, remaining / STOP_SECONDS);

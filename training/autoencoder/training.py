@@ -1,0 +1,114 @@
+"""Training the motion autoencoder on 4 s windows of CMU locomotion (data/windows.py), and reading its
+checkpoints back.
+
+Recipe (Yearsley §3.1.1): masked noise with p = 0.3 on the normalised input, mean squared error against the
+clean window, Adam with its default settings (lr 1e-3), here with batches of 32 random windows, a small L1
+penalty on the latent (Holden's Lasso loss) and the learning rate halved twice late in the run.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+from tqdm import tqdm
+
+from ..data.locomotion import FPS, load_clips
+from ..data.windows import POSITION_DIM, ROW_DIM, WINDOW, WindowCorpus
+from ..models.autoencoder import MotionAutoencoder, masked_noise
+from ..runs import Run
+
+SPARSITY = 1e-3
+VALIDATE_EVERY = 250  # iterations
+
+
+def load_autoencoder(checkpoint: Path) -> tuple[MotionAutoencoder, dict]:
+    """The model (eval mode) and its meta."""
+    state = torch.load(checkpoint, weights_only=False)
+    meta = state["meta"]
+    model = MotionAutoencoder(meta["dim"], meta["hidden"], meta["latent"])
+    model.load_state_dict(state["model"])
+    return model.eval(), meta
+
+
+def position_error_cm(model: MotionAutoencoder, corpus: WindowCorpus, windows: np.ndarray, mask_p: float = 0.0,
+                      seed: int = 0) -> float:
+    """Mean distance (cm) per joint and frame between the clean windows' joint positions (root facing frame)
+    and the reconstruction from the windows, corrupted by masked noise with probability `mask_p`."""
+    torch.manual_seed(seed)
+    x = torch.from_numpy(windows)
+    with torch.no_grad():
+        y = model(masked_noise(x, mask_p) if mask_p > 0 else x)[0].numpy()
+    std, mean = corpus.std[:POSITION_DIM], corpus.mean[:POSITION_DIM]
+    real = (windows[..., :POSITION_DIM] * std + mean).reshape(*windows.shape[:2], -1, 3)
+    made = (y[..., :POSITION_DIM] * std + mean).reshape(*windows.shape[:2], -1, 3)
+    return float(np.linalg.norm(real - made, axis=-1).mean() * 100)
+
+
+def train_autoencoder(args: argparse.Namespace) -> tuple[float, Path]:
+    """One run with the options of python -m training.autoencoder.train; returns the best held-out
+    reconstruction error (cm, clean input) and the run directory."""
+    torch.set_num_threads(args.threads)
+    run = Run(args.run, args.checkpoint_minutes)
+    corpus = WindowCorpus(load_clips(args.mocap))
+    valid = corpus.valid_windows()
+    model = MotionAutoencoder(ROW_DIM, args.hidden, args.latent)
+    optimiser = torch.optim.Adam(model.parameters(), lr=args.lr)
+    milestones = [int(args.iterations * 0.7), int(args.iterations * 0.9)]
+    scheduler = torch.optim.lr_scheduler.MultiStepLR(optimiser, milestones, gamma=0.5)
+    rng = np.random.default_rng(args.seed)
+    torch.manual_seed(args.seed)
+    start, best, elapsed_before = 0, float("inf"), 0.0
+    if args.resume:
+        state = run.resume(rng, model=model, optimiser=optimiser, scheduler=scheduler)
+        start, best, elapsed_before = state["iteration"], state["best"], state["elapsed"]
+        run.log.info("resumed at iteration %d", start)
+    meta = {"dim": ROW_DIM, "hidden": args.hidden, "latent": args.latent, "fps": FPS, "window": WINDOW,
+            "mean": corpus.mean.tolist(), "std": corpus.std.tolist(), "valid_files": corpus.valid_files,
+            "train_frames": corpus.train_frames, "args": vars(args)}
+    params = sum(p.numel() for p in model.parameters())
+    run.log.info("start: %d parameters, %d training frames (augmented), %d held-out windows", params,
+                 corpus.train_frames, len(valid))
+    t0 = time.monotonic()
+    elapsed = lambda: elapsed_before + time.monotonic() - t0
+
+    def checkpoint(iteration: int) -> dict:
+        return {"model": model.state_dict(), "optimiser": optimiser.state_dict(), "scheduler": scheduler.state_dict(),
+                "rng": rng.bit_generator.state, "torch_rng": torch.get_rng_state(), "iteration": iteration,
+                "best": best, "elapsed": elapsed(), "meta": meta}
+
+    bar = tqdm(total=args.iterations, initial=start, desc="autoencoder", unit="it")
+    losses, it = [], start
+    for it in range(start, args.iterations):
+        x = corpus.batch(rng, args.batch)
+        y, z = model(masked_noise(x, args.mask))
+        loss = ((y - x) ** 2).mean() + SPARSITY * z.abs().mean()
+        optimiser.zero_grad()
+        loss.backward()
+        optimiser.step()
+        scheduler.step()
+        losses.append(float(loss))
+        bar.update(1)
+        bar.set_postfix(loss=f"{np.mean(losses[-50:]):.4f}")
+        if (it + 1) % VALIDATE_EVERY == 0 or it + 1 == args.iterations:
+            model.eval()
+            clean, noisy = position_error_cm(model, corpus, valid), position_error_cm(model, corpus, valid, args.mask)
+            model.train()
+            if clean < best:
+                best = clean
+                run.save({"model": model.state_dict(), "iteration": it + 1, "valid_cm": clean, "meta": meta}, run.best_path)
+            run.log.info("iteration %d loss %.4f held-out error %.2f cm clean, %.2f cm masked (p=%.1f) best %.2f minutes %.1f",
+                         it + 1, np.mean(losses[-VALIDATE_EVERY:]), clean, noisy, args.mask, best, elapsed() / 60)
+        if run.due():
+            run.save(checkpoint(it + 1))
+        if elapsed() > args.minutes * 60:
+            run.log.info("stopped: time budget of %.0f minutes used (iteration %d)", args.minutes, it + 1)
+            break
+    bar.close()
+    run.save(checkpoint(it + 1))
+    (run.dir / "summary.json").write_text(json.dumps({"best_valid_cm": best, "iterations": it + 1,
+                                                       "minutes": elapsed() / 60, "parameters": params}, indent=1))
+    return best, run.dir
