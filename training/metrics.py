@@ -81,3 +81,29 @@ def wasserstein_1d(a: np.ndarray, b: np.ndarray) -> float:
 def summary(values: np.ndarray) -> dict:
     return {"mean": float(np.mean(values)), "p10": float(np.percentile(values, 10)),
             "p50": float(np.percentile(values, 50)), "p90": float(np.percentile(values, 90))}
+
+
+FOOT_GROUP = {"left": ("LeftFoot", "LeftToeBase", "LeftToeBase_end"), "right": ("RightFoot", "RightToeBase", "RightToeBase_end")}
+NEAR_FLOOR = 0.04  # metres
+
+
+def low_foot_speeds(positions: np.ndarray, fps: float, skel: Skeleton, near: float = NEAR_FLOOR) -> np.ndarray:
+    """Horizontal speeds (m/s) of each foot's lowest point (ankle, toe or toe tip, chosen in the first frame of
+    each pair) over the frame pairs in which that point is within `near` of the floor (y = 0) in both frames.
+    Needs no contact labels, so it also counts feet near the floor whose contact bit is off."""
+    speeds = []
+    for names in FOOT_GROUP.values():
+        idx = [skel.index(n) for n in names]
+        pts = positions[:, idx]  # (frames, 3, 3)
+        low = pts[..., 1].argmin(axis=1)
+        rows = np.arange(len(positions) - 1)
+        a, b = pts[rows, low[:-1]], pts[rows + 1, low[:-1]]
+        near_both = (a[:, 1] < near) & (b[:, 1] < near)
+        speeds.append(np.linalg.norm((b - a)[:, [0, 2]], axis=-1)[near_both] * fps)
+    return np.concatenate(speeds)
+
+
+def low_foot_sliding_clips(clips: list[np.ndarray], fps: float, skel: Skeleton) -> float:
+    """low_foot_speeds pooled over separate clips (each measured on its own), mean m/s."""
+    allv = np.concatenate([low_foot_speeds(p, fps, skel) for p in clips]) if clips else np.zeros(0)
+    return float(allv.mean()) if len(allv) else float("nan")

@@ -1,0 +1,250 @@
+"""docs/models/latent-erd.{md,json}: the motion manifold and the latent ERD against the pose-space ERD and the
+generator, measured as training/latent_erd/measures.py describes; the page's numbers (paths, live control,
+× real time in Chromium) come from docs/models/latent-erd-browser.json (npm run evaluate:latent-erd).
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from .. import metrics
+from ..data.locomotion import load_clips
+from ..data.windows import WindowCorpus
+from ..generator.shipped import ShippedGenerator
+from ..paths import MODELS_DIR, REPO_ROOT, REPORTS_DIR
+from . import measures as m
+from .training import load_erd
+
+LOOKAHEADS = (0, 1, 3, 6, 9)
+BROWSER_JSON = REPORTS_DIR / "latent-erd-browser.json"
+
+
+def evaluate(mocap: str | None, frames: int, n_seeds: int, pose_checkpoint: Path, models_dir: Path = MODELS_DIR) -> dict:
+    torch.set_num_threads(1)
+    clips = load_clips(mocap)
+    corpus = WindowCorpus(clips)
+    shipped = m.Shipped.load(models_dir)
+    encoder = m.OnnxEncoder(shipped.encoder_path)
+    fps = shipped.info["fps"]
+    report: dict = {"manifold": shipped.manifold["report"], "lookahead": shipped.info["lookahead"], "fps": fps}
+
+    # Prediction from held-out seeds, driven by the clips' own control.
+    windows = m.prediction_windows(corpus)
+    real = [corpus.valid_clips[w.clip].positions[w.start + m.SEED_FRAMES: w.start + m.SEED_FRAMES + m.PREDICT_FRAMES] for w in windows]
+    latent = [m.latent_prediction(shipped, encoder, corpus, w, m.PREDICT_FRAMES) for w in windows]
+    rows = {"latent ERD": [o.positions for o in latent]}
+    if pose_checkpoint.exists():
+        pose, _ = load_erd(pose_checkpoint)
+        rows["pose-space ERD"] = [m.pose_erd_prediction(pose, corpus, w, m.PREDICT_FRAMES) for w in windows]
+    gen = ShippedGenerator(models_dir)
+    by_file = {c.file: c for c in clips}
+    rng = np.random.default_rng(0)
+    rows["generator (free-running)"] = [m.generator_prediction(gen, corpus, by_file, w, m.PREDICT_FRAMES, rng) for w in windows]
+    report["prediction"] = {"windows": len(windows), "clips": sorted({corpus.valid_clips[w.clip].file for w in windows}),
+                            "rows": {name: m.prediction_errors(p, real) for name, p in rows.items()}}
+    report["sliding_held_out_control"] = m.sliding([(o.positions, o.contacts) for o in latent], fps)
+    report["sliding_real"] = m.real_sliding(corpus, fps)
+
+    # Long runs of random control.
+    median = m.real_pose_change_median(corpus, fps)
+    runs = []
+    long_outputs = []
+    for seed in range(n_seeds):
+        out, seconds = m.random_run(shipped, seed, frames)
+        change = metrics.pose_change_per_second(out.positions, fps)
+        speed = np.linalg.norm(np.diff(out.roots[:, :2], axis=0), axis=1) * fps
+        runs.append({"seed": seed, "seed_clip": shipped.info["seeds"][seed % len(shipped.info["seeds"])]["name"],
+                     "frames": len(out.positions), "finite": bool(np.isfinite(out.positions).all()),
+                     "min_pose_change_share_of_median": round(float(change.min() / median), 3),
+                     "seconds_below_20pct": round(float((change < m.FREEZE_FRACTION * median).mean()), 4),
+                     "mean_speed": round(float(speed.mean()), 3), "native_onnx_seconds": round(seconds, 2),
+                     "x_real_time_native": round(len(out.positions) / fps / seconds, 1)})
+        long_outputs.append((out.positions, out.contacts))
+    report["long_runs"] = {"real_median_pose_change": round(median, 4), "runs": runs,
+                           "collapsed": sum(r["seconds_below_20pct"] > 0 or not r["finite"] for r in runs)}
+    report["sliding_random_control"] = m.sliding(long_outputs, fps)
+
+    # Seams against look-ahead.
+    seams = []
+    for k in LOOKAHEADS:
+        out, seconds = m.random_run(shipped, 0, 2000, lookahead=k)
+        seams.append({"lookahead": k, **m.seam_ratio(out.positions, fps), "native_ms_per_frame": round(seconds / len(out.positions) * 1000, 3)})
+    report["seams"] = {"real_frame_change_cm": m.real_frame_change(corpus), "rows": seams}
+    if BROWSER_JSON.exists():
+        report["browser"] = json.loads(BROWSER_JSON.read_text())
+    report["sizes_bytes"] = {"latent-erd.onnx": (models_dir / "latent-erd.onnx").stat().st_size,
+                             "manifold-encoder.onnx": (models_dir / "manifold-encoder.onnx").stat().st_size,
+                             "manifold-decoder.onnx": (models_dir / "manifold-decoder.onnx").stat().st_size}
+    for name in ("autoencoder", "latent-erd", "pose-erd"):
+        summary = REPO_ROOT / "runs" / name / "summary.json"
+        if summary.exists():
+            report.setdefault("training", {})[name] = json.loads(summary.read_text())
+    return report
+
+
+
+def _mean(values) -> float:
+    return float(np.mean(values)) if len(values) else float("nan")
+
+
+def browser_tables(browser: dict) -> list[str]:
+    """Paths and live-control rows from the page's own evaluation (control.json's fields), latent ERD beside
+    the generator with the MAP optimiser when both were measured."""
+    out = []
+    paths = browser.get("paths", [])
+    if paths:
+        out += ["| path | model | mean error (m) | max error (m) | arc progress (least) | × real time (least) | sliding after lock (m/s) |",
+                "|---|---|---|---|---|---|---|"]
+        keys = sorted({(p["path"], p.get("model", "latent-erd")) for p in paths}, key=lambda k: (k[0], k[1]))
+        for name, model in keys:
+            rows = [p for p in paths if p["path"] == name and p.get("model", "latent-erd") == model]
+            out.append(f"| {name} | {model} | {_mean([r['meanError'] for r in rows]):.3f} | {max(r['maxError'] for r in rows):.3f} | "
+                       f"{min(r['arcProgress'] for r in rows):.1%} | {min(r['realtime'] for r in rows):.1f} | "
+                       f"{_mean([r['skating'] for r in rows if r.get('skating') is not None]):.3f} |")
+    control = browser.get("control", [])
+    if control:
+        out += ["", "| scenario | model | heading within 15° after (s) | speed 1 s after the change (m/s) | |speed − target| worst (m/s) | compute p95 / max (ms per frame) | sliding (m/s) |",
+                "|---|---|---|---|---|---|---|"]
+        keys = sorted({(c["scenario"], c.get("model", "latent-erd")) for c in control})
+        for name, model in keys:
+            rows = [c for c in control if c["scenario"] == name and c.get("model", "latent-erd") == model]
+            head = ", ".join("—" if r.get("headingResponse") is None else f"{r['headingResponse']:.2f}" for r in rows)
+            speeds = ", ".join(f"{r['speedAt1s']:.2f}" for r in rows)
+            out.append(f"| {name} | {model} | {head} | {speeds} | "
+                       f"{max(r['speedError'] for r in rows):.2f} | {max(r['p95ms'] for r in rows):.1f} / {max(r['maxMs'] for r in rows):.1f} | "
+                       f"{_mean([r['skating'] for r in rows]):.3f} |")
+    return out
+
+
+def write_markdown(r: dict, path: Path) -> None:
+    man, pred, longr, seams = r["manifold"], r["prediction"], r["long_runs"], r["seams"]
+    sr, sh, sl = r["sliding_real"], r["sliding_held_out_control"], r["sliding_random_control"]
+    lines = [
+        "# Motion manifold and latent ERD",
+        "",
+        "Made by `python -m training.latent_erd.evaluate` on the shipped models (`public/models/manifold-*.onnx`, "
+        "`latent-erd.onnx`, native onnxruntime, one thread); the page's numbers come from `npm run evaluate:latent-erd` "
+        "(headless Chromium, `docs/models/latent-erd-browser.json`). The method follows Yearsley's thesis: a denoising "
+        "convolutional autoencoder of motion windows (Holden et al.), and an ERD in its latent space driven by a control "
+        "signal (forward, sideways and turning speed of the root, `training/control.py`, the same rules in "
+        "`web/motion/control.ts`, checked by `tests/fixtures/control_signal.json`).",
+        "",
+        "## Data",
+        "",
+        "CMU walking and running on the canonical skeleton at 30 fps, split by clip as for the generator (every 8th clip "
+        "of each category is held out), training clips mirrored and played at 0.9, 1.0 and 1.1× speed. 30 fps rather than "
+        "60: the generator's corpus is at 30 fps, a 4 s window is 120 frames, and two poolings (1:4) give a latent step of "
+        "133 ms, the thesis's 1:8 at 60 fps, at half the cost. Per frame: 25 joint positions in the root's "
+        "ground-projected facing frame (hips and shoulders across-vector, smoothed over 0.17 s, as is the ground "
+        "trajectory, so the control carries the course and not each step's sway), the 3 control values, and the 2 "
+        "contact bits: 80 values.",
+        "",
+        "## Autoencoder",
+        "",
+        f"Encoder: Conv1d(80→{r.get('ae_hidden', 96)}, 25) · ReLU · MaxPool(2) · Conv1d(→256, 25) · ReLU · MaxPool(2); decoder: "
+        "nearest upsampling ×2 · Conv1d(25) · ReLU · upsampling ×2 · Conv1d(25) (deterministic, exports as ONNX Resize). "
+        "Masked noise p = 0.3, Adam 1e-3; the control channels weigh 10× in the loss (see below).",
+        "",
+        "| held-out windows | error from clean input (cm per joint) | from input with 30% of values masked (cm per joint) |",
+        "|---|---|---|",
+        f"| {man.get('held_out_windows')} | {man.get('reconstruction_cm_clean')} | {man.get('reconstruction_cm_masked_0.3')} |",
+        "",
+    ]
+    if "control_rmse" in man:
+        lines += [f"Reconstructed control, RMS error on the same windows: forward {man['control_rmse'][0]:.3f} m/s, sideways "
+                  f"{man['control_rmse'][1]:.3f} m/s, turn {man['control_rmse'][2]:.3f} rad/s.", ""]
+    for note in r.get("notes", {}).get("autoencoder", []):
+        lines += [note, ""]
+    lines += [
+        "## Latent ERD and online emission",
+        "",
+        "ELU encoder (256 latent + 12 control: the next step's 4 frames) → 3 × LSTM(224) with skip connections (every "
+        "layer also sees the encoder's output; the decoder sees all three) → dropout 0.2 → linear decoder of the change to "
+        "the next latent. 224 units rather than the thesis's 256 so the file stays under 8 MB. The pose-space ERD baseline "
+        "is the same network on the 80-value rows, one frame per step, with Fragkiadaki-style input noise growing to 0.3.",
+        "",
+        "The decoder needs latents 9 steps (1.2 s) on both sides of a frame. Waiting for them would add 1.2 s of lag, so "
+        "each 133 ms step the ERD commits the next latent, then guesses `lookahead` further steps from a copy of its state "
+        "with the current control, and the unpadded decoder turns [9 committed steps, the new one, the guesses, the last "
+        "guess repeated] into the new step's 4 frames (`training/latent_erd/streaming.py`, the same in the page). A change "
+        "of control shows in the next emitted step: the added lag is one latent step, 133 ms, at most.",
+        "",
+        f"Seams: mean joint displacement relative to the hips between consecutive frames, across the boundary of two "
+        f"emitted steps and inside a step (2,000 frames of random control, seed 0); real held-out clips move "
+        f"{seams['real_frame_change_cm']} cm per frame.",
+        "",
+        "| look-ahead (steps) | across a boundary (cm) | inside a step (cm) | ratio | native ms per frame |",
+        "|---|---|---|---|---|",
+    ]
+    lines += [f"| {s['lookahead']} | {s['boundary_cm']} | {s['inside_cm']} | {s['ratio']} | {s['native_ms_per_frame']} |" for s in seams["rows"]]
+    lines += ["", f"The shipped stream uses look-ahead {r['lookahead']}.", ""]
+    lines += [
+        "## Prediction from held-out seeds (VAE-LSTM paper, Tables 1 and 2)",
+        "",
+        f"{pred['windows']} windows from the held-out clips long enough for 16 seed frames and 210 predicted ones "
+        f"({', '.join(pred['clips'])}; starts every 60 frames). Every model sees only the past: seed rows and latents are "
+        "computed from the clip up to the seed's end. The ERDs are driven by the clip's own control; the generator has no "
+        "control input and free-runs (one draw at temperature 1) from the same 16 frames, teacher-forced from a zero state. "
+        "Mean joint position error in cm.",
+        "",
+        "| model | " + " | ".join(f"{k} frames" for k in m.HORIZONS) + " | (relative to the root) " + " | ".join(f"{k}" for k in m.HORIZONS) + " |",
+        "|---|" + "---|" * (2 * len(m.HORIZONS) + 1),
+    ]
+    for name, e in pred["rows"].items():
+        lines.append(f"| {name} | " + " | ".join(str(e["with_root_cm"][k]) for k in m.HORIZONS) + " | | "
+                     + " | ".join(str(e["relative_cm"][k]) for k in m.HORIZONS) + " |")
+    lines += [
+        "",
+        "## Long runs of random control",
+        "",
+        f"{len(longr['runs'])} seeds × {longr['runs'][0]['frames']:,} frames of `randomControl` (new target speed 0.4–2.0 m/s and turn "
+        f"±1.2 rad/s every 2 s, eased). A run collapses when a second's pose change (mean joint speed relative to the root) "
+        f"falls below 20% of the real median ({longr['real_median_pose_change']} m/s).",
+        "",
+        "| seed | seed clip | frames | lowest second / real median | seconds below 20% | mean speed (m/s) | × real time (native) |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    lines += [f"| {x['seed']} | {x['seed_clip']} | {x['frames']:,} | {x['min_pose_change_share_of_median']} | {x['seconds_below_20pct']:.1%} | "
+              f"{x['mean_speed']} | {x['x_real_time_native']} |" for x in longr["runs"]]
+    lines += ["", f"Runs that collapsed: {longr['collapsed']} of {len(longr['runs'])}.", ""]
+    lines += [
+        "## Foot sliding",
+        "",
+        "Two measures: the toe's horizontal speed while its contact bit is on (the other reports' measure), and the "
+        "horizontal speed of each foot's lowest point (ankle, toe or toe tip) while it is within 4 cm of the floor, which "
+        "needs no contact bits. Each clip or run on its own. The foot lock is `training/footlock.py` (the page's "
+        "`web/motion/footLock.ts`), driven by the decoded contact bits.",
+        "",
+        "| motion | contact-bit measure before / after lock (m/s) | lowest-point measure before / after lock (m/s) |",
+        "|---|---|---|",
+        f"| real held-out clips | {sr['contact_bits']} | {sr['low_foot']} |",
+        f"| latent ERD, held-out control | {sh['contact_bits_before']} / {sh['contact_bits_after']} | {sh['low_foot_before']} / {sh['low_foot_after']} |",
+        f"| latent ERD, random control | {sl['contact_bits_before']} / {sl['contact_bits_after']} | {sl['low_foot_before']} / {sl['low_foot_after']} |",
+        "",
+    ]
+    if "browser" in r:
+        lines += ["## In the page: paths and live control", "", r["browser"].get("note", ""), ""] + browser_tables(r["browser"]) + [""]
+    else:
+        lines += ["## In the page", "", "Not measured in this run (`docs/models/latent-erd-browser.json` missing).", ""]
+    for section, notes in r.get("notes", {}).items():
+        if section != "autoencoder":
+            lines += [f"## {section}", ""] + [f"- {n}" for n in notes] + [""]
+    if "training" in r:
+        lines += ["## Training runs", "", "| run | minutes | iterations | best held-out |", "|---|---|---|---|"]
+        for name, t in r["training"].items():
+            best = t.get("best_valid_cm", t.get("best_valid_loss"))
+            lines.append(f"| {name} | {t['minutes']:.1f} | {t['iterations']} | {best:.4g} |")
+        lines.append("")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def write_report(mocap: str | None, frames: int, n_seeds: int, pose_checkpoint: Path, notes: dict) -> dict:
+    REPORTS_DIR.mkdir(parents=True, exist_ok=True)
+    report = evaluate(mocap, frames, n_seeds, pose_checkpoint)
+    report["notes"] = notes
+    (REPORTS_DIR / "latent-erd.json").write_text(json.dumps(report, indent=1) + "\n")
+    write_markdown(report, REPORTS_DIR / "latent-erd.md")
+    return report
