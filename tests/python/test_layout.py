@@ -108,7 +108,7 @@ MAY_IMPORT = {
     "aclstm": {"mocap", "data", "models"} | SHARED,
     "refiner": {"mocap", "data", "models", "generator"} | SHARED,
     "autoencoder": {"mocap", "data", "models"} | SHARED,
-    "latent_erd": {"mocap", "data", "models", "autoencoder", "control"} | SHARED,
+    "latent_erd": {"mocap", "data", "models", "autoencoder", "control", "generator"} | SHARED,
     "fixtures": {"mocap", "data", "models", "generator", "refiner", "aclstm", "control", "autoencoder", "latent_erd"} | SHARED,
 }
 
