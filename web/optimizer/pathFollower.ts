@@ -288,7 +288,7 @@ function framesToKeep(path: GroundPath, result: RolloutResult, b: number, arc: n
 }
 
 /** Mean and largest distance from the root (on the ground) to the path, and the share of the path covered. */
-function pathErrors(path: GroundPath, positions: Float32Array, J: number, frames: number): Pick<FollowPathStats, 'meanError' | 'maxError' | 'arcProgress'> {
+export function pathErrors(path: GroundPath, positions: Float32Array, J: number, frames: number): Pick<FollowPathStats, 'meanError' | 'maxError' | 'arcProgress'> {
   let sum = 0, worst = 0, s = 0;
   for (let f = 0; f < frames; f++) {
     const x = positions[f * J * 3], z = positions[f * J * 3 + 2];
