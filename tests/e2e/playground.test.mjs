@@ -83,9 +83,9 @@ describe('motion playground page', { timeout: 150_000 }, () => {
     });
     assert.equal(info.isolated, true, 'COOP/COEP headers should make the page cross-origin isolated');
     assert.match(info.version, /^\d+\.\d+\.\d+/);
-    // models() lists the manifest's entries without their internal `file`.
+    // models() lists the manifest's entries without their internal `file` (and `files`, of a model with several).
     const manifest = JSON.parse(readFileSync(path.join(ROOT, 'public', 'models', 'index.json'), 'utf8'));
-    assert.deepEqual(info.models, manifest.models.map(({ file, ...rest }) => rest));
+    assert.deepEqual(info.models, manifest.models.map(({ file, files, ...rest }) => rest));
     assert.equal(info.current, null);
     assert.equal(info.lastError, null);
     assert.equal(info.state.frames, 0);

@@ -16,6 +16,8 @@ import { checkPathPoints, GroundPath } from '../optimizer/path';
 import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed, optional } from '../optimizer/options';
 import { describeValue } from '../motion/describe';
 import { loadManifest, type ModelInfo } from '../model/manifest';
+import { checkControlSignal } from '../model/latentErdInfo';
+import { checkPathSpeed, LATENT_PATH_SPEED } from '../runtime/latentErdRequests';
 
 declare const __APP_VERSION__: string;
 
@@ -42,15 +44,23 @@ export interface CancellableOptions {
 }
 
 export interface GenerateOptions extends CancellableOptions {
-  /** A model id from `models()` of kind "lstm-gmm" ("generator") or "aclstm" ("aclstm", "aclstm-vanilla"). */
+  /** A model id from `models()` of kind "lstm-gmm" ("generator"), "aclstm" ("aclstm", "aclstm-vanilla") or "latent-erd" ("latent-erd"). */
   model: string;
   /** Number of frames, an integer 1…100000. */
   frames: number;
   /**
    * Integer 0…2³²−1. Generator: picks the seed state (seed mod the number of seed states) and seeds the
-   * random stream. acLSTM: picks the seed motion, seed mod the number of seed motions of the style.
+   * random stream. acLSTM: picks the seed motion, seed mod the number of seed motions of the style. Latent
+   * ERD: picks the seed state (seed mod the number of seeds in latent-erd.json) and, without `control`, the
+   * random control.
    */
   seed: number;
+  /**
+   * Latent ERD only: the control signal, one [forward m/s, sideways m/s, turn rad/s] per frame (at least
+   * `frames`; further ones are the future the look-ahead sees at the end). Left out: smooth random control
+   * drawn from the seed (web/motion/control.ts randomControl).
+   */
+  control?: [number, number, number][];
   /** acLSTM models only, and required there: one of the model's `styles` ("salsa", "indian", "martial"). */
   style?: string;
   /** Generator only. Sampling temperature 0…2 (left out: 0.5; null is refused): 0 = each step's most likely mixture mean, 1 = the trained distribution. */
@@ -62,15 +72,22 @@ export interface GenerateOptions extends CancellableOptions {
   refine?: boolean;
 }
 
+/** The models that follow paths and take live control: the generator with the MAP optimiser (default), or the latent ERD. */
+export type ControlModel = 'generator' | 'latent-erd';
+
 export interface FollowPathOptions extends CancellableOptions {
+  /** "generator" (default: the MAP optimiser over the generator) or "latent-erd" (closed-loop control, no search). */
+  model?: ControlModel;
   /** The path on the ground: [x, z] pairs in metres, at least 2, each x and z within ±10000 m, 0.5–200 m long. The character starts at the first point facing along the path. */
   points: [number, number][];
   /** "walk" (default) or "run": picks the seed states and the pace. */
   gait?: 'walk' | 'run';
   /** Integer 0…2³²−1 (default 0): the same seed and path give the same motion. */
   seed?: number;
-  /** σ_fit of the path-fit term in metres, 0.02–2 (default 0.1): smaller follows tighter. */
+  /** Generator only. σ_fit of the path-fit term in metres, 0.02–2 (default 0.1): smaller follows tighter. */
   fitTolerance?: number;
+  /** Latent ERD only. The forward speed asked for, above 0 and at most 4 m/s (default 1.2 walking, 2.8 running). */
+  speed?: number;
   /** Lock planted feet (the refiner issue's contact clean-up; default true). The root path is not changed. */
   footLock?: boolean;
 }
@@ -91,6 +108,8 @@ export interface FollowPathStats {
 export type FollowedPathMotion = Motion & { contacts: Uint8Array; stats: FollowPathStats };
 
 export interface SimulateControlOptions extends CancellableOptions {
+  /** "generator" (default: the MAP live controller) or "latent-erd" (controlTowardHeading every latent step). */
+  model?: ControlModel;
   /** Length of the simulated run, seconds (0 < seconds ≤ 600), rounded to whole frames (at least one). */
   seconds: number;
   /** Targets over time: [{ t: 0, speed, heading }, …] with t in seconds, increasing; speed 0–4 m/s; heading in radians (0 faces +z). */
@@ -171,25 +190,27 @@ declare global {
 
 type GeneratorCall = { kind: 'lstm-gmm'; model: string; frames: number; seed: number; temperature: number; refine: boolean };
 type DanceCall = { kind: 'aclstm'; model: string; frames: number; seed: number; style: string };
+type LatentCall = { kind: 'latent-erd'; model: string; frames: number; seed: number; control?: Float64Array };
 
 /** Checks generate's options against the model they name (`models`: the manifest); the error says what is wrong. */
-export function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorCall | DanceCall {
+export function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorCall | DanceCall | LatentCall {
   if (typeof options !== 'object' || options === null || Array.isArray(options)) {
     throw new TypeError(`options must be an object: { model, frames, seed, temperature? } (acLSTM: { model, style, frames, seed }), got ${describeValue(options)}`);
   }
   const o = options as Partial<Record<keyof GenerateOptions, unknown>>;
-  const usable = models.filter((m) => m.kind === 'lstm-gmm' || m.kind === 'aclstm');
+  const usable = models.filter((m) => m.kind === 'lstm-gmm' || m.kind === 'aclstm' || m.kind === 'latent-erd');
   const available = usable.map((m) => m.id).join(', ');
   if (typeof o.model !== 'string') throw new TypeError(`model must be a model id string (available: ${available || 'none'}), got ${describeValue(o.model)}`);
   const entry = usable.find((m) => m.id === o.model);
   if (!entry) throw new Error(`unknown model ${describeValue(o.model)} (available: ${available || 'none — the model list did not load'})`);
   const dance = entry.kind === 'aclstm';
+  const latent = entry.kind === 'latent-erd';
   if (dance) {
     // Dance models have no sampling and no refiner: say so rather than silently ignoring the option.
     if ('temperature' in o) throw new TypeError(`temperature is not meaningful for acLSTM models: they are deterministic (the seed only picks the seed motion); leave it out`);
     if ('refine' in o) throw new TypeError(`refine is not available for acLSTM models (there is no refiner for dance); leave it out`);
   }
-  const known = dance ? ['model', 'style', 'frames', 'seed', 'signal'] : ['model', 'frames', 'seed', 'temperature', 'refine', 'signal'];
+  const known = dance ? ['model', 'style', 'frames', 'seed', 'signal'] : latent ? ['model', 'frames', 'seed', 'control', 'signal'] : ['model', 'frames', 'seed', 'temperature', 'refine', 'signal'];
   for (const k of Object.keys(options)) {
     if (!known.includes(k)) throw new TypeError(`unknown option ${describeValue(k)} for model "${entry.id}" (known: ${known.join(', ')})`);
   }
@@ -197,6 +218,10 @@ export function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorC
     throw new RangeError(`frames must be an integer from 1 to ${GENERATE_MAX_FRAMES}, got ${describeValue(o.frames)}`);
   }
   const seed = checkSeed(o.seed);
+  if (latent) {
+    const control = o.control === undefined ? undefined : checkControlSignal(o.control, o.frames);
+    return { kind: 'latent-erd', model: entry.id, frames: o.frames, seed, ...(control ? { control } : {}) };
+  }
   if (dance) {
     const styles = entry.styles ?? [];
     if (o.style === undefined) throw new TypeError(`style is required for model "${entry.id}" (styles: ${styles.join(', ')})`);
@@ -249,6 +274,33 @@ function checkSignal(options: unknown): AbortSignal | undefined {
     throw new TypeError(`signal must be an AbortSignal (an AbortController's signal), got ${describeValue(signal)}`);
   }
   return signal as AbortSignal;
+}
+
+/**
+ * The `model` option of followPath and simulateControl: "generator" when left out, else a listed model of
+ * kind "lstm-gmm" or "latent-erd" (`models`: the manifest).
+ */
+function checkControlModel(value: unknown, models: ModelInfo[]): ControlModel {
+  if (value === undefined) return 'generator';
+  const usable = models.filter((m) => (m.kind === 'lstm-gmm' && m.id === 'generator') || (m.kind === 'latent-erd' && m.id === 'latent-erd')).map((m) => m.id);
+  const available = usable.join(', ') || 'none — the model list did not load';
+  if (typeof value !== 'string') throw new TypeError(`model must be "generator" or "latent-erd", got ${describeValue(value)}`);
+  if (!usable.includes(value)) throw new Error(`unknown model ${describeValue(value)} (available: ${available})`);
+  return value as ControlModel;
+}
+
+const FOLLOW_PATH_OPTIONS: Record<ControlModel, string[]> = {
+  generator: ['model', 'points', 'gait', 'seed', 'fitTolerance', 'footLock', 'signal'],
+  'latent-erd': ['model', 'points', 'gait', 'seed', 'speed', 'footLock', 'signal'],
+};
+const FOLLOW_PATH_SHAPE = '{ points: [[x, z], …], model?, gait?, seed?, fitTolerance? (generator) or speed? (latent-erd), footLock?, signal? }';
+const SIMULATE_OPTIONS = ['model', 'seconds', 'schedule', 'seed', 'gait', 'footLock', 'signal'];
+
+/** A latent ERD motion as a Motion: the fitted, foot-locked positions and the decoded contacts. */
+async function generateLatent(app: App, o: LatentCall, signal: AbortSignal | undefined): Promise<Motion> {
+  const { client } = await app.latentErd.load();
+  const m = await client.generate({ seed: o.seed, frames: o.frames, ...(o.control ? { control: o.control } : {}) }, { signal });
+  return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts };
 }
 
 /** A dance as a Motion: the fitted positions, and foot contacts detected as for imported clips. */
@@ -381,6 +433,7 @@ export function createPlayground(app: App): Playground {
         await ready;
         const o = checkGenerate(options, models);
         if (o.kind === 'aclstm') return generateDance(app, o, signal);
+        if (o.kind === 'latent-erd') return generateLatent(app, o, signal);
         const { client } = await app.generator.load();
         const m = await client.generate({ frames: o.frames, seed: o.seed, temperature: o.temperature, ...(o.refine ? { refine: true } : {}) }, { signal });
         const shown = o.refine ? m.refined : m;
@@ -392,15 +445,24 @@ export function createPlayground(app: App): Playground {
 
     followPath(options) {
       return cancellable('followPath', options, async (signal) => {
-        const o = checkKeys(options, ['points', 'gait', 'seed', 'fitTolerance', 'footLock', 'signal'], '{ points: [[x, z], …], gait?, seed?, fitTolerance?, footLock?, signal? }');
+        checkKeys(options, Object.keys(options ?? {}), FOLLOW_PATH_SHAPE); // an object; its keys are checked once the model is known
+        await ready;
+        const model = checkControlModel((options as { model?: unknown }).model, models);
+        const o = checkKeys(options, FOLLOW_PATH_OPTIONS[model], FOLLOW_PATH_SHAPE);
         // Checked here too (the worker checks again), so bad input fails fast and without a worker prefix.
         const points = checkPathPoints(o.points);
         GroundPath.fromPoints(points);
         const gait = checkGait(optional(o.gait, 'walk'));
         const seed = checkSeed(optional(o.seed, 0));
-        const fitSigma = checkFitSigma(optional(o.fitTolerance, 0.1), 'fitTolerance');
         const lockFeet = checkFootLock(o.footLock);
-        await ready;
+        if (model === 'latent-erd') {
+          const speed = checkPathSpeed(optional(o.speed, LATENT_PATH_SPEED[gait]));
+          const { client } = await app.latentErd.load();
+          const m = await client.followPath({ points, gait, seed, speed, footLock: lockFeet }, { signal });
+          const { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock } = m.stats;
+          return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, stats: { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock } };
+        }
+        const fitSigma = checkFitSigma(optional(o.fitTolerance, 0.1), 'fitTolerance');
         const { client } = await app.generator.load();
         const m = await client.followPath({ points, gait, seed, fitSigma, footLock: lockFeet }, { signal });
         const { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock } = m.stats;
@@ -410,13 +472,18 @@ export function createPlayground(app: App): Playground {
 
     simulateControl(options) {
       return cancellable('simulateControl', options, async (signal) => {
-        const o = checkKeys(options, ['seconds', 'schedule', 'seed', 'gait', 'footLock', 'signal'], '{ seconds, schedule: [{ t, speed, heading }, …], seed?, gait?, footLock?, signal? }');
+        const o = checkKeys(options, SIMULATE_OPTIONS, '{ seconds, schedule: [{ t, speed, heading }, …], model?, seed?, gait?, footLock?, signal? }');
         const lockFeet = checkFootLock(o.footLock);
         const seconds = checkSeconds(o.seconds);
         const schedule = checkSchedule(o.schedule);
         const seed = checkSeed(optional(o.seed, 0));
         const gait = o.gait === undefined ? undefined : checkGait(o.gait);
         await ready;
+        if (checkControlModel(o.model, models) === 'latent-erd') {
+          const { client } = await app.latentErd.load();
+          const m = await client.simulateControl({ seconds, schedule, seed, footLock: lockFeet, ...(gait ? { gait } : {}) }, { signal });
+          return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, speed: m.speed, heading: m.heading, computeMs: m.computeMsPerFrame };
+        }
         const { client } = await app.generator.load();
         const m = await client.simulateControl({ seconds, schedule, seed, footLock: lockFeet, ...(gait ? { gait } : {}) }, { signal });
         return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, speed: m.speed, heading: m.heading, computeMs: m.computeMs };

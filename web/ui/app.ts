@@ -7,6 +7,7 @@ import type { Motion } from '../motion/types';
 import { Viewer } from '../viewer/viewer';
 import { DanceClient, type DanceInitResult } from '../runtime/danceClient';
 import { GeneratorClient, type InitResult } from '../runtime/generatorClient';
+import { LatentErdClient, type LatentErdInitResult } from '../runtime/latentErdClient';
 import { ImportClient } from '../runtime/importClient';
 import { baseName, type FileImportOutcome } from '../runtime/motionFiles';
 import { ImportIndicator } from './files';
@@ -31,6 +32,8 @@ export class App implements ModeHost {
   private readonly busy = new BusyIndicator(document.getElementById('model-status'));
   /** The generator model, loaded on first use (playground.generate, Random walk). */
   readonly generator = new ModelHost<GeneratorClient, InitResult>(() => new GeneratorClient({ threads: pageThreads() }), this.busy);
+  /** The latent ERD and its autoencoder's decoder (one worker), loaded on first use (playground.generate, followPath, simulateControl; Steer and Path modes). */
+  readonly latentErd = new ModelHost<LatentErdClient, LatentErdInitResult>(() => new LatentErdClient({ threads: pageThreads() }), this.busy);
   private readonly danceHosts = new Map<string, ModelHost<DanceClient, DanceInitResult>>();
   /** Parses imports off the page thread (dropped and picked files, playground.importMotion). */
   readonly importer = new ImportClient();

@@ -5,6 +5,7 @@
 import type { Motion } from '../../motion/types';
 import type { DanceClient, DanceInitResult } from '../../runtime/danceClient';
 import type { GeneratorClient, InitResult } from '../../runtime/generatorClient';
+import type { LatentErdClient, LatentErdInitResult } from '../../runtime/latentErdClient';
 import type { Viewer } from '../../viewer/viewer';
 import type { ModelHost } from '../modelHost';
 
@@ -25,6 +26,8 @@ export interface ModeHost {
   readonly viewer: ModeViewer;
   /** The generator model (Random walk, Steer, Path), loaded on first use and shared with the API. */
   readonly generator: ModelHost<GeneratorClient, InitResult>;
+  /** The latent ERD (Steer and Path modes' other model), loaded on first use and shared with the API. */
+  readonly latentErd: ModelHost<LatentErdClient, LatentErdInitResult>;
   /** A dance model (`id` "aclstm" or "aclstm-vanilla"), loaded on first use. */
   dance(id: string): ModelHost<DanceClient, DanceInitResult>;
   /** Shows a live mode's window of streamed frames (`dropped` < 0: a new stream); `name` names exports. */
