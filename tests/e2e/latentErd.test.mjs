@@ -1,13 +1,14 @@
-// End-to-end tests of the latent ERD in the page (issue 14): playground.generate with and without a
-// control signal, followPath and simulateControl with model 'latent-erd', refusals that leave the page as it
-// was, and parity in the browser (one ERD step, one decoder window and the fixture's whole stream run by the
+// End-to-end tests of the latent ERD in the page (issue 14): the model choice of Steer and Path modes (the
+// stream steered live, a drawn path followed, the choice kept across mode switches, and back to the
+// generator), playground.generate with and without a control signal, followPath and simulateControl with
+// model 'latent-erd', refusals that leave the page as it was, and parity in the browser (one ERD step, one decoder window and the fixture's whole stream run by the
 // worker against tests/fixtures/latent_erd_reference.json). Every number compared comes from the fixture
 // or the model JSON (the models are replaced by retrained ones). Run with `node --test tests/e2e/latentErd.test.mjs`.
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
 import { describe, test } from 'node:test';
-import { ROOT, usePlayground } from './harness.mjs';
+import { drawStroke, ROOT, usePlayground, waitUntil } from './harness.mjs';
 
 const REFERENCE = JSON.parse(readFileSync(path.join(ROOT, 'tests/fixtures/latent_erd_reference.json'), 'utf8'));
 const ERD = JSON.parse(readFileSync(path.join(ROOT, 'public/models/latent-erd.json'), 'utf8'));
@@ -61,6 +62,133 @@ function worstBone(m) {
   }
   return w;
 }
+
+const STATS = /error mean (\d+\.\d) cm · max (\d+\.\d) cm · (\d+) % of the path · (\d+\.\d) s for (\d+\.\d) s of motion/;
+
+const steerStatus = (page) =>
+  page.evaluate(() => {
+    const s = document.getElementById('steer-status');
+    return { model: s.dataset.model, frame: Number(s.dataset.frame), text: s.textContent, meta: document.getElementById('clip-meta').textContent };
+  });
+
+/** Waits until Steer mode streams from `model` and has shown more than `frames` frames of it. */
+function steerStreams(page, model, frames = 8) {
+  return waitUntil(
+    page,
+    ({ model, frames }) => {
+      const s = document.getElementById('steer-status');
+      // The status names the stream's model once it describes a frame of it ("… latent ERD · 2.1 ms per 4 frames", "… 24 particles").
+      const marker = model === 'latent-erd' ? / · latent ERD · / : / particles$/;
+      return s.dataset.model === model && marker.test(s.textContent) && Number(s.dataset.frame) > frames && document.getElementById('clip-meta').textContent.includes(model === 'latent-erd' ? 'latent ERD' : 'generator');
+    },
+    { model, frames },
+    { timeout: 90_000, message: `Steer mode streams from the ${model}` },
+  );
+}
+
+/** The values of both model selects. */
+const choices = (page) => page.evaluate(() => [document.getElementById('steer-model').value, document.getElementById('path-model').value]);
+
+describe('the model choice of Steer and Path modes', { timeout: 400_000 }, () => {
+  const suite = usePlayground();
+
+  test('Steer mode: the latent ERD is chosen from the keyboard, steered live, kept across mode switches; back to the generator', async () => {
+    const page = suite.page;
+    await page.click('#mode-steer');
+    const labels = await page.evaluate(() => [...document.getElementById('steer-model').options].map((o) => [o.value, o.textContent]));
+    assert.deepEqual(labels, [['generator', 'Generator + MAP optimiser'], ['latent-erd', 'Latent ERD']]);
+    assert.deepEqual(await choices(page), ['generator', 'generator'], 'the generator by default');
+    await steerStreams(page, 'generator');
+    assert.match((await steerStatus(page)).text, /particles/, 'the MAP controller runs');
+
+    // Keyboard: the select is in the tab order, and typing an option's first letter picks it.
+    assert.equal(await page.evaluate(() => document.getElementById('steer-model').tabIndex), 0);
+    await page.focus('#steer-model');
+    await page.keyboard.press('l');
+    assert.deepEqual(await choices(page), ['latent-erd', 'latent-erd'], 'one choice for both modes');
+    await page.evaluate(() => document.activeElement.blur());
+    await steerStreams(page, 'latent-erd');
+    const erd = await steerStatus(page);
+    assert.match(erd.text, /latent ERD · \d+\.\d ms per 4 frames/);
+    assert.doesNotMatch(erd.text, /particles/);
+    const m = await page.evaluate(() => {
+      const c = window.playground.current();
+      return { joints: c.joints.length, fps: c.fps, finite: c.positions.every(Number.isFinite), contacts: c.contacts?.length === c.frames * 2 };
+    });
+    assert.deepEqual(m, { joints: J, fps: ERD.fps, finite: true, contacts: true });
+
+    // The keys steer the latent ERD: the target turns, and the stream goes on.
+    const before = await steerStatus(page);
+    await page.keyboard.down('ArrowLeft');
+    try {
+      await waitUntil(page, () => Number(document.getElementById('steer-readout').dataset.targetHeading) > 0.6, null, { timeout: 20_000, message: '← turns the target heading' });
+    } finally {
+      await page.keyboard.up('ArrowLeft');
+    }
+    await waitUntil(page, (f) => Number(document.getElementById('steer-status').dataset.frame) > f + 30, before.frame, { timeout: 60_000, message: 'the latent ERD stream goes on' });
+    const readout = await page.evaluate(() => ({ ...document.getElementById('steer-readout').dataset }));
+    assert.ok(Number.isFinite(Number(readout.speed)) && readout.speed !== '', `an achieved speed is shown (${readout.speed})`);
+
+    // Away and back: still the latent ERD.
+    await page.click('#mode-clip');
+    await page.click('#mode-steer');
+    assert.deepEqual(await choices(page), ['latent-erd', 'latent-erd']);
+    await steerStreams(page, 'latent-erd');
+
+    await page.selectOption('#steer-model', 'generator');
+    await steerStreams(page, 'generator');
+    assert.match((await steerStatus(page)).text, /particles/);
+    await page.click('#mode-clip');
+  });
+
+  test('Path mode: a drawn path is followed by the latent ERD with progress; the generator walks it again when chosen back', async () => {
+    const page = suite.page;
+    await page.click('#mode-path');
+    if (await page.locator('#path-clear').isEnabled()) await page.click('#path-clear');
+    await page.selectOption('#path-model', 'latent-erd');
+    assert.deepEqual(await choices(page), ['latent-erd', 'latent-erd']);
+    assert.equal(await page.locator('#path-fit').isDisabled(), true, 'no fit tolerance for the latent ERD');
+    await drawStroke(page, Array.from({ length: 31 }, (_, i) => [0.3 + (0.4 * i) / 30, 0.45]));
+    assert.equal(await page.evaluate(() => document.getElementById('path-status').dataset.state), 'drawn');
+    await page.evaluate(() => (document.getElementById('path-progress').value = 0));
+    await page.click('#path-go');
+    await waitUntil(page, () => document.getElementById('path-status').dataset.state === 'done', null, { timeout: 120_000, message: 'the latent ERD walks the path' });
+    const done = await page.evaluate(() => {
+      const s = document.getElementById('path-status');
+      const m = window.playground.current();
+      return {
+        walkedBy: s.dataset.walkedBy, text: s.textContent, meta: document.getElementById('clip-meta').textContent,
+        progress: document.getElementById('path-progress').value, progressHidden: document.getElementById('path-progress').hidden,
+        frames: m.frames, joints: m.joints.length, finite: m.positions.every(Number.isFinite), playing: window.playground.state().playing,
+      };
+    });
+    assert.equal(done.walkedBy, 'latent-erd');
+    assert.match(done.text, /^latent ERD · /);
+    assert.ok(STATS.test(done.text), `the stats are shown: ${done.text}`);
+    assert.match(done.meta, /latent ERD · walk · \d+ frames/);
+    assert.equal(done.progress, 1, 'the progress bar went to the end');
+    assert.equal(done.progressHidden, true);
+    assert.equal(done.joints, J);
+    assert.ok(done.frames > 0 && done.finite && done.playing);
+    const motionSeconds = Number(STATS.exec(done.text)[5]);
+    assert.ok(Math.abs((done.frames - 1) / ERD.fps - motionSeconds) < 0.1, 'the stats describe the shown walk');
+
+    // Away and back: the choice and the walk stay; then the generator walks the same path.
+    await page.click('#mode-clip');
+    await page.click('#mode-path');
+    assert.deepEqual(await choices(page), ['latent-erd', 'latent-erd']);
+    assert.equal(await page.evaluate(() => document.getElementById('path-status').dataset.walkedBy), 'latent-erd');
+    await page.selectOption('#path-model', 'generator');
+    assert.equal(await page.locator('#path-fit').isDisabled(), false);
+    await page.click('#path-go');
+    await waitUntil(page, () => document.getElementById('path-status').dataset.walkedBy === 'generator' && document.getElementById('path-status').dataset.state === 'done', null, { timeout: 180_000, message: 'the generator walks the path' });
+    const generator = await page.evaluate(() => ({ text: document.getElementById('path-status').textContent, meta: document.getElementById('clip-meta').textContent }));
+    assert.doesNotMatch(generator.text, /latent ERD/);
+    assert.ok(STATS.test(generator.text));
+    assert.match(generator.meta, /generator · walk/);
+    await page.click('#mode-clip');
+  });
+});
 
 describe('latent ERD in the page', { timeout: 300_000 }, () => {
   const suite = usePlayground();

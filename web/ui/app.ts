@@ -16,6 +16,7 @@ import { BusyIndicator, ModelHost, pageThreads } from './modelHost';
 import { DanceMode } from './modes/danceMode';
 import type { ModeHost } from './modes/host';
 import type { LiveChunk, LiveMode } from './modes/liveMode';
+import { CONTROL_MODEL_SHORT, ModelChoice } from './modes/modelChoice';
 import { PathMode } from './modes/pathMode';
 import { RandomWalk } from './modes/randomWalk';
 import { SteerMode } from './modes/steerMode';
@@ -41,6 +42,8 @@ export class App implements ModeHost {
   private name = '';
   private lastErrorMessage: string | null = null;
   private readonly exportBtn = $<HTMLButtonElement>('export-btn');
+  /** The model Steer and Path modes run (one choice for both, kept across mode switches). */
+  readonly controlModel = new ModelChoice([$<HTMLSelectElement>('steer-model'), $<HTMLSelectElement>('path-model')]);
   readonly walk: RandomWalk;
   readonly danceMode: DanceMode;
   readonly pathMode: PathMode;
@@ -128,7 +131,7 @@ export class App implements ModeHost {
       this.setLiveLabel('Random walk', 'generator · 30 fps · live');
       this.exportBtn.title = 'Download the last 20 s of the walk as BVH';
     } else if (mode === 'steer') {
-      this.setLiveLabel('Steer', 'generator · 30 fps · live control');
+      this.setLiveLabel('Steer', `${CONTROL_MODEL_SHORT[this.controlModel.value]} · 30 fps · live control`);
       this.exportBtn.title = 'Download the last 20 s of steering as BVH';
     } else {
       this.setLiveLabel('Dance', 'loading…');

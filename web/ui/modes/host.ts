@@ -8,6 +8,7 @@ import type { GeneratorClient, InitResult } from '../../runtime/generatorClient'
 import type { LatentErdClient, LatentErdInitResult } from '../../runtime/latentErdClient';
 import type { Viewer } from '../../viewer/viewer';
 import type { ModelHost } from '../modelHost';
+import type { ModelChoice } from './modelChoice';
 
 /**
  * The parts of the viewer a mode uses: the camera rig (camera, orbit controls, framing), the scene for
@@ -28,6 +29,8 @@ export interface ModeHost {
   readonly generator: ModelHost<GeneratorClient, InitResult>;
   /** The latent ERD (Steer and Path modes' other model), loaded on first use and shared with the API. */
   readonly latentErd: ModelHost<LatentErdClient, LatentErdInitResult>;
+  /** Which of the two Steer and Path modes run (the generator or the latent ERD). */
+  readonly controlModel: ModelChoice;
   /** A dance model (`id` "aclstm" or "aclstm-vanilla"), loaded on first use. */
   dance(id: string): ModelHost<DanceClient, DanceInitResult>;
   /** Shows a live mode's window of streamed frames (`dropped` < 0: a new stream); `name` names exports. */

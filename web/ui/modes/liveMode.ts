@@ -24,6 +24,9 @@ export interface LiveSkeleton {
 export interface LiveStream<Chunk extends LiveChunk> {
   skeleton: LiveSkeleton;
   pull(frames: number): Promise<Chunk>;
+  /** This stream's frames per pull and frames kept ready (default the mode's settings: a mode may run streams of two models). */
+  chunk?: number;
+  ahead?: number;
 }
 
 export interface LiveSettings {
@@ -126,8 +129,8 @@ export abstract class LiveMode<Chunk extends LiveChunk> {
     let first = true;
     while (token === this.token) {
       const ahead = first ? 0 : this.frames - 1 - this.app.viewer.playback.frameFloat;
-      if (ahead < this.settings.ahead) {
-        const chunk = await stream.pull(this.settings.chunk);
+      if (ahead < (stream.ahead ?? this.settings.ahead)) {
+        const chunk = await stream.pull(stream.chunk ?? this.settings.chunk);
         if (token !== this.token) return;
         this.append(chunk, first);
         this.received(chunk, first);

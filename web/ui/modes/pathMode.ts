@@ -1,6 +1,8 @@
-// Path mode: draw a path on the ground (mouse, pen or touch) and the generator walks it. The path
-// follower (web/optimizer) optimises the motion in the generator worker; the result plays with the
-// path as followed (mint) and the character's root trajectory (the viewer's purple trail) on the ground.
+// Path mode: draw a path on the ground (mouse, pen or touch) and the chosen model walks it (the model
+// choice, modelChoice.ts): the generator's path follower (web/optimizer) optimises the motion in the
+// generator worker, or the latent ERD follows the path in closed loop in its worker (a control signal
+// from where the character stands, every latent step: web/runtime/latentErdRequests.ts). The result plays
+// with the path as followed (mint) and the character's root trajectory (the viewer's purple trail) on the ground.
 // Redrawing replaces the path; a stroke that is too short, or a failed optimisation, keeps what was there.
 // A new path drawn while the last one is being walked, or leaving the mode, cancels that optimisation.
 
@@ -8,9 +10,11 @@ import * as THREE from 'three';
 import { MAX_PATH_LENGTH, MIN_PATH_LENGTH } from '../../optimizer/path';
 import type { Motion } from '../../motion/types';
 import type { FollowedPath, GeneratorClient } from '../../runtime/generatorClient';
+import type { LatentErdClient } from '../../runtime/latentErdClient';
 import { GroundLine, TARGET_COLOR } from '../../viewer/groundPath';
 import { $, element, errorMessage, readSeed, setSliderFill } from '../dom';
 import type { ModeHost } from './host';
+import { CONTROL_MODEL_SHORT, type ControlModelId } from './modelChoice';
 import type { Gait } from '../../optimizer/pathFollower';
 
 type Point = [number, number];
@@ -34,6 +38,8 @@ interface Result {
   path: Float32Array;
   stats: FollowedPath['stats'];
   gait: Gait;
+  /** The model that walked it. */
+  model: ControlModelId;
   /** The drawn points it was made from. */
   points: Point[];
 }
@@ -76,6 +82,8 @@ export class PathMode {
     this.fit.value = String(DEFAULT_FIT);
     this.showFit();
     this.fit.addEventListener('input', () => this.showFit());
+    // The latent ERD has no fit tolerance (no optimiser): its slider is off while it is chosen.
+    app.controlModel.onChange(() => this.showState());
     this.goBtn.addEventListener('click', () => void this.go());
     this.clearBtn.addEventListener('click', () => this.clear());
 
@@ -282,20 +290,27 @@ export class PathMode {
       return;
     }
     const { gait, seed, fitSigma } = this.params();
+    const model = this.app.controlModel.value;
     const run = (this.optimising = new AbortController());
     this.progress.value = 0;
     this.showState();
-    let client: GeneratorClient | undefined;
+    let client: GeneratorClient | LatentErdClient | undefined;
     try {
-      client = (await this.app.generator.load()).client;
       const onProgress = (fraction: number) => {
         this.progress.value = fraction;
-        this.status.textContent = `finding a ${gait} along the path… ${Math.round(fraction * 100)} %`;
+        this.status.textContent = `${model === 'latent-erd' ? 'the latent ERD follows the path' : `finding a ${gait} along the path`}… ${Math.round(fraction * 100)} %`;
       };
-      const r = await client.followPath({ points, gait, seed, fitSigma, stroke: true }, { signal: run.signal, onProgress });
+      let r: Pick<FollowedPath, 'fps' | 'frames' | 'joints' | 'parents' | 'positions' | 'contacts' | 'path' | 'stats'>;
+      if (model === 'latent-erd') {
+        const erd = (client = (await this.app.latentErd.load()).client);
+        r = await erd.followPath({ points, gait, seed, stroke: true }, { signal: run.signal, onProgress });
+      } else {
+        const generator = (client = (await this.app.generator.load()).client);
+        r = await generator.followPath({ points, gait, seed, fitSigma, stroke: true }, { signal: run.signal, onProgress });
+      }
       if (run.signal.aborted) return;
       const motion: Motion = { fps: r.fps, frames: r.frames, joints: r.joints, parents: r.parents, positions: r.positions, contacts: r.contacts };
-      this.result = { motion, path: r.path, stats: r.stats, gait, points };
+      this.result = { motion, path: r.path, stats: r.stats, gait, points, model };
       this.optimising = null;
       // Not cancelled by a new path or by leaving the mode: the result is for the drawn path, in Path mode.
       this.display(this.result);
@@ -305,7 +320,10 @@ export class PathMode {
       this.optimising = null;
       const message = errorMessage(e);
       // A request the worker refused leaves the worker fine; anything else (a crash) needs a new one.
-      if (client && !message.startsWith('generator followPath:')) this.app.generator.reset(client);
+      if (client && !message.startsWith(`${model} followPath:`)) {
+        if (model === 'latent-erd') this.app.latentErd.reset(client as LatentErdClient);
+        else this.app.generator.reset(client as GeneratorClient);
+      }
       this.app.reportError(`Path: ${message}`);
     }
     this.showState();
@@ -315,7 +333,7 @@ export class PathMode {
     const viewer = this.app.viewer;
     this.app.showInMode(r.motion, `path-${r.gait}`);
     const secs = (r.motion.frames - 1) / r.motion.fps;
-    this.app.setLiveLabel('Path', `${r.gait} · ${r.motion.frames} frames · ${secs.toFixed(1)} s · ${viewer.footprintCount} steps`);
+    this.app.setLiveLabel('Path', `${CONTROL_MODEL_SHORT[r.model]} · ${r.gait} · ${r.motion.frames} frames · ${secs.toFixed(1)} s · ${viewer.footprintCount} steps`);
     this.line.set(r.points === this.points ? r.path : flat(this.points));
     viewer.frameGround(r.path, RISE);
     // Look a little lower, so the walk sits above the control bar.
@@ -337,6 +355,14 @@ export class PathMode {
     this.clearBtn.disabled = this.busy || (!this.points.length && !r);
     this.progress.hidden = !this.busy;
     this.status.dataset.state = this.busy ? 'optimising' : current ? 'done' : this.points.length ? 'drawn' : 'empty';
+    const model = this.app.controlModel.value;
+    // The model chosen, and the one whose walk is shown.
+    this.status.dataset.model = model;
+    if (current) this.status.dataset.walkedBy = r.model;
+    else delete this.status.dataset.walkedBy;
+    this.fit.disabled = model === 'latent-erd';
+    if (model === 'latent-erd') this.fit.title = 'The latent ERD follows the path in closed loop, with no optimiser: it has no fit tolerance';
+    else this.fit.removeAttribute('title');
     this.hint.hidden = this.points.length > 0 || r !== null || this.stroke !== null;
     this.status.replaceChildren();
     if (this.busy) {
@@ -345,7 +371,7 @@ export class PathMode {
       const s = r.stats;
       const secs = (r.motion.frames - 1) / r.motion.fps;
       this.status.append(
-        `error mean ${(s.meanError * 100).toFixed(1)} cm · max ${(s.maxError * 100).toFixed(1)} cm · ${Math.round(s.arcProgress * 100)} % of the path · ` +
+        `${r.model === 'latent-erd' ? 'latent ERD · ' : ''}error mean ${(s.meanError * 100).toFixed(1)} cm · max ${(s.maxError * 100).toFixed(1)} cm · ${Math.round(s.arcProgress * 100)} % of the path · ` +
           `${(s.optimizeMs / 1000).toFixed(1)} s for ${secs.toFixed(1)} s of motion`,
         legend('path', 'drawn path'),
         legend('walked', 'walked (root)'),

@@ -1,22 +1,36 @@
-// Steer mode: live control of the generator by speed and heading (Wang, Chai, Xia §5.3, Fig. 9). The
-// live controller in the generator worker optimises 6 frames at a time toward the current target, a
-// little ahead of the playhead (LiveMode). Inputs: keyboard (turn and speed), a gamepad's left stick or
+// Steer mode: live control by speed and heading, of the generator (Wang, Chai, Xia §5.3, Fig. 9) or the
+// latent ERD (the model choice, modelChoice.ts). The generator's live controller (in its worker) optimises 6
+// frames at a time toward the current target; the latent ERD (in its worker) makes one latent step of 4
+// frames at a time, its control signal controlTowardHeading(root heading, target heading, target speed)
+// from where the character stands (web/motion/control.ts); both a little ahead of the playhead
+// (LiveMode), feet locked. Inputs: keyboard (turn and speed), a gamepad's left stick or
 // the on-screen stick (direction relative to the camera, push further to go faster), the speed slider.
 // A mint arrow on the ground at the character shows the target heading; the readout at the top left
 // compares target and achieved speed.
 
 import { angleDifference } from '../../optimizer/path';
-import type { ControlledMotion, GeneratorClient } from '../../runtime/generatorClient';
+import type { GeneratorClient } from '../../runtime/generatorClient';
+import type { LatentErdClient } from '../../runtime/latentErdClient';
 import { GroundArrow, TARGET_COLOR } from '../../viewer/groundPath';
 import { $, setSliderFill } from '../dom';
 import type { ModeHost } from './host';
-import { LiveMode, type LiveStream } from './liveMode';
+import { LiveMode, type LiveChunk, type LiveStream } from './liveMode';
+import { CONTROL_MODEL_SHORT, type ControlModelId } from './modelChoice';
 import type { Gait } from '../../optimizer/pathFollower';
+
+/** What a live batch of either model carries: frames, achieved speed and heading per frame, compute time. */
+type SteerChunk = LiveChunk & { startFrame: number; speed: Float32Array; heading: Float32Array; computeMs: number };
 
 
 /** Frames per optimised batch, and frames kept ready beyond the playhead (0.4 s at 30 fps). */
 const BATCH = 6;
 const AHEAD = 12;
+/**
+ * The latent ERD: one latent step (4 frames) per pull, and 8 frames (0.27 s) kept ready. A step takes a few
+ * milliseconds in the worker, so less is kept ready than for the generator: the input shows sooner.
+ */
+const ERD_BATCH = 4;
+const ERD_AHEAD = 8;
 /** Turn rate of the left / right keys (rad/s) and speed change of up / down (m/s per second). */
 const TURN_RATE = Math.PI / 2;
 const SPEED_RATE = 1;
@@ -54,7 +68,7 @@ const KEYS: Record<string, 'left' | 'right' | 'up' | 'down'> = {
 
 const degrees = (a: number) => Math.round((angleDifference(a, 0) * 180) / Math.PI);
 
-export class SteerMode extends LiveMode<ControlledMotion> {
+export class SteerMode extends LiveMode<SteerChunk> {
   private readonly gait = $<HTMLSelectElement>('steer-gait');
   private readonly speed = $<HTMLInputElement>('steer-speed');
   private readonly speedOut = $('steer-speed-out');
@@ -67,7 +81,9 @@ export class SteerMode extends LiveMode<ControlledMotion> {
   private readonly joystick = $('steer-joystick');
   private readonly knob = $('steer-knob');
   private readonly arrow = new GroundArrow(TARGET_COLOR, 0.85);
-  private client: GeneratorClient | undefined;
+  private client: GeneratorClient | LatentErdClient | undefined;
+  /** The model of the stream running (the choice when it started). */
+  private model: ControlModelId = 'generator';
   private seedName = '';
 
   /**
@@ -107,6 +123,8 @@ export class SteerMode extends LiveMode<ControlledMotion> {
       this.setSpeed(GAIT_SPEED[this.gaitValue]);
       this.restartIfActive();
     });
+    // Another model: a new stream at the origin.
+    app.controlModel.onChange(() => this.restartIfActive());
     // On the document, so it runs before the page's own shortcuts (on window), which it then skips.
     document.addEventListener('keydown', (e) => this.onKey(e, true));
     document.addEventListener('keyup', (e) => this.onKey(e, false));
@@ -159,26 +177,42 @@ export class SteerMode extends LiveMode<ControlledMotion> {
     this.app.viewer.invalidate();
   }
 
-  protected async open(signal: AbortSignal): Promise<LiveStream<ControlledMotion>> {
-    const { client, info } = await this.app.generator.load();
-    this.client = client;
-    const stream = await client.controlStart({ seed: 0, gait: this.gaitValue }, { signal });
-    this.seedName = stream.seedName;
+  protected async open(signal: AbortSignal): Promise<LiveStream<SteerChunk>> {
+    const model = (this.model = this.app.controlModel.value);
+    $('steer-status').dataset.model = model;
+    const started = model === 'latent-erd' ? await this.openLatent(signal) : await this.openGenerator(signal);
     // The stream starts at the origin facing +z, at the slider's speed.
     this.heading = 0;
     this.throttle = 1;
     this.history = { start: 0, speed: [], heading: [] };
     this.computeMs = 0;
     this.particles = PARTICLES_MAX;
-    this.app.setLiveLabel('Steer', `generator · ${info.fps} fps · live control · ${this.gaitValue}`);
+    this.app.setLiveLabel('Steer', `${CONTROL_MODEL_SHORT[model]} · ${started.skeleton.fps} fps · live control · ${this.gaitValue}`);
+    return started;
+  }
+
+  private async openGenerator(signal: AbortSignal): Promise<LiveStream<SteerChunk>> {
+    const { client, info } = await this.app.generator.load();
+    this.client = client;
+    const stream = await client.controlStart({ seed: 0, gait: this.gaitValue }, { signal });
+    this.seedName = stream.seedName;
     return { skeleton: info, pull: (frames) => client.controlPull(frames, { speed: this.targetSpeed, heading: this.heading, particles: this.particles }, { signal }) };
   }
 
-  protected forget(): void {
-    this.app.generator.reset(this.client);
+  private async openLatent(signal: AbortSignal): Promise<LiveStream<SteerChunk>> {
+    const { client, info } = await this.app.latentErd.load();
+    this.client = client;
+    const stream = await client.controlStart({ seed: 0, gait: this.gaitValue }, { signal });
+    this.seedName = stream.seedName;
+    return { skeleton: info, chunk: ERD_BATCH, ahead: ERD_AHEAD, pull: (frames) => client.controlPull(frames, { speed: this.targetSpeed, heading: this.heading }, { signal }) };
   }
 
-  protected received(chunk: ControlledMotion, first: boolean): void {
+  protected forget(): void {
+    if (this.model === 'latent-erd') this.app.latentErd.reset(this.client as LatentErdClient);
+    else this.app.generator.reset(this.client as GeneratorClient);
+  }
+
+  protected received(chunk: SteerChunk, first: boolean): void {
     if (first) this.placeCamera();
     const h = this.history;
     const at = chunk.startFrame - h.start;
@@ -191,13 +225,16 @@ export class SteerMode extends LiveMode<ControlledMotion> {
       h.start += 300;
     }
     this.computeMs = this.computeMs ? this.computeMs * 0.8 + chunk.computeMs * 0.2 : chunk.computeMs;
+    if (this.model !== 'generator') return; // the particle budget is the optimiser's
     const budget = (chunk.frames / 30) * 1000;
     if (chunk.computeMs > 0.7 * budget) this.particles = Math.max(PARTICLES_MIN, Math.round(this.particles * 0.75));
     else if (chunk.computeMs < 0.35 * budget) this.particles = Math.min(PARTICLES_MAX, Math.round(this.particles * 1.25));
   }
 
   protected describe(frame: number, fps: number): string {
-    return `frame ${frame} · ${(frame / fps).toFixed(1)} s · ${this.seedName} · ${Math.round(this.computeMs)} ms per ${BATCH} frames · ${this.particles} particles`;
+    const time = `frame ${frame} · ${(frame / fps).toFixed(1)} s · ${this.seedName}`;
+    if (this.model === 'latent-erd') return `${time} · latent ERD · ${this.computeMs.toFixed(1)} ms per ${ERD_BATCH} frames`;
+    return `${time} · ${Math.round(this.computeMs)} ms per ${BATCH} frames · ${this.particles} particles`;
   }
 
   // ---------- camera ----------
