@@ -199,12 +199,19 @@ async function generatorBenchmark(ctx, threads, batch, steps) {
   return { ...r, ...(batch === 1 ? { target_steps_per_s: 1000 } : { target_particle_steps_per_s: 20000 }) };
 }
 
-/** Display frame rate while a live mode streams (default threads), plus how far its stream got per second. */
-async function liveModeBenchmark(ctx, button, statusId) {
+/**
+ * Display frame rate while a live mode streams (default threads), plus how far its stream got per second.
+ * `model`: Steer mode's model choice (#steer-model) to set first.
+ */
+async function liveModeBenchmark(ctx, button, statusId, model) {
   const { context, page, problems } = await openPlayground(ctx.browser, ctx.url, VIEWPORT);
   const streamFrame = () => page.evaluate((id) => Number(document.getElementById(id).dataset.frame), statusId);
   try {
     await page.click(button);
+    if (model) {
+      await page.selectOption('#steer-model', model); // restarts the stream with that model
+      await page.waitForFunction((m) => document.getElementById('steer-status').dataset.model === m, model, { timeout: 60_000 });
+    }
     await page.waitForFunction((id) => Number(document.getElementById(id).dataset.frame) > 0, statusId, { timeout: 60_000 });
     await page.waitForTimeout(WARMUP_SECONDS * 1000);
     const f0 = await streamFrame();
@@ -341,6 +348,75 @@ async function pathFollowBenchmark(ctx) {
   } finally {
     await context.close();
   }
+}
+
+/** The models path following is compared over (followPath's `model`): the latent ERD and the generator with the MAP optimiser. */
+const PATH_MODELS = ['latent-erd', 'generator'];
+
+/**
+ * followPath on each benchmark path (walk, seed 0) with the latent ERD and, in the same run, the generator
+ * (the default model): path error, progress, motion and compute time, × real time, and the feet's sliding
+ * after the foot lock (stats.skating: mean planted-toe speed).
+ */
+async function latentErdPathsBenchmark(ctx) {
+  const { context, page, problems } = await openPlayground(ctx.browser, ctx.url, VIEWPORT);
+  try {
+    // Warm-up of both models (load, first wasm calls), as the raw-step benchmarks do.
+    for (const model of PATH_MODELS) await page.evaluate((model) => window.playground.followPath({ model, points: [[0, 0], [0, 1]], seed: 0 }), model);
+    const rows = [];
+    for (const [name, { points }] of Object.entries(BENCHMARK_PATHS)) {
+      for (const model of PATH_MODELS) {
+        const r = await page.evaluate(
+          async ({ points, model }) => {
+            const m = await window.playground.followPath({ model, points, gait: 'walk', seed: 0 });
+            return { seconds: m.frames / m.fps, ...m.stats };
+          },
+          { points, model },
+        );
+        rows.push({
+          path: name,
+          model,
+          mean_error_m: +r.meanError.toFixed(3),
+          max_error_m: +r.maxError.toFixed(3),
+          progress: +r.arcProgress.toFixed(3),
+          motion_s: +r.seconds.toFixed(2),
+          compute_s: +(r.optimizeMs / 1000).toFixed(2),
+          realtime_factor: +((r.seconds * 1000) / r.optimizeMs).toFixed(1),
+          sliding_m_per_s: +r.skating.toFixed(3),
+          sliding_before_lock_m_per_s: +r.skatingBeforeLock.toFixed(3),
+        });
+      }
+    }
+    const summary = Object.fromEntries(
+      PATH_MODELS.map((model) => {
+        const g = rows.filter((r) => r.model === model);
+        return [model, {
+          mean_error_m: +(g.reduce((a, r) => a + r.mean_error_m, 0) / g.length).toFixed(3),
+          worst_mean_error_m: Math.max(...g.map((r) => r.mean_error_m)),
+          worst_max_error_m: Math.max(...g.map((r) => r.max_error_m)),
+          least_progress: Math.min(...g.map((r) => r.progress)),
+          least_realtime_factor: Math.min(...g.map((r) => r.realtime_factor)),
+          mean_sliding_m_per_s: +(g.reduce((a, r) => a + r.sliding_m_per_s, 0) / g.length).toFixed(3),
+        }];
+      }),
+    );
+    return { rows, summary, targets: { 'latent-erd': { mean_error_m: 0.15, progress: 0.95, realtime_factor: 20 }, generator: { mean_error_m: 0.1, progress: 0.95, realtime_factor: 2 } }, page_errors: problems.length };
+  } finally {
+    await context.close();
+  }
+}
+
+/** The latent ERD's and the generator's rows of latent-erd-paths side by side, one line per path. */
+function latentPathsTable(r) {
+  const cols = ['mean error (m)', 'max error (m)', 'progress', 'motion (s)', 'compute (s)', '× real time', 'sliding (m/s)'];
+  const keys = ['mean_error_m', 'max_error_m', 'progress', 'motion_s', 'compute_s', 'realtime_factor', 'sliding_m_per_s'];
+  const lines = [`    | path | ${cols.map((c) => `${c}: latent ERD / generator`).join(' | ')} |`, `    |---|${cols.map(() => '---').join('|')}|`];
+  for (const name of Object.keys(BENCHMARK_PATHS)) {
+    const [a, b] = PATH_MODELS.map((model) => r.rows.find((x) => x.path === name && x.model === model));
+    if (!a || !b) continue;
+    lines.push(`    | ${name} | ${keys.map((k) => `${a[k]} / ${b[k]}`).join(' | ')} |`);
+  }
+  return lines.join('\n');
 }
 
 /** simulateControl (the live loop, scripted): compute per model frame while turning and changing speed. */
@@ -513,6 +589,12 @@ const OPTIMIZER_BENCHMARKS = [
     kind: 'control',
     run: liveControlBenchmark,
   },
+  {
+    name: 'latent-erd-paths',
+    description: 'followPath on the five benchmark paths (walk, seed 0) with model "latent-erd", and with the generator (default model) in the same run — latent ERD targets: mean error ≤ 0.15 m, progress ≥ 95%, ≥ 20× real time',
+    kind: 'latent-paths',
+    run: latentErdPathsBenchmark,
+  },
 ];
 
 export const BENCHMARKS = [
@@ -557,6 +639,12 @@ export const BENCHMARKS = [
     description: 'Steer mode: live control streaming (no input: straight ahead at 1.2 m/s), default quality — target 60 fps',
     kind: 'live',
     run: (ctx) => liveModeBenchmark(ctx, '#mode-steer', 'steer-status'),
+  },
+  {
+    name: 'steer-mode-latent-erd',
+    description: 'Steer mode with the latent ERD: one latent step (4 frames) per pull from its worker (no input: straight ahead at 1.2 m/s), default quality — target 60 fps',
+    kind: 'live',
+    run: (ctx) => liveModeBenchmark(ctx, '#mode-steer', 'steer-status', 'latent-erd'),
   },
   {
     name: 'steer-keys',
@@ -627,6 +715,15 @@ async function main() {
     }
     if (b.kind === 'path') {
       console.log(`  ${b.name}: least ${r.least_realtime_factor}× real time (target ≥ 2×): ${JSON.stringify(r.realtime_factor)}\n    ${b.description}`);
+      continue;
+    }
+    if (b.kind === 'latent-paths') {
+      const [a, g] = PATH_MODELS.map((m) => r.summary[m]);
+      console.log(
+        `  ${b.name}: latent ERD mean error ${a.mean_error_m} m (worst ${a.worst_mean_error_m}, target ≤ 0.15), least progress ${(a.least_progress * 100).toFixed(1)}% (target ≥ 95%),` +
+          ` least ${a.least_realtime_factor}× real time (target ≥ 20×), sliding ${a.mean_sliding_m_per_s} m/s; generator ${g.mean_error_m} m, ${(g.least_progress * 100).toFixed(1)}%, ${g.least_realtime_factor}×, ${g.mean_sliding_m_per_s} m/s` +
+          `\n${latentPathsTable(r)}\n    ${b.description}`,
+      );
       continue;
     }
     if (b.kind === 'control') {
