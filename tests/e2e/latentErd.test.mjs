@@ -311,6 +311,29 @@ describe('latent ERD in the page', { timeout: 300_000 }, () => {
     assert.equal(await page.evaluate(() => window.playground.state().playing), true);
   });
 
+  test('latent ERD requests cancel like the others: AbortError at once, nothing shown, the next call works', async () => {
+    const r = await suite.page.evaluate(async () => {
+      const pg = window.playground;
+      const before = pg.lastError();
+      const outcome = async (start) => {
+        const c = new AbortController();
+        const run = start(c.signal);
+        c.abort();
+        return run.then(() => ({ name: 'resolved' }), (e) => ({ name: e.name, message: e.message }));
+      };
+      const path = await outcome((signal) => pg.followPath({ model: 'latent-erd', points: [[0, 0], [0, 60]], signal }));
+      const sim = await outcome((signal) => pg.simulateControl({ model: 'latent-erd', seconds: 300, schedule: [{ t: 0, speed: 1.2, heading: 0 }], signal }));
+      const gen = await outcome((signal) => pg.generate({ model: 'latent-erd', frames: 50000, seed: 0, signal }));
+      const next = await pg.generate({ model: 'latent-erd', frames: 8, seed: 0 });
+      return { path, sim, gen, lastErrorUnchanged: pg.lastError() === before, next: next.frames };
+    });
+    assert.deepEqual(r.path, { name: 'AbortError', message: 'followPath: cancelled' });
+    assert.deepEqual(r.sim, { name: 'AbortError', message: 'simulateControl: cancelled' });
+    assert.deepEqual(r.gen, { name: 'AbortError', message: 'generate: cancelled' });
+    assert.equal(r.lastErrorUnchanged, true, 'a cancel is not shown');
+    assert.equal(r.next, 8);
+  });
+
   test('parity in the browser: one ERD step and one decoder window within 1e-4; the fixture stream within 1e-4 (rows) and 1 mm', async () => {
     const s = REFERENCE.stream;
     const r = await suite.page.evaluate(async ({ step, decode, stream }) => {
