@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 
 from ..paths import add_mocap_argument
-from .training import CONTROL_WEIGHT, train_autoencoder
+from .training import CONTROL_WEIGHT, SPARSITY, train_autoencoder
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -20,6 +20,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--hidden", type=int, default=96, help="channels of the first convolution")
     parser.add_argument("--latent", type=int, default=256, help="channels of the latent")
     parser.add_argument("--control-weight", type=float, default=CONTROL_WEIGHT, help="loss weight of the control channels")
+    parser.add_argument("--sparsity", type=float, default=SPARSITY, help="L1 weight on the latent (Holden's Lasso term)")
     parser.add_argument("--batch", type=int, default=32)
     parser.add_argument("--lr", type=float, default=1e-3)
     parser.add_argument("--mask", type=float, default=0.3, help="masked-noise probability (thesis: 0.3)")

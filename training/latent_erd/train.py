@@ -27,6 +27,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--steps", type=int, default=48, help="steps per training stretch (latent: 4 frames each)")
     parser.add_argument("--lr", type=float, default=1e-3)
     parser.add_argument("--noise", type=float, default=0.05, help="final input-noise sigma (normalised units)")
+    parser.add_argument("--self-fed", type=float, default=1.0,
+                        help="share of each stretch (after the 4 seed steps) fed the model's own predictions by the end of the ramp")
     parser.add_argument("--iterations", type=int, default=12000)
     parser.add_argument("--minutes", type=float, default=60.0, help="stop cleanly after this much training time")
     parser.add_argument("--checkpoint-minutes", type=float, default=3.0)

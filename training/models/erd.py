@@ -5,6 +5,9 @@ frame (a latent step of the motion manifold, or a pose row for the pose-space ba
 for the next step, and predicts the next frame as a change from the current one.
 
 The state is explicit: h and c of shape (layers, batch, hidden), in and out, so one step exports to ONNX.
+Each prediction is clamped per channel to the range seen in training (`set_range`): a free-running ERD
+that drifts cannot leave the box its decoder was trained on (a dead ReLU channel of the manifold stays
+exactly at its constant).
 """
 from __future__ import annotations
 
@@ -20,6 +23,12 @@ class ControlERD(nn.Module):
         self.lstms = nn.ModuleList(nn.LSTM(hidden if i == 0 else 2 * hidden, hidden, batch_first=True) for i in range(layers))
         self.dropout = nn.Dropout(dropout)
         self.decoder = nn.Linear(layers * hidden, dim)
+        self.register_buffer("low", torch.full((dim,), -1e6))
+        self.register_buffer("high", torch.full((dim,), 1e6))
+
+    def set_range(self, low, high) -> None:
+        self.low.copy_(torch.as_tensor(low, dtype=torch.float32))
+        self.high.copy_(torch.as_tensor(high, dtype=torch.float32))
 
     def zero_state(self, batch: int) -> tuple[torch.Tensor, torch.Tensor]:
         z = torch.zeros(self.layers, batch, self.hidden)
@@ -38,4 +47,4 @@ class ControlERD(nn.Module):
             hs.append(h)
             cs.append(c)
         delta = self.decoder(self.dropout(torch.cat(outs, dim=-1)))
-        return x + delta, (torch.cat(hs), torch.cat(cs))
+        return torch.minimum(torch.maximum(x + delta, self.low), self.high), (torch.cat(hs), torch.cat(cs))
