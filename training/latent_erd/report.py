@@ -75,6 +75,8 @@ def evaluate(mocap: str | None, frames: int, n_seeds: int, pose_checkpoint: Path
     report["seams"] = {"real_frame_change_cm": m.real_frame_change(corpus), "rows": seams}
     if BROWSER_JSON.exists():
         report["browser"] = json.loads(BROWSER_JSON.read_text())
+    if (REPORTS_DIR / "control.json").exists():
+        report["generator_browser"] = json.loads((REPORTS_DIR / "control.json").read_text())
     report["sizes_bytes"] = {"latent-erd.onnx": (models_dir / "latent-erd.onnx").stat().st_size,
                              "manifold-encoder.onnx": (models_dir / "manifold-encoder.onnx").stat().st_size,
                              "manifold-decoder.onnx": (models_dir / "manifold-decoder.onnx").stat().st_size}
@@ -90,32 +92,45 @@ def _mean(values) -> float:
     return float(np.mean(values)) if len(values) else float("nan")
 
 
-def browser_tables(browser: dict) -> list[str]:
-    """Paths and live-control rows from the page's own evaluation (control.json's fields), latent ERD beside
-    the generator with the MAP optimiser when both were measured."""
+def browser_tables(browser: dict, generator: dict | None) -> list[str]:
+    """Paths and live-control rows from the page's evaluation (npm run evaluate:latent-erd), each beside the
+    generator with the MAP optimiser measured the same way (docs/models/control.json, npm run evaluate:control)."""
     out = []
+
+    def path_row(rows, model):
+        sk = [r["skating"] for r in rows if r.get("skating") is not None]
+        return (f"| {rows[0]['path']} | {rows[0]['gait']} | {model} | {_mean([r['meanError'] for r in rows]):.3f} | "
+                f"{max(r['meanError'] for r in rows):.3f} | {max(r['maxError'] for r in rows):.3f} | {min(r['arcProgress'] for r in rows):.1%} | "
+                f"{min(r['realtime'] for r in rows):.1f} | {_mean([r['speed'] for r in rows]):.2f} | {_mean(sk):.3f} |")
+
     paths = browser.get("paths", [])
     if paths:
-        out += ["| path | model | mean error (m) | max error (m) | arc progress (least) | × real time (least) | sliding after lock (m/s) |",
-                "|---|---|---|---|---|---|---|"]
-        keys = sorted({(p["path"], p.get("model", "latent-erd")) for p in paths}, key=lambda k: (k[0], k[1]))
-        for name, model in keys:
-            rows = [p for p in paths if p["path"] == name and p.get("model", "latent-erd") == model]
-            out.append(f"| {name} | {model} | {_mean([r['meanError'] for r in rows]):.3f} | {max(r['maxError'] for r in rows):.3f} | "
-                       f"{min(r['arcProgress'] for r in rows):.1%} | {min(r['realtime'] for r in rows):.1f} | "
-                       f"{_mean([r['skating'] for r in rows if r.get('skating') is not None]):.3f} |")
+        out += ["| path | gait | model | mean error (m) | worst run's mean (m) | max error (m) | arc progress (least) | "
+                "× real time (least) | speed (m/s) | sliding after lock (m/s) |", "|---|---|---|---|---|---|---|---|---|---|"]
+        for key in dict.fromkeys((p["gait"], p["path"]) for p in paths):
+            out.append(path_row([p for p in paths if (p["gait"], p["path"]) == key], "latent ERD"))
+            if generator:
+                same = [p for p in generator.get("paths", []) if (p["gait"], p["path"]) == key]
+                if same:
+                    out.append(path_row(same, "generator + MAP"))
     control = browser.get("control", [])
     if control:
-        out += ["", "| scenario | model | heading within 15° after (s) | speed 1 s after the change (m/s) | |speed − target| worst (m/s) | compute p95 / max (ms per frame) | sliding (m/s) |",
-                "|---|---|---|---|---|---|---|"]
-        keys = sorted({(c["scenario"], c.get("model", "latent-erd")) for c in control})
-        for name, model in keys:
-            rows = [c for c in control if c["scenario"] == name and c.get("model", "latent-erd") == model]
-            head = ", ".join("—" if r.get("headingResponse") is None else f"{r['headingResponse']:.2f}" for r in rows)
+        out += ["", "| scenario | model | heading within 15° after (s) | speed 1 s after the change (m/s) | |speed − target| worst (m/s) | "
+                "compute p95 / max (ms per frame) | sliding (m/s) |", "|---|---|---|---|---|---|---|"]
+
+        def control_row(rows, model):
+            head = ", ".join("—" if r.get("headingResponse") is None else
+                             (f"{r['headingResponse']:.2f}" if r.get("reached", True) else "not reached") for r in rows)
             speeds = ", ".join(f"{r['speedAt1s']:.2f}" for r in rows)
-            out.append(f"| {name} | {model} | {head} | {speeds} | "
-                       f"{max(r['speedError'] for r in rows):.2f} | {max(r['p95ms'] for r in rows):.1f} / {max(r['maxMs'] for r in rows):.1f} | "
-                       f"{_mean([r['skating'] for r in rows]):.3f} |")
+            return (f"| {rows[0]['scenario']} | {model} | {head} | {speeds} | {max(r['speedError'] for r in rows):.2f} | "
+                    f"{max(r['p95ms'] for r in rows):.1f} / {max(r['maxMs'] for r in rows):.1f} | {_mean([r['skating'] for r in rows]):.3f} |")
+
+        for name in dict.fromkeys(c["scenario"] for c in control):
+            out.append(control_row([c for c in control if c["scenario"] == name], "latent ERD"))
+            if generator:
+                same = [c for c in generator.get("control", []) if c["scenario"] == name]
+                if same:
+                    out.append(control_row(same, "generator + MAP"))
     return out
 
 
@@ -226,7 +241,14 @@ def write_markdown(r: dict, path: Path) -> None:
         "",
     ]
     if "browser" in r:
-        lines += ["## In the page: paths and live control", "", r["browser"].get("note", ""), ""] + browser_tables(r["browser"]) + [""]
+        b = r["browser"]
+        lines += ["## In the page: paths and live control", "",
+                  f"`npm run evaluate:latent-erd` ({b.get('date')}, headless Chromium, {b.get('seeds')} seeds per case, cross-origin "
+                  f"isolated: {b.get('crossOriginIsolated')}, load average {b.get('loadBefore')} before and {b.get('loadAfter')} after on "
+                  f"{b.get('cores')} cores). Paths are `tests/fixtures/benchmark_paths.json`, followed in closed loop by pure pursuit "
+                  "(`controlAlongPath`); live control asks `controlTowardHeading` of the scheduled heading and speed. The generator rows "
+                  "are `docs/models/control.json` (`npm run evaluate:control`), measured the same way.", ""]
+        lines += browser_tables(b, r.get("generator_browser")) + [""]
     else:
         lines += ["## In the page", "", "Not measured in this run (`docs/models/latent-erd-browser.json` missing).", ""]
     for section, notes in r.get("notes", {}).items():
