@@ -10,11 +10,21 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+import numpy as np
+import torch
+
 from ..data.locomotion import load_clips
 from ..data.windows import WindowCorpus
 from ..paths import MODELS_DIR, REPO_ROOT, add_mocap_argument
 from .exporting import export_autoencoder
-from .training import load_autoencoder, position_error_cm
+from .training import control_rmse, load_autoencoder, position_error_cm
+
+
+def live_channels(model, corpus: WindowCorpus) -> int:
+    """Latent channels that ever fire on the training clips (ReLU channels can die in training)."""
+    with torch.no_grad():
+        z = np.concatenate([model.encode(torch.from_numpy(s[None, :len(s) // 4 * 4])).numpy()[0] for s in corpus.train])
+    return int((z.std(axis=0) > 1e-3).sum())
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -28,7 +38,9 @@ def main(argv: list[str] | None = None) -> None:
     windows = corpus.valid_windows()
     report = {"held_out_windows": len(windows),
               "reconstruction_cm_clean": round(position_error_cm(model, corpus, windows), 3),
-              "reconstruction_cm_masked_0.3": round(position_error_cm(model, corpus, windows, 0.3), 3)}
+              "reconstruction_cm_masked_0.3": round(position_error_cm(model, corpus, windows, 0.3), 3),
+              "control_rmse": [round(float(v), 4) for v in control_rmse(model, corpus, windows)],
+              "live_latent_channels": live_channels(model, corpus)}
     export_autoencoder(model, meta, windows, report, Path(args.out))
 
 

@@ -29,7 +29,8 @@ def evaluate(mocap: str | None, frames: int, n_seeds: int, pose_checkpoint: Path
     shipped = m.Shipped.load(models_dir)
     encoder = m.OnnxEncoder(shipped.encoder_path)
     fps = shipped.info["fps"]
-    report: dict = {"manifold": shipped.manifold["report"], "lookahead": shipped.info["lookahead"], "fps": fps}
+    report: dict = {"manifold": shipped.manifold["report"], "ae_hidden": shipped.manifold["hidden"],
+                    "lookahead": shipped.info["lookahead"], "fps": fps}
 
     # Prediction from held-out seeds, driven by the clips' own control.
     windows = m.prediction_windows(corpus)
@@ -171,6 +172,11 @@ def write_markdown(r: dict, path: Path) -> None:
     if "control_rmse" in man:
         lines += [f"Reconstructed control, RMS error on the same windows: forward {man['control_rmse'][0]:.3f} m/s, sideways "
                   f"{man['control_rmse'][1]:.3f} m/s, turn {man['control_rmse'][2]:.3f} rad/s.", ""]
+    if "live_latent_channels" in man:
+        lines += [f"Only {man['live_latent_channels']} of the 256 ReLU latent channels ever fire on the training clips; the rest "
+                  "died during training (with or without Holden's L1 term, see below), so the manifold is in effect "
+                  f"{man['live_latent_channels']}-dimensional per 133 ms step. The ERD's output is clamped to the training range, "
+                  "so the dead channels stay exactly at zero.", ""]
     for note in r.get("notes", {}).get("autoencoder", []):
         lines += [note, ""]
     lines += [
