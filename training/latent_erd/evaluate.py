@@ -22,7 +22,8 @@ def main(argv: list[str] | None = None) -> None:
     add_mocap_argument(parser)
     parser.add_argument("--frames", type=int, default=10000)
     parser.add_argument("--seeds", type=int, default=5)
-    parser.add_argument("--pose-checkpoint", default=str(REPO_ROOT / "runs" / "pose-erd" / "best.pt"))
+    parser.add_argument("--pose-checkpoint", default=str(REPO_ROOT / "runs" / "pose-erd" / "last.pt"),
+                        help="the pose-space baseline: its last checkpoint, after the input-noise ramp (its best next-step loss came before the noise)")
     args = parser.parse_args(argv)
     notes = json.loads(NOTES.read_text()) if NOTES.exists() else {}
     report = write_report(args.mocap, args.frames, args.seeds, Path(args.pose_checkpoint), notes)
