@@ -34,7 +34,7 @@ from ..mocap.skeleton import canonical_skeleton
 from ..models.autoencoder import POOLING
 from ..models.erd import ControlERD
 from .sequences import encode_clip, step_control
-from .streaming import LatentStream, Normalisation, OnnxBackend, Root, StreamOutput, run_stream
+from .streaming import LatentStream, Normalisation, OnnxBackend, Root, StreamOutput, place_rows, run_stream
 
 SEED_FRAMES = 16
 HORIZONS = (70, 90, 120, 160, 210)
@@ -137,24 +137,7 @@ def pose_erd_prediction(model: ControlERD, corpus: WindowCorpus, w: Window, fram
             x, state = model(x, control[:, t:t + 1], state)
             out.append(x)
     rows_out = corpus.denormalise(torch.cat(out, 1)[0].numpy())
-    return place_rows(rows_out, root)
-
-
-def place_rows(rows: np.ndarray, root: Root, fps: float = 30.0) -> np.ndarray:
-    """World positions of physical rows, the root moved by their own control (as the stream places them)."""
-    local = rows[:, :POSITION_DIM].reshape(len(rows), -1, 3)
-    out = np.empty_like(local)
-    x, z, h = root.x, root.z, root.heading
-    for t in range(len(rows)):
-        c, s = np.cos(h), np.sin(h)
-        out[t, :, 0] = c * local[t, :, 0] + s * local[t, :, 2] + x
-        out[t, :, 1] = local[t, :, 1]
-        out[t, :, 2] = -s * local[t, :, 0] + c * local[t, :, 2] + z
-        fwd, side, turn = rows[t, CONTROL_SLICE] / fps
-        x += c * side + s * fwd
-        z += -s * side + c * fwd
-        h += turn
-    return out
+    return place_rows(rows_out, root, 30.0)[0]
 
 
 def generator_prediction(gen: ShippedGenerator, corpus: WindowCorpus, clips_by_file: dict, w: Window, frames: int,

@@ -24,7 +24,6 @@ import numpy as np
 import torch
 
 from ..autoencoder.exporting import RADIUS, ValidDecoder
-from ..control import rotate_to_local
 from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, POSITION_DIM
 from ..models.autoencoder import POOLING, MotionAutoencoder
 from ..models.erd import ControlERD
@@ -140,22 +139,28 @@ class LatentStream:
         return self._place(rows)
 
     def _place(self, rows: np.ndarray) -> StreamOutput:
-        local = rows[:, :POSITION_DIM].reshape(len(rows), -1, 3)
-        positions = np.empty_like(local)
-        roots = np.empty((len(rows), 3))
-        r = self.root
-        for t in range(len(rows)):
-            ch, sh = np.cos(r.heading), np.sin(r.heading)
-            lx, lz = local[t, :, 0], local[t, :, 2]
-            positions[t, :, 0] = ch * lx + sh * lz + r.x
-            positions[t, :, 1] = local[t, :, 1]
-            positions[t, :, 2] = -sh * lx + ch * lz + r.z
-            roots[t] = r.x, r.z, r.heading
-            fwd, side, turn = rows[t, CONTROL_SLICE] / self.fps
-            r.x += ch * side + sh * fwd
-            r.z += -sh * side + ch * fwd
-            r.heading = float((r.heading + turn + np.pi) % (2 * np.pi) - np.pi)
+        positions, roots = place_rows(rows, self.root, self.fps)
         return StreamOutput(rows, positions, roots, (rows[:, CONTACT_SLICE] > 0.5).astype(np.uint8))
+
+
+def place_rows(rows: np.ndarray, root: Root, fps: float) -> tuple[np.ndarray, np.ndarray]:
+    """World positions (frames, joints, 3) and roots (frames, 3: x, z, heading) of physical rows, the root
+    moved by the rows' own control channels from `root`, which is advanced past them (in place)."""
+    local = rows[:, :POSITION_DIM].reshape(len(rows), -1, 3)
+    positions = np.empty_like(local)
+    roots = np.empty((len(rows), 3))
+    for t in range(len(rows)):
+        ch, sh = np.cos(root.heading), np.sin(root.heading)
+        lx, lz = local[t, :, 0], local[t, :, 2]
+        positions[t, :, 0] = ch * lx + sh * lz + root.x
+        positions[t, :, 1] = local[t, :, 1]
+        positions[t, :, 2] = -sh * lx + ch * lz + root.z
+        roots[t] = root.x, root.z, root.heading
+        fwd, side, turn = rows[t, CONTROL_SLICE] / fps
+        root.x += ch * side + sh * fwd
+        root.z += -sh * side + ch * fwd
+        root.heading = float((root.heading + turn + np.pi) % (2 * np.pi) - np.pi)
+    return positions, roots
 
 
 def run_stream(stream: LatentStream, controls: np.ndarray, known_future: bool = True) -> StreamOutput:
