@@ -230,8 +230,10 @@ describe('latent ERD control requests', () => {
     expect(m.targetHeading[0]).toBe(0);
     expect(m.targetHeading[m.frames - 1]).toBeCloseTo(Math.PI / 2, 6);
     expect(m.computeMsPerFrame.every((v) => v > 0)).toBe(true);
-    // Turning toward +x: the control's turn is positive once the target changes.
-    expect(m.control[(m.frames - 1) * 3 + 2]).toBeGreaterThan(0);
+    // Turning toward +x: the control's turn is positive in the first step after the target changes.
+    const changed = m.targetHeading.findIndex((h) => h > 0);
+    expect(changed).toBeGreaterThan(0);
+    expect(m.control[changed * 3 + 2]).toBeGreaterThan(0);
     expect(m.heading.every((h) => h > -Math.PI && h <= Math.PI)).toBe(true);
   });
 

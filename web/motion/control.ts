@@ -17,7 +17,7 @@ export interface Root {
 }
 
 /** The stick and the path follower close a heading error in TURN_TIME s, at most MAX_TURN_RATE rad/s. */
-export const TURN_TIME = 0.5;
+export const TURN_TIME = 0.25;
 export const MAX_TURN_RATE = 2.5;
 /** Pure pursuit looks LOOKAHEAD_SECONDS of travel ahead along the path, and at least MIN_LOOKAHEAD m. */
 export const LOOKAHEAD_SECONDS = 0.6;
