@@ -181,6 +181,12 @@ def real_pose_change_median(corpus: WindowCorpus, fps: float) -> float:
     return float(np.median(np.concatenate([c for c in changes if len(c)])))
 
 
+def real_share_below(corpus: WindowCorpus, fps: float, median: float) -> float:
+    """Share of the held-out clips' seconds whose pose change is below FREEZE_FRACTION of `median`."""
+    changes = np.concatenate([metrics.pose_change_per_second(c.positions, fps) for c in corpus.valid_clips])
+    return round(float((changes < FREEZE_FRACTION * median).mean()), 4)
+
+
 def seam_ratio(positions: np.ndarray, fps: float) -> dict:
     """Mean joint displacement relative to the hips between consecutive frames (cm/frame): across the boundary
     of two emitted 4-frame steps, and inside a step."""

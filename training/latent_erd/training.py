@@ -38,7 +38,10 @@ def load_erd(checkpoint: Path) -> tuple[ControlERD, dict]:
     state = torch.load(checkpoint, weights_only=False)
     meta = state["meta"]
     model = ControlERD(meta["dim"], meta["control_dim"], meta["hidden"], meta["layers"], meta["dropout"])
-    model.load_state_dict(state["model"])
+    # Checkpoints from before the output clamp (the pose-space baseline's run) have no range: unclamped.
+    result = model.load_state_dict(state["model"], strict=False)
+    if result.unexpected_keys or set(result.missing_keys) - {"low", "high"}:
+        raise SystemExit(f"error: {checkpoint} does not fit ControlERD: missing {result.missing_keys}, unexpected {result.unexpected_keys}")
     return model.eval(), meta
 
 
