@@ -10,21 +10,11 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-import numpy as np
-import torch
-
 from ..data.locomotion import load_clips
 from ..data.windows import WindowCorpus
 from ..paths import MODELS_DIR, REPO_ROOT, add_mocap_argument
 from .exporting import export_autoencoder
-from .training import control_rmse, load_autoencoder, position_error_cm
-
-
-def live_channels(model, corpus: WindowCorpus) -> int:
-    """Latent channels that ever fire on the training clips (ReLU channels can die in training)."""
-    with torch.no_grad():
-        z = np.concatenate([model.encode(torch.from_numpy(s[None, :len(s) // 4 * 4])).numpy()[0] for s in corpus.train])
-    return int((z.std(axis=0) > 1e-3).sum())
+from .training import control_rmse, live_channels, load_autoencoder, position_error_cm
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -64,6 +64,13 @@ def control_rmse(model: MotionAutoencoder, corpus: WindowCorpus, windows: np.nda
     return np.sqrt((((y - windows)[..., CONTROL_SLICE] * std) ** 2).mean(axis=(0, 1)))
 
 
+def live_channels(model: MotionAutoencoder, corpus: WindowCorpus) -> int:
+    """Latent channels that ever fire on the training clips (ReLU channels can die in training)."""
+    with torch.no_grad():
+        z = np.concatenate([model.encode(torch.from_numpy(s[None, :len(s) // 4 * 4])).numpy()[0] for s in corpus.train])
+    return int((z.std(axis=0) > 1e-3).sum())
+
+
 def train_autoencoder(args: argparse.Namespace) -> tuple[float, Path]:
     """One run with the options of python -m training.autoencoder.train; returns the best held-out
     reconstruction error (cm, clean input) and the run directory."""
