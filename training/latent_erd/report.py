@@ -136,12 +136,40 @@ def browser_tables(browser: dict, generator: dict | None) -> list[str]:
     return out
 
 
+def summary_lines(r: dict) -> list[str]:
+    """The issue's targets against what was measured."""
+    out = ["## Against the targets", "", "| target | measured | met |", "|---|---|---|"]
+    b = r.get("browser")
+    if b:
+        walk = [p for p in b["paths"] if p["gait"] == "walk"]
+        worst_mean = max(_mean([q["meanError"] for q in walk if q["path"] == name]) for name in {p["path"] for p in walk})
+        least_progress, least_rt = min(p["arcProgress"] for p in walk), min(p["realtime"] for p in walk)
+        out.append(f"| five benchmark paths (walk) in Chromium: mean error ≤ 0.15 m, progress ≥ 95%, ≥ 20× real time | worst path's "
+                   f"mean {worst_mean:.3f} m, least progress {least_progress:.1%}, least {least_rt:.1f}× | "
+                   f"{'yes' if worst_mean <= 0.15 and least_progress >= 0.95 and least_rt >= 20 else 'no'} |")
+        for name, limit in (("turn 90°", 1.0), ("turn 180°", 1.5)):
+            rows = [c for c in b["control"] if c["scenario"] == name]
+            worst = max((c["headingResponse"] if c.get("reached", True) and c["headingResponse"] is not None else float("inf")) for c in rows)
+            out.append(f"| {name} response within {limit} s (control.md) | worst {worst:.2f} s | {'yes' if worst <= limit else 'no'} |")
+    lr = r["long_runs"]
+    worst_low = min(x["min_pose_change_share_of_median"] for x in lr["runs"])
+    counts = [round(x["seconds_below_20pct"] * x["frames"] / r["fps"]) for x in lr["runs"]]
+    spread = f"{min(c for c in counts if c)}–{max(counts)}" if any(counts) else "0"
+    out.append(f"| {len(lr['runs'])} × {lr['runs'][0]['frames']:,}-frame random-control runs never below 20% of the real median pose change | "
+               f"{lr['collapsed']} runs have {spread} such seconds (lowest {worst_low:.0%}); real clips spend {lr['real_share_below']:.1%} of "
+               f"their seconds there | {'yes' if lr['collapsed'] == 0 else 'no'} |")
+    real, h, rc = r["sliding_real"], r["sliding_held_out_control"], r["sliding_random_control"]
+    ok = h["contact_bits_after"] <= real["contact_bits"] and h["low_foot_after"] <= real["low_foot"]
+    out.append(f"| after the foot lock, feet slide no more than real motion's (held-out control; both measures) | contact bits "
+               f"{h['contact_bits_after']} vs real {real['contact_bits']} m/s; lowest point {h['low_foot_after']} vs {real['low_foot']} m/s "
+               f"(random control: {rc['contact_bits_after']}, {rc['low_foot_after']}) | {'yes' if ok else 'no'} |")
+    return out + [""]
+
+
 def write_markdown(r: dict, path: Path) -> None:
     man, pred, longr, seams = r["manifold"], r["prediction"], r["long_runs"], r["seams"]
     sr, sh, sl = r["sliding_real"], r["sliding_held_out_control"], r["sliding_random_control"]
-    lines = [
-        "# Motion manifold and latent ERD",
-        "",
+    lines = ["# Motion manifold and latent ERD", ""] + summary_lines(r) + [
         "Made by `python -m training.latent_erd.evaluate` on the shipped models (`public/models/manifold-*.onnx`, "
         "`latent-erd.onnx`, native onnxruntime, one thread); the page's numbers come from `npm run evaluate:latent-erd` "
         "(headless Chromium, `docs/models/latent-erd-browser.json`). The method follows Yearsley's thesis: a denoising "
@@ -263,10 +291,12 @@ def write_markdown(r: dict, path: Path) -> None:
         if section != "autoencoder":
             lines += [f"## {section}", ""] + [f"- {n}" for n in notes] + [""]
     if "training" in r:
-        lines += ["## Training runs", "", "| run | minutes | iterations | best held-out |", "|---|---|---|---|"]
+        measure = {"autoencoder": "reconstruction, cm per joint", "latent-erd": "free-running MSE over 40 steps (normalised latents)",
+                   "pose-erd": "next-step MSE (normalised rows, teacher-forced; the shipped comparison uses its last checkpoint)"}
+        lines += ["## Training runs", "", "| run | minutes | iterations | best held-out | measure |", "|---|---|---|---|---|"]
         for name, t in r["training"].items():
             best = t.get("best_valid_cm", t.get("best_valid_loss"))
-            lines.append(f"| {name} | {t['minutes']:.1f} | {t['iterations']} | {best:.4g} |")
+            lines.append(f"| {name} | {t['minutes']:.1f} | {t['iterations']} | {best:.4g} | {measure.get(name, '')} |")
         lines.append("")
     path.write_text("\n".join(lines) + "\n")
 
