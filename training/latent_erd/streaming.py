@@ -29,7 +29,11 @@ from ..models.autoencoder import POOLING, MotionAutoencoder
 from ..models.erd import ControlERD
 from ..onnx.sessions import cpu_session
 
-LOOKAHEAD = 3  # chosen by the seam measurements in docs/models/latent-erd.md
+# Chosen by measurement (docs/models/latent-erd.md): across a step boundary the pose jumps 2.0 cm with 3 guesses
+# against 1.3 cm inside a step (ratio 1.55; 6 guesses: ratio 1.08), but in Chromium 6 guesses brought the
+# slowest benchmark path down to 20.5x real time (target 20x) and the worst 180-degree turn to 1.40 s, against
+# 24-37x (two runs) and 1.30 s with 3.
+LOOKAHEAD = 3
 
 
 class TorchBackend:
