@@ -12,43 +12,15 @@ import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { launchBrowser, openPlayground, ROOT, startServer } from '../tests/e2e/harness.mjs';
+import { headingResponse, mean, percentile, rootSpeed, SCENARIOS, SIM_SECONDS } from './controlScenarios.mjs';
 
 const SEEDS = Number(process.env.SEEDS ?? 3);
 const OUT = path.join(ROOT, 'docs/models');
 const PATHS = JSON.parse(readFileSync(path.join(ROOT, 'tests/fixtures/benchmark_paths.json'), 'utf8')).paths;
 const TARGETS = { meanError: 0.1, maxError: 0.3, arcProgress: 0.95, realtime: 2, heading90: 1.0, heading180: 1.5, speedError: 0.2, p95ms: 33, skatingRatio: 1.5 };
-const DEG = Math.PI / 180;
 
-/** Control scenarios: a change at t = 3 s from a steady start. */
-const SCENARIOS = {
-  'turn 90°': { kind: 'heading', change: 90, schedule: [{ t: 0, speed: 1.2, heading: 0 }, { t: 3, speed: 1.2, heading: Math.PI / 2 }] },
-  'turn 180°': { kind: 'heading', change: 180, schedule: [{ t: 0, speed: 1.2, heading: 0 }, { t: 3, speed: 1.2, heading: Math.PI }] },
-  'speed 0.8 → 1.5 m/s': { kind: 'speed', schedule: [{ t: 0, speed: 0.8, heading: 0 }, { t: 3, speed: 1.5, heading: 0 }] },
-  'speed 1.5 → 0.8 m/s': { kind: 'speed', schedule: [{ t: 0, speed: 1.5, heading: 0 }, { t: 3, speed: 0.8, heading: 0 }] },
-  'run 2.5 → 3.2 m/s': { kind: 'speed', gait: 'run', schedule: [{ t: 0, speed: 2.5, heading: 0 }, { t: 3, speed: 3.2, heading: 0 }] },
-};
-const SIM_SECONDS = 6;
-
-const wrap = (a) => {
-  let d = a % (2 * Math.PI);
-  if (d > Math.PI) d -= 2 * Math.PI;
-  if (d <= -Math.PI) d += 2 * Math.PI;
-  return d;
-};
-const mean = (v) => v.reduce((a, b) => a + b, 0) / v.length;
-const percentile = (v, p) => {
-  const s = [...v].sort((a, b) => a - b);
-  return s[Math.min(s.length - 1, Math.floor((p / 100) * s.length))];
-};
 const fmt = (v, d = 2) => (Number.isFinite(v) ? v.toFixed(d) : String(v));
 
-/** Mean root speed (m/s) over the whole motion. */
-function rootSpeed(m) {
-  const J = m.joints.length;
-  let d = 0;
-  for (let f = 1; f < m.frames; f++) d += Math.hypot(m.positions[f * J * 3] - m.positions[(f - 1) * J * 3], m.positions[f * J * 3 + 2] - m.positions[(f - 1) * J * 3 + 2]);
-  return (d * m.fps) / Math.max(1, m.frames - 1);
-}
 
 async function followOne(page, name, gait, seed) {
   return page.evaluate(
@@ -81,13 +53,6 @@ async function simulateOne(page, scenario, seed) {
     },
     { schedule: scenario.schedule, seed, seconds: SIM_SECONDS, gait: scenario.gait },
   );
-}
-
-/** Seconds after the change until the heading is within 15° of the new target (Infinity if never). */
-function headingResponse(sim, change) {
-  const f0 = Math.round(change.t * sim.fps);
-  for (let f = f0; f < sim.frames; f++) if (Math.abs(wrap(sim.heading[f] - change.heading)) <= 15 * DEG) return (f - f0) / sim.fps;
-  return Infinity;
 }
 
 async function main() {
