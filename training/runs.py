@@ -57,3 +57,19 @@ class Run:
         rng.bit_generator.state = state["rng"]
         torch.set_rng_state(state["torch_rng"])
         return state
+
+    def start(self, resume: bool, rng, **parts) -> tuple[int, float, float]:
+        """(iteration, best, seconds trained before) to start from: from the latest checkpoint (restoring
+        `parts` and the random generators, as `resume`) when `resume`, else a fresh start."""
+        if not resume:
+            return 0, float("inf"), 0.0
+        state = self.resume(rng, **parts)
+        self.log.info("resumed at iteration %d", state["iteration"])
+        return state["iteration"], state["best"], state["elapsed"]
+
+    @staticmethod
+    def state(rng, iteration: int, best: float, elapsed: float, meta: dict, **parts) -> dict:
+        """A checkpoint that `start` reads back: each part's state_dict under its name, the random generators,
+        the counters and the meta."""
+        return {**{k: p.state_dict() for k, p in parts.items()}, "rng": rng.bit_generator.state,
+                "torch_rng": torch.get_rng_state(), "iteration": iteration, "best": best, "elapsed": elapsed, "meta": meta}

@@ -84,11 +84,8 @@ def train_autoencoder(args: argparse.Namespace) -> tuple[float, Path]:
     scheduler = torch.optim.lr_scheduler.MultiStepLR(optimiser, milestones, gamma=0.5)
     rng = np.random.default_rng(args.seed)
     torch.manual_seed(args.seed)
-    start, best, elapsed_before = 0, float("inf"), 0.0
-    if args.resume:
-        state = run.resume(rng, model=model, optimiser=optimiser, scheduler=scheduler)
-        start, best, elapsed_before = state["iteration"], state["best"], state["elapsed"]
-        run.log.info("resumed at iteration %d", start)
+    parts = {"model": model, "optimiser": optimiser, "scheduler": scheduler}
+    start, best, elapsed_before = run.start(args.resume, rng, **parts)
     meta = {"dim": ROW_DIM, "hidden": args.hidden, "latent": args.latent, "fps": FPS, "window": WINDOW,
             "mean": corpus.mean.tolist(), "std": corpus.std.tolist(), "valid_files": corpus.valid_files,
             "train_frames": corpus.train_frames, "args": vars(args)}
@@ -99,9 +96,7 @@ def train_autoencoder(args: argparse.Namespace) -> tuple[float, Path]:
     elapsed = lambda: elapsed_before + time.monotonic() - t0
 
     def checkpoint(iteration: int) -> dict:
-        return {"model": model.state_dict(), "optimiser": optimiser.state_dict(), "scheduler": scheduler.state_dict(),
-                "rng": rng.bit_generator.state, "torch_rng": torch.get_rng_state(), "iteration": iteration,
-                "best": best, "elapsed": elapsed(), "meta": meta}
+        return run.state(rng, iteration, best, elapsed(), meta, **parts)
 
     weights = torch.ones(ROW_DIM)
     weights[CONTROL_SLICE] = args.control_weight

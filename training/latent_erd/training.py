@@ -94,11 +94,8 @@ def train_erd(args: argparse.Namespace) -> tuple[float, Path]:
     scheduler = torch.optim.lr_scheduler.MultiStepLR(optimiser, [int(args.iterations * 0.6), int(args.iterations * 0.85)], 0.5)
     rng = np.random.default_rng(args.seed)
     torch.manual_seed(args.seed)
-    start, best, elapsed_before = 0, float("inf"), 0.0
-    if args.resume:
-        state = run.resume(rng, model=model, optimiser=optimiser, scheduler=scheduler)
-        start, best, elapsed_before = state["iteration"], state["best"], state["elapsed"]
-        run.log.info("resumed at iteration %d", start)
+    parts = {"model": model, "optimiser": optimiser, "scheduler": scheduler}
+    start, best, elapsed_before = run.start(args.resume, rng, **parts)
     params = sum(p.numel() for p in model.parameters())
     run.log.info("start: %s space, %d parameters, %d training sequences, %d held-out, steps of %d x %d",
                  args.space, params, len(train.xs), len(valid.xs), args.batch, args.steps)
@@ -106,9 +103,7 @@ def train_erd(args: argparse.Namespace) -> tuple[float, Path]:
     elapsed = lambda: elapsed_before + time.monotonic() - t0
 
     def checkpoint(iteration: int) -> dict:
-        return {"model": model.state_dict(), "optimiser": optimiser.state_dict(), "scheduler": scheduler.state_dict(),
-                "rng": rng.bit_generator.state, "torch_rng": torch.get_rng_state(), "iteration": iteration,
-                "best": best, "elapsed": elapsed(), "meta": meta}
+        return run.state(rng, iteration, best, elapsed(), meta, **parts)
 
     bar = tqdm(total=args.iterations, initial=start, desc=f"{args.space} ERD", unit="it")
     losses, it = [], start
