@@ -37,7 +37,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--threads", type=int, default=1)
     args = parser.parse_args(argv)
     best, run_dir = train_erd(args)
-    print(f"done: best held-out next-step loss {best:.4f}; checkpoints in {run_dir}")
+    print(f"done: best held-out free-running loss {best:.4f}; checkpoints in {run_dir}")
 
 
 if __name__ == "__main__":
