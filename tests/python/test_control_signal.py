@@ -10,28 +10,14 @@ import pytest
 
 from training import control
 from training.fixtures.control_signal_parity import FPS, OUT, PATHS, build, follow, made_up_trajectory
+from conftest import assert_same_json
 
-
-def _same(a, b, where="") -> None:
-    if isinstance(a, dict):
-        assert a.keys() == b.keys(), where
-        for k in a:
-            _same(a[k], b[k], f"{where}.{k}")
-    elif isinstance(a, list):
-        assert len(a) == len(b), where
-        for i, (x, y) in enumerate(zip(a, b)):
-            _same(x, y, f"{where}[{i}]")
-    elif isinstance(a, float) and isinstance(b, (int, float)):
-        # libm's sin, cos and atan2 may differ in the last bit between machines
-        assert math.isclose(a, b, rel_tol=1e-12, abs_tol=1e-12), f"{where}: {a} != {b}"
-    else:
-        assert a == b, f"{where}: {a!r} != {b!r}"
 
 
 def test_control_signal_fixture_is_current():
     committed = json.loads(OUT.read_text())
     fresh = json.loads(json.dumps(build()))
-    _same(fresh, committed)
+    assert_same_json(fresh, committed)
 
 
 @pytest.mark.parametrize("case", PATHS, ids=[p[0] for p in PATHS])
