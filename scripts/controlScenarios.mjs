@@ -40,3 +40,25 @@ export function headingResponse(sim, change) {
   for (let f = f0; f < sim.frames; f++) if (Math.abs(wrap(sim.heading[f] - change.heading)) <= 15 * DEG) return (f - f0) / sim.fps;
   return Infinity;
 }
+
+/**
+ * One live-control result row, measured the same way for every model: the heading response (seconds, Infinity
+ * if never; heading scenarios also say whether it was reached and their limit from `targets`), the speed 1 s
+ * after the change and its error, the compute per frame (p95, max) and the skating of the run.
+ */
+export function controlRow(name, scenario, seed, sim, targets) {
+  const change = scenario.schedule[1];
+  const f1 = Math.min(sim.frames - 1, Math.round((change.t + 1) * sim.fps));
+  const heading = scenario.kind === 'heading';
+  const response = heading ? headingResponse(sim, change) : null;
+  return {
+    scenario: name, seed, kind: scenario.kind,
+    headingResponse: response,
+    ...(heading ? { reached: Number.isFinite(response), limit: scenario.change === 90 ? targets.heading90 : targets.heading180 } : {}),
+    speedAt1s: sim.speed[f1],
+    speedError: Math.abs(sim.speed[f1] - change.speed),
+    p95ms: percentile(sim.computeMs, 95),
+    maxMs: Math.max(...sim.computeMs),
+    skating: sim.skating,
+  };
+}

@@ -12,7 +12,7 @@ import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { launchBrowser, openPlayground, ROOT, startServer } from '../tests/e2e/harness.mjs';
-import { headingResponse, mean, percentile, rootSpeed, SCENARIOS, SIM_SECONDS } from './controlScenarios.mjs';
+import { controlRow, mean, rootSpeed, SCENARIOS, SIM_SECONDS } from './controlScenarios.mjs';
 
 const SEEDS = Number(process.env.SEEDS ?? 3);
 const OUT = path.join(ROOT, 'docs/models');
@@ -87,18 +87,7 @@ async function main() {
     for (const [name, scenario] of Object.entries(SCENARIOS)) {
       for (let seed = 0; seed < SEEDS; seed++) {
         const sim = await simulateOne(page, scenario, seed);
-        const change = scenario.schedule[1];
-        const f1 = Math.min(sim.frames - 1, Math.round((change.t + 1) * sim.fps));
-        const row = {
-          scenario: name, seed, kind: scenario.kind,
-          headingResponse: scenario.kind === 'heading' ? headingResponse(sim, change) : null,
-          speedAt1s: sim.speed[f1],
-          speedError: Math.abs(sim.speed[f1] - change.speed),
-          p95ms: percentile(sim.computeMs, 95),
-          maxMs: Math.max(...sim.computeMs),
-          skating: sim.skating,
-        };
-        if (scenario.kind === 'heading') row.limit = scenario.change === 90 ? TARGETS.heading90 : TARGETS.heading180;
+        const row = controlRow(name, scenario, seed, sim, TARGETS);
         report.control.push(row);
         console.log(JSON.stringify(row));
       }

@@ -17,7 +17,7 @@ import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { launchBrowser, openPlayground, ROOT, startServer } from '../tests/e2e/harness.mjs';
-import { headingResponse, mean, percentile, rootSpeed, SCENARIOS, SIM_SECONDS } from './controlScenarios.mjs';
+import { controlRow, mean, percentile, rootSpeed, SCENARIOS, SIM_SECONDS } from './controlScenarios.mjs';
 
 const SEEDS = Number(process.env.SEEDS ?? 3);
 const OUT = path.join(ROOT, 'docs/models/latent-erd-browser.json');
@@ -117,19 +117,8 @@ async function main() {
     for (const [name, scenario] of Object.entries(SCENARIOS)) {
       for (let seed = 0; seed < SEEDS; seed++) {
         const sim = await simulateOne(page, scenario, seed);
-        const change = scenario.schedule[1];
-        const f1 = Math.min(sim.frames - 1, Math.round((change.t + 1) * sim.fps));
-        const response = scenario.kind === 'heading' ? headingResponse(sim, change) : null;
-        const row = {
-          scenario: name, seed, kind: scenario.kind,
-          headingResponse: finite(response),
-          ...(scenario.kind === 'heading' ? { reached: Number.isFinite(response), limit: scenario.change === 90 ? TARGETS.heading90 : TARGETS.heading180 } : {}),
-          speedAt1s: sim.speed[f1],
-          speedError: Math.abs(sim.speed[f1] - change.speed),
-          p95ms: percentile(sim.computeMs, 95),
-          maxMs: Math.max(...sim.computeMs),
-          skating: sim.skating,
-        };
+        const row = controlRow(name, scenario, seed, sim, TARGETS);
+        row.headingResponse = finite(row.headingResponse);
         report.control.push(row);
         console.log(JSON.stringify(row));
       }
