@@ -9,21 +9,13 @@ import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed, optio
 import { checkSchedule, checkTarget } from '../../web/optimizer/liveControl';
 import { checkPathPoints } from '../../web/optimizer/path';
 import { threadCount } from '../../web/ui/modelHost';
+import { messageOf } from './messageOf';
 
 const MODELS: ModelInfo[] = [
   { id: 'generator', kind: 'lstm-gmm', skeleton: 'cmu-canonical', fps: 30, bytes: 1 },
   { id: 'aclstm', kind: 'aclstm', skeleton: 'aclstm-standard', fps: 30, styles: ['salsa', 'indian', 'martial'], bytes: 1 },
   { id: 'refiner', kind: 'refiner', skeleton: 'cmu-canonical', fps: 30, bytes: 1 },
 ];
-
-const messageOf = (fn: () => unknown): string => {
-  try {
-    fn();
-  } catch (e) {
-    return (e as Error).message;
-  }
-  throw new Error('expected a throw');
-};
 
 describe('describeValue', () => {
   it('shows what JSON.stringify and String hide', () => {

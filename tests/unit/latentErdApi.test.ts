@@ -2,21 +2,13 @@
 // and models that are not its kind.
 import { describe, expect, it } from 'vitest';
 import { checkGenerate, type ModelInfo } from '../../web/api/playground';
+import { messageOf } from './messageOf';
 
 const MODELS: ModelInfo[] = [
   { id: 'generator', kind: 'lstm-gmm', skeleton: 'cmu-canonical', fps: 30, bytes: 1 },
   { id: 'latent-erd', kind: 'latent-erd', skeleton: 'cmu-canonical', fps: 30, bytes: 1 },
   { id: 'manifold', kind: 'autoencoder', skeleton: 'cmu-canonical', fps: 30, bytes: 1 },
 ];
-
-const messageOf = (fn: () => unknown): string => {
-  try {
-    fn();
-  } catch (e) {
-    return (e as Error).message;
-  }
-  throw new Error('expected a throw');
-};
 
 describe('checkGenerate for the latent ERD', () => {
   it('takes frames, seed and an optional per-frame control, flattened', () => {
