@@ -2,7 +2,7 @@
 // playground.simulateControl (the code the Path and Steer modes run), with their error handling.
 import assert from 'node:assert/strict';
 import { describe, test } from 'node:test';
-import { usePlayground } from './harness.mjs';
+import { apiFailure, usePlayground } from './harness.mjs';
 
 const BEND = [[0, 0], [0, 2], [1.5, 3.5]];
 
@@ -12,21 +12,6 @@ function followPath(page, options) {
     const m = await window.playground.followPath(o);
     return { fps: m.fps, frames: m.frames, joints: m.joints, positions: Array.from(m.positions), contacts: Array.from(m.contacts), stats: m.stats };
   }, options);
-}
-
-/** The error message a call rejects with (null if it resolves), plus lastError and whether a motion is shown. */
-function failure(page, method, options) {
-  return page.evaluate(
-    async ({ method, options }) => {
-      try {
-        await window.playground[method](options);
-        return { message: null };
-      } catch (e) {
-        return { message: e.message, lastError: window.playground.lastError(), shown: window.playground.current()?.frames ?? null };
-      }
-    },
-    { method, options },
-  );
 }
 
 describe('path following and live control in the page', { timeout: 300_000 }, () => {
@@ -67,17 +52,17 @@ describe('path following and live control in the page', { timeout: 300_000 }, ()
       const m = await window.playground.generate({ model: 'generator', frames: 40, seed: 1 });
       window.playground.show(m, 'before');
     });
-    const short = await failure(suite.page, 'followPath', { points: [[0, 0], [0, 0.2]] });
+    const short = await apiFailure(suite.page, 'followPath', { points: [[0, 0], [0, 0.2]] });
     assert.match(short.message, /^followPath: the path is 0\.20 m long; it must be at least 0\.5 m/);
     assert.equal(short.lastError, short.message);
     assert.equal(short.shown, 40);
-    const bad = await failure(suite.page, 'followPath', { points: [[0, 0], [1, null]] });
+    const bad = await apiFailure(suite.page, 'followPath', { points: [[0, 0], [1, null]] });
     assert.match(bad.message, /points\[1\] must be a pair of finite numbers/);
-    const gait = await failure(suite.page, 'followPath', { points: BEND, gait: 'crawl' });
+    const gait = await apiFailure(suite.page, 'followPath', { points: BEND, gait: 'crawl' });
     assert.match(gait.message, /gait must be "walk" or "run"/);
-    const option = await failure(suite.page, 'followPath', { points: BEND, speed: 2 });
+    const option = await apiFailure(suite.page, 'followPath', { points: BEND, speed: 2 });
     assert.match(option.message, /unknown option "speed"/);
-    const lock = await failure(suite.page, 'followPath', { points: BEND, footLock: 'yes' });
+    const lock = await apiFailure(suite.page, 'followPath', { points: BEND, footLock: 'yes' });
     assert.match(lock.message, /footLock must be true or false/);
   });
 
@@ -89,10 +74,10 @@ describe('path following and live control in the page', { timeout: 300_000 }, ()
       return { frames: m.frames, shown: pg.state().frames, exported: /Frames: (\d+)/.exec(pg.exportBVH(m))?.[1] };
     });
     assert.deepEqual(r, { frames: 1, shown: 1, exported: '1' });
-    const far = await failure(suite.page, 'followPath', { points: [[1e15, 0], [1e15, 5]] });
+    const far = await apiFailure(suite.page, 'followPath', { points: [[1e15, 0], [1e15, 5]] });
     assert.match(far.message, /^followPath: points\[0\] \[1000000000000000, 0\] is too far out: x and z must be within ±10000 m/);
     assert.equal(far.shown, 1);
-    const nan = await failure(suite.page, 'followPath', { points: [[0, 0], [NaN, 5]] });
+    const nan = await apiFailure(suite.page, 'followPath', { points: [[0, 0], [NaN, 5]] });
     assert.match(nan.message, /points\[1\] must be a pair of finite numbers \[x, z\], got \[NaN, 5\]$/);
   });
 
@@ -118,11 +103,11 @@ describe('path following and live control in the page', { timeout: 300_000 }, ()
   });
 
   test('simulateControl refuses bad schedules', async () => {
-    const late = await failure(suite.page, 'simulateControl', { seconds: 2, schedule: [{ t: 0.5, speed: 1, heading: 0 }] });
+    const late = await apiFailure(suite.page, 'simulateControl', { seconds: 2, schedule: [{ t: 0.5, speed: 1, heading: 0 }] });
     assert.match(late.message, /^simulateControl: schedule\[0\]\.t must be 0/);
-    const fast = await failure(suite.page, 'simulateControl', { seconds: 2, schedule: [{ t: 0, speed: 12, heading: 0 }] });
+    const fast = await apiFailure(suite.page, 'simulateControl', { seconds: 2, schedule: [{ t: 0, speed: 12, heading: 0 }] });
     assert.match(fast.message, /speed must be a number from 0 to 4/);
-    const long = await failure(suite.page, 'simulateControl', { seconds: 6000, schedule: [{ t: 0, speed: 1, heading: 0 }] });
+    const long = await apiFailure(suite.page, 'simulateControl', { seconds: 6000, schedule: [{ t: 0, speed: 1, heading: 0 }] });
     assert.match(long.message, /seconds must be a number above 0 and at most 600/);
     assert.deepEqual(suite.problems, []);
   });

@@ -157,3 +157,21 @@ export async function drawStroke(page, points, steps = 3) {
   await page.mouse.up();
   await nextFrames(page, 2);
 }
+
+/**
+ * How a window.playground call fails: { message: null } if it resolves, else its message and name, lastError
+ * and the frames shown (so a test can check the page kept what it showed).
+ */
+export function apiFailure(page, method, options) {
+  return page.evaluate(
+    async ({ method, options }) => {
+      try {
+        await window.playground[method](options);
+        return { message: null };
+      } catch (e) {
+        return { message: e.message, name: e.name, lastError: window.playground.lastError(), shown: window.playground.current()?.frames ?? null };
+      }
+    },
+    { method, options },
+  );
+}

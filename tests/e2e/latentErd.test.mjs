@@ -8,7 +8,7 @@ import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
 import { describe, test } from 'node:test';
-import { drawStroke, ROOT, usePlayground, waitUntil } from './harness.mjs';
+import { apiFailure, drawStroke, ROOT, usePlayground, waitUntil } from './harness.mjs';
 
 const REFERENCE = JSON.parse(readFileSync(path.join(ROOT, 'tests/fixtures/latent_erd_reference.json'), 'utf8'));
 const ERD = JSON.parse(readFileSync(path.join(ROOT, 'public/models/latent-erd.json'), 'utf8'));
@@ -33,21 +33,6 @@ function generate(page, options) {
       positionsType: Object.prototype.toString.call(m.positions), shownUnchanged: window.playground.current() === before,
     };
   }, options);
-}
-
-/** The error message a call rejects with (null if it resolves), plus lastError and the frames shown. */
-function failure(page, method, options) {
-  return page.evaluate(
-    async ({ method, options }) => {
-      try {
-        await window.playground[method](options);
-        return { message: null };
-      } catch (e) {
-        return { message: e.message, name: e.name, lastError: window.playground.lastError(), shown: window.playground.current()?.frames ?? null };
-      }
-    },
-    { method, options },
-  );
 }
 
 /** Worst bone-length error (m) of a motion of the manifold skeleton. */
@@ -303,7 +288,7 @@ describe('latent ERD in the page', { timeout: 300_000 }, () => {
       ['simulateControl', { model: 'latent-erd', seconds: 1, schedule: [{ t: 0, speed: 9, heading: 0 }] }, /speed must be a number from 0 to 4/],
     ];
     for (const [method, options, expected] of cases) {
-      const r = await failure(page, method, options);
+      const r = await apiFailure(page, method, options);
       assert.match(String(r.message), expected, `${method}(${JSON.stringify(options)})`);
       assert.equal(r.lastError, r.message, 'the message is shown on the page');
       assert.equal(r.shown, 40, 'the motion shown stays');
