@@ -68,8 +68,10 @@ def check_parity(erd: ControlERD, path: Path, steps: int = 20) -> float:
     return worst
 
 
-def pick_seeds(corpus: WindowCorpus, autoencoder: MotionAutoencoder, norm: Normalisation, per_category=(6, 2)) -> list[dict]:
-    """SEED_STEPS real latent steps from held-out clips: a spread of walks and some runs, a third of the way in."""
+def pick_seeds(corpus: WindowCorpus, autoencoder: MotionAutoencoder, norm: Normalisation, control_sigma: float,
+               per_category=(6, 2)) -> list[dict]:
+    """SEED_STEPS real latent steps from held-out clips: a spread of walks and some runs, a third of the way in,
+    with their control as the ERD reads it (smoothed over `control_sigma` frames)."""
     seeds = []
     for category, count in zip(("walk", "run"), per_category):
         pool = sorted((i for i, c in enumerate(corpus.valid_clips) if c.category == category and len(c.rows) >= 36),
@@ -80,7 +82,7 @@ def pick_seeds(corpus: WindowCorpus, autoencoder: MotionAutoencoder, norm: Norma
             z = encode_clip(autoencoder, rows)
             start = len(z) // 3
             latents = (z[start:start + SEED_STEPS] - norm.latent_mean) / norm.latent_std
-            controls = step_control(rows[start * POOLING:], SEED_STEPS)
+            controls = step_control(rows, len(z), control_sigma)[start:start + SEED_STEPS]
             clip = corpus.valid_clips[i]
             seeds.append({"name": f"{category} {clip.file.split('/')[-1].split('.')[0]}", "file": clip.file, "category": category,
                           "latents": np.round(latents, 6).tolist(), "controls": np.round(controls, 6).tolist()})
@@ -138,12 +140,14 @@ def export_latent_erd(erd: ControlERD, meta: dict, autoencoder: MotionAutoencode
     export_step(erd, path)
     parity = check_parity(erd, path)
     norm = Normalisation.from_meta(meta)
+    control_sigma = float(meta.get("control_sigma", 0.0))
     info = {"id": "latent-erd", "kind": "latent-erd", "file": path.name, "manifold": "manifold.json", "fps": meta["fps"],
             "pooling": POOLING, "radius": RADIUS, "lookahead": LOOKAHEAD, "latent": erd.dim, "control_dim": erd.control,
             "hidden": erd.hidden, "layers": erd.layers,
             "inputs": INPUTS, "outputs": OUTPUTS,
             "latent_normalisation": {"mean": np.round(norm.latent_mean, 6).tolist(), "std": np.round(norm.latent_std, 6).tolist()},
-            "control_range": control_range(corpus), "seeds": pick_seeds(corpus, autoencoder, norm),
+            "control_range": control_range(corpus), "seeds": pick_seeds(corpus, autoencoder, norm, control_sigma),
+            "control_smoothing_frames": control_sigma,
             "parity_max_abs": parity, "report": report, "bytes": path.stat().st_size}
     (out / "latent-erd.json").write_text(json.dumps(info) + "\n")
     if out == MODELS_DIR:

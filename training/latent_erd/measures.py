@@ -25,7 +25,7 @@ import torch
 from .. import metrics
 from ..control import random_control
 from ..data.features import heading_of
-from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, POSITION_DIM, WindowCorpus, ground_frame, motion_rows
+from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, POSITION_DIM, WindowCorpus, ground_frame, motion_rows, smooth
 from ..footlock import foot_lock
 from ..generator.sampling import sample_mixture, snap_contacts
 from ..generator.shipped import ShippedGenerator
@@ -60,6 +60,11 @@ class Shipped:
                              np.array(manifold["normalisation"]["mean"]), np.array(manifold["normalisation"]["std"]))
         backend = OnnxBackend(models_dir / info["file"], models_dir / manifold["files"]["decoder"])
         return cls(info, manifold, norm, backend, models_dir / manifold["files"]["encoder"])
+
+    @property
+    def control_sigma(self) -> float:
+        """Frames of Gaussian smoothing the ERD's control input had in training (0: none)."""
+        return float(self.info.get("control_smoothing_frames", 0.0))
 
     def stream(self, seed_latents, seed_controls, root: Root, lookahead: int | None = None) -> LatentStream:
         return LatentStream(self.backend, self.norm, seed_latents, seed_controls, (self.info["layers"], self.info["hidden"]),
@@ -114,12 +119,25 @@ def past_seed(shipped: Shipped, encoder: OnnxEncoder, corpus: WindowCorpus, w: W
     z = encode_clip(encoder, rows)
     steps = SEED_FRAMES // POOLING
     latents = ((z[-steps:] - shipped.norm.latent_mean) / shipped.norm.latent_std).astype(np.float32)
-    return latents, step_control(rows[-SEED_FRAMES:], steps), root
+    return latents, step_control(rows, len(z), shipped.control_sigma)[-steps:], root
 
 
-def latent_prediction(shipped: Shipped, encoder: OnnxEncoder, corpus: WindowCorpus, w: Window, frames: int) -> StreamOutput:
+def driving_control(shipped: Shipped, corpus: WindowCorpus, w: Window, frames: int) -> np.ndarray:
+    """The held-out clip's own control (physical) for the predicted frames, smoothed as the ERD reads it."""
+    control = corpus.valid_clips[w.clip].rows[:, CONTROL_SLICE]
+    if shipped.control_sigma > 0:
+        control = smooth(control, shipped.control_sigma)
+    return control[w.start + SEED_FRAMES: w.start + SEED_FRAMES + frames]
+
+
+def latent_prediction(shipped: Shipped, encoder: OnnxEncoder, corpus: WindowCorpus, w: Window, frames: int,
+                      constant: bool = False) -> StreamOutput:
+    """The stream from the window's seed driven by the clip's own control, or with `constant` by that control's
+    mean over the window (a stick held still: no stride in the signal)."""
     stream = shipped.stream(*past_seed(shipped, encoder, corpus, w))
-    control = corpus.valid_clips[w.clip].rows[w.start + SEED_FRAMES: w.start + SEED_FRAMES + frames, CONTROL_SLICE]
+    control = driving_control(shipped, corpus, w, frames)
+    if constant:
+        control = np.repeat(control.mean(axis=0, keepdims=True), len(control), axis=0)
     return run_stream(stream, control, known_future=True)
 
 
@@ -179,6 +197,37 @@ def prediction_errors(predicted: list[np.ndarray], real: list[np.ndarray]) -> di
 def real_pose_change_median(corpus: WindowCorpus, fps: float) -> float:
     changes = [metrics.pose_change_per_second(c.positions, fps) for c in corpus.valid_clips + corpus.train_clips[::6]]
     return float(np.median(np.concatenate([c for c in changes if len(c)])))
+
+
+SPEED_BANDS = ((0.4, 0.6), (0.6, 0.8), (0.8, 1.0), (1.0, 1.5), (1.5, 2.0))
+
+
+def per_second_mean(values: np.ndarray, fps: float) -> np.ndarray:
+    """The mean of each whole second of per-frame values, aligned with metrics.pose_change_per_second (which
+    measures len - 1 frame changes)."""
+    step = int(round(fps))
+    return np.array([values[a:a + step].mean() for a in range(0, len(values) - step, step)])
+
+
+def pose_change_by_speed(changes: list[np.ndarray], speeds: list[np.ndarray], median: float) -> list[dict]:
+    """Per band of forward speed (m/s, each second's mean): how many seconds, and their pose change against the
+    real median (mean and lowest)."""
+    change, speed = np.concatenate(changes), np.concatenate(speeds)
+    out = []
+    for lo, hi in SPEED_BANDS:
+        sel = (speed >= lo) & (speed < hi)
+        out.append({"band": [lo, hi], "seconds": int(sel.sum()),
+                    "mean_share_of_median": round(float(change[sel].mean() / median), 3) if sel.any() else None,
+                    "lowest_share_of_median": round(float(change[sel].min() / median), 3) if sel.any() else None})
+    return out
+
+
+def real_pose_change_by_speed(corpus: WindowCorpus, fps: float, median: float) -> list[dict]:
+    """pose_change_by_speed of the real clips (those real_pose_change_median measures), by their own speed."""
+    clips = corpus.valid_clips + corpus.train_clips[::6]
+    changes = [metrics.pose_change_per_second(c.positions, fps) for c in clips]
+    speeds = [per_second_mean(c.rows[:, CONTROL_SLICE][:, 0], fps) for c in clips]
+    return pose_change_by_speed(changes, speeds, median)
 
 
 def real_share_below(corpus: WindowCorpus, fps: float, median: float) -> float:

@@ -29,6 +29,10 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--noise", type=float, default=0.05, help="final input-noise sigma (normalised units)")
     parser.add_argument("--self-fed", type=float, default=1.0,
                         help="share of each stretch (after the 4 seed steps) fed the model's own predictions by the end of the ramp")
+    parser.add_argument("--energy", type=float, default=0.0,
+                        help="weight of the motion-energy term (training.py energy_loss); 0 is mean squared error alone")
+    parser.add_argument("--control-sigma", type=float, default=0.0,
+                        help="latent ERD: read the control smoothed over this many frames (sequences.py); 0 reads it as it is")
     parser.add_argument("--iterations", type=int, default=12000)
     parser.add_argument("--minutes", type=float, default=60.0, help="stop cleanly after this much training time")
     parser.add_argument("--checkpoint-minutes", type=float, default=3.0)
