@@ -54,7 +54,8 @@ def evaluate(mocap: str | None, frames: int, n_seeds: int, pose_checkpoint: Path
     if not pose_checkpoint.exists() and "pose-space ERD" in previous.get("prediction", {}).get("rows", {}):
         # The baseline does not change with the latent ERD; its checkpoint is not in git (runs/), so a fresh clone
         # keeps the row that the last report measured on the same windows.
-        report["prediction"]["rows"]["pose-space ERD"] = previous["prediction"]["rows"]["pose-space ERD"]
+        row = previous["prediction"]["rows"]["pose-space ERD"]
+        report["prediction"]["rows"]["pose-space ERD"] = {kind: {int(k): v for k, v in e.items()} for kind, e in row.items()}
         report["prediction"]["carried"] = ["pose-space ERD"]
 
     # Motion energy: the pose change of the stream driven by held-out control, and by the same control held at
@@ -190,11 +191,12 @@ def summary_lines(r: dict) -> list[str]:
     counts = [round(x["seconds_below_20pct"] * x["frames"] / r["fps"]) for x in lr["runs"]]
     spread = f"{min(c for c in counts if c)}–{max(counts)}" if any(counts) else "0"
     page = page_long_runs(b, lr["real_median_pose_change"]) if b else None
+    runs_text = f"{lr['collapsed']} runs have {spread} such seconds" if lr["collapsed"] else "no run has such a second"
     page_text = (f"; in the page (skeleton-fitted and foot-locked, what is shown) {page['collapsed']} of {page['runs']} runs "
                  f"(lowest {page['lowest']:.0%})") if page else ""
     met = lr["collapsed"] == 0 and (page is None or page["collapsed"] == 0)
     out.append(f"| {len(lr['runs'])} × {lr['runs'][0]['frames']:,}-frame random-control runs never below 20% of the real median pose change | "
-               f"{lr['collapsed']} runs have {spread} such seconds (lowest {worst_low:.0%}){page_text}; real clips spend "
+               f"{runs_text} (lowest {worst_low:.0%}){page_text}; real clips spend "
                f"{lr['real_share_below']:.1%} of their seconds there | {'yes' if met else 'no'} |")
     real, h, rc = r["sliding_real"], r["sliding_held_out_control"], r["sliding_random_control"]
     ok = h["contact_bits_after"] <= real["contact_bits"] and h["low_foot_after"] <= real["low_foot"]
