@@ -107,3 +107,21 @@ def test_shipped_latent_erd_files_agree():
         assert (MODELS / name).stat().st_size <= 8 * 1024 * 1024, name
     index = {m["id"]: m for m in json.loads((MODELS / "index.json").read_text())["models"]}
     assert index["latent-erd"]["kind"] == "latent-erd" and index["manifold"]["kind"] == "autoencoder"
+
+
+def test_shipped_seeds_carry_the_control_as_the_erd_reads_it(mocap):
+    """Each seed's controls are its held-out clip's signal smoothed as in training (control_smoothing_frames)."""
+    from training.data.windows import WindowCorpus
+    from training.latent_erd.sequences import step_control
+    info = json.loads((MODELS / "latent-erd.json").read_text())
+    sigma = info["control_smoothing_frames"]
+    corpus = WindowCorpus(load_clips(str(mocap)))
+    for seed in info["seeds"]:
+        i = next(k for k, c in enumerate(corpus.valid_clips) if c.file == seed["file"])
+        rows = corpus.valid[i]
+        steps = len(rows) // POOLING
+        start = steps // 3
+        want = step_control(rows, steps, sigma)[start:start + len(seed["controls"])]
+        np.testing.assert_allclose(seed["controls"], want, atol=1e-5)
+        if sigma > 0:  # and not the raw signal, which sways with the stride
+            assert np.abs(step_control(rows, steps)[start:start + len(seed["controls"])] - want).max() > 1e-3
