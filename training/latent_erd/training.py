@@ -13,11 +13,12 @@ ones) over the first 60% of the run (the ramp of Dance Revolution and MVAE). A p
 forward speed reached -44 m/s within 20 s.
 
 Motion energy (`energy`): mean squared error alone shrinks the motion. Once a self-fed stretch has lost the
-real stride's phase, the prediction that costs least is the average over phases, a smaller step, so the
-shipped run without this term moved its pose at about half the real clips' rate at 0.4-0.8 m/s (and froze
-for whole seconds there in random control). The term asks each channel's mean squared step change over the
-stretch to match the real one's (on the square roots, so it is in the units of a step), which does not
-depend on the phase.
+real stride's phase, the prediction that costs least is the average over phases, a smaller step; the first
+shipped ERD, trained without this term, moved its pose at about half the real clips' rate at 0.4-0.8 m/s (and
+froze for whole seconds there in random control). The term asks each channel's mean squared step change over
+the stretch to match the real one's (on the square roots, so it is in the units of a step), which does not
+depend on the phase. Alone it added motion only where the control sways with the stride; with the control
+smoothed (sequences.py) it ships (pilots: docs/models/latent-erd-notes.json).
 """
 from __future__ import annotations
 
