@@ -42,12 +42,16 @@ def turning_rate(features: np.ndarray, fps: float) -> np.ndarray:
     return features[:, 2] * fps
 
 
+def per_second_means(values: np.ndarray, fps: float) -> np.ndarray:
+    """The mean of each whole second of a per-frame series (a last partial second is dropped)."""
+    step = int(round(fps))
+    return np.array([values[a:a + step].mean() for a in range(0, len(values) - step + 1, step)])
+
+
 def pose_change_per_second(positions: np.ndarray, fps: float) -> np.ndarray:
     """Mean joint speed relative to the root (m/s), averaged over each whole second: low values mean a frozen pose."""
     local = positions - positions[:, :1]
-    speed = np.linalg.norm(np.diff(local, axis=0), axis=-1).mean(axis=1) * fps
-    step = int(round(fps))
-    return np.array([speed[a:a + step].mean() for a in range(0, len(speed) - step + 1, step)])
+    return per_second_means(np.linalg.norm(np.diff(local, axis=0), axis=-1).mean(axis=1) * fps, fps)
 
 
 def power_spectra(windows: np.ndarray) -> np.ndarray:

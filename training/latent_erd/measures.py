@@ -202,11 +202,10 @@ def real_pose_change_median(corpus: WindowCorpus, fps: float) -> float:
 SPEED_BANDS = ((0.4, 0.6), (0.6, 0.8), (0.8, 1.0), (1.0, 1.5), (1.5, 2.0))
 
 
-def per_second_mean(values: np.ndarray, fps: float) -> np.ndarray:
-    """The mean of each whole second of per-frame values, aligned with metrics.pose_change_per_second (which
-    measures len - 1 frame changes)."""
-    step = int(round(fps))
-    return np.array([values[a:a + step].mean() for a in range(0, len(values) - step, step)])
+def forward_speed_per_second(control: np.ndarray, fps: float) -> np.ndarray:
+    """Each whole second's mean forward speed of a per-frame control (frames, 3), aligned with
+    metrics.pose_change_per_second of the same frames (frame t's control is the motion from t to t + 1)."""
+    return metrics.per_second_means(control[:-1, 0], fps)
 
 
 def pose_change_by_speed(changes: list[np.ndarray], speeds: list[np.ndarray], median: float) -> list[dict]:
@@ -226,7 +225,7 @@ def real_pose_change_by_speed(corpus: WindowCorpus, fps: float, median: float) -
     """pose_change_by_speed of the real clips (those real_pose_change_median measures), by their own speed."""
     clips = corpus.valid_clips + corpus.train_clips[::6]
     changes = [metrics.pose_change_per_second(c.positions, fps) for c in clips]
-    speeds = [per_second_mean(c.rows[:, CONTROL_SLICE][:, 0], fps) for c in clips]
+    speeds = [forward_speed_per_second(c.rows[:, CONTROL_SLICE], fps) for c in clips]
     return pose_change_by_speed(changes, speeds, median)
 
 
@@ -251,12 +250,13 @@ def real_frame_change(corpus: WindowCorpus) -> float:
     return round(float(np.concatenate(d).mean() * 100), 3)
 
 
-def random_run(shipped: Shipped, seed: int, frames: int, lookahead: int | None = None) -> tuple[StreamOutput, float]:
+def random_run(shipped: Shipped, seed: int, frames: int, lookahead: int | None = None) -> tuple[StreamOutput, float, np.ndarray]:
+    """The stream on random control from `seed`: its output, the seconds it took, and the control of its frames."""
     control = random_control(seed, frames, shipped.info["fps"])
     stream = shipped.seed_stream(seed, lookahead)
     t0 = time.perf_counter()
     out = run_stream(stream, control, known_future=True)
-    return out, time.perf_counter() - t0
+    return out, time.perf_counter() - t0, control[:len(out.positions)]
 
 
 def sliding(runs: list[tuple[np.ndarray, np.ndarray]], fps: float) -> dict:

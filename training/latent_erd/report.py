@@ -11,7 +11,6 @@ import numpy as np
 import torch
 
 from .. import metrics
-from ..control import random_control
 from ..data.locomotion import load_clips
 from ..data.windows import WindowCorpus
 from ..generator.shipped import ShippedGenerator
@@ -62,9 +61,9 @@ def evaluate(mocap: str | None, frames: int, n_seeds: int, pose_checkpoint: Path
     # its mean (a stick held still), against the real clips over the same frames.
     median = m.real_pose_change_median(corpus, fps)
     held_constant = [m.latent_prediction(shipped, encoder, corpus, w, m.PREDICT_FRAMES, constant=True) for w in windows]
-    change = lambda outs: float(np.mean([metrics.pose_change_per_second(p, fps).mean() for p in outs]) / median)
-    report["energy"] = {"real": round(change(real), 3), "held_out_control": round(change(rows["latent ERD"]), 3),
-                        "constant_control": round(change([o.positions for o in held_constant]), 3)}
+    energy = lambda outs: float(np.mean([metrics.pose_change_per_second(p, fps).mean() for p in outs]) / median)
+    report["energy"] = {"real": round(energy(real), 3), "held_out_control": round(energy(rows["latent ERD"]), 3),
+                        "constant_control": round(energy([o.positions for o in held_constant]), 3)}
     report["sliding_held_out_control"] = m.sliding([(o.positions, o.contacts) for o in latent], fps)
     report["sliding_real"] = m.real_sliding(corpus, fps)
 
@@ -72,10 +71,10 @@ def evaluate(mocap: str | None, frames: int, n_seeds: int, pose_checkpoint: Path
     runs = []
     long_outputs, changes, speeds = [], [], []
     for seed in range(n_seeds):
-        out, seconds = m.random_run(shipped, seed, frames)
+        out, seconds, control = m.random_run(shipped, seed, frames)
         change = metrics.pose_change_per_second(out.positions, fps)
         changes.append(change)
-        speeds.append(m.per_second_mean(random_control(seed, frames, fps)[:len(out.positions), 0], fps))
+        speeds.append(m.forward_speed_per_second(control, fps))
         speed = np.linalg.norm(np.diff(out.roots[:, :2], axis=0), axis=1) * fps
         runs.append({"seed": seed, "seed_clip": shipped.info["seeds"][seed % len(shipped.info["seeds"])]["name"],
                      "frames": len(out.positions), "finite": bool(np.isfinite(out.positions).all()),
@@ -94,7 +93,7 @@ def evaluate(mocap: str | None, frames: int, n_seeds: int, pose_checkpoint: Path
     # Seams against look-ahead.
     seams = []
     for k in LOOKAHEADS:
-        out, seconds = m.random_run(shipped, 0, 2000, lookahead=k)
+        out, seconds, _ = m.random_run(shipped, 0, 2000, lookahead=k)
         seams.append({"lookahead": k, **m.seam_ratio(out.positions, fps), "native_ms_per_frame": round(seconds / len(out.positions) * 1000, 3)})
     report["seams"] = {"real_frame_change_cm": m.real_frame_change(corpus), "rows": seams}
     if BROWSER_JSON.exists():
