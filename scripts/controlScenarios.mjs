@@ -60,5 +60,6 @@ export function controlRow(name, scenario, seed, sim, targets) {
     p95ms: percentile(sim.computeMs, 95),
     maxMs: Math.max(...sim.computeMs),
     skating: sim.skating,
+    sliding: sim.sliding,
   };
 }

@@ -5,9 +5,11 @@
 //   SEEDS=5 npm run evaluate:control
 //
 // Path fit, arc progress and optimisation time come from followPath's stats; foot skating (planted toe
-// speed: the app's web/motion/footSkating.ts, as training/metrics.py foot_skating) is measured in the
-// page, the control responses here from the returned motions, against unconstrained generation
-// (generate, temperature 0.5) from the same seed states.
+// speed by the returned contacts: the app's web/motion/footSkating.ts, as training/metrics.py foot_skating)
+// and foot sliding (the lowest foot point's speed within 4 cm of the floor, no contacts: lowFootSliding, as
+// metrics.py low_foot_speeds) are measured in the page, the control responses here from the returned motions,
+// against unconstrained generation (generate, temperature 0.5) from the same seed states, and sliding against
+// the real held-out clips measured the same way (docs/models/refiner.json, python -m training.refiner.evaluate).
 import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
@@ -48,8 +50,8 @@ async function simulateOne(page, scenario, seed) {
   return page.evaluate(
     async ({ schedule, seed, seconds, gait }) => {
       const m = await window.playground.simulateControl({ seconds, schedule, seed, ...(gait ? { gait } : {}) });
-      const { footSkating } = await import('/motion/footSkating.ts');
-      return { skating: footSkating(m), fps: m.fps, frames: m.frames, speed: Array.from(m.speed), heading: Array.from(m.heading), computeMs: Array.from(m.computeMs) };
+      const { footSkating, lowFootSliding } = await import('/motion/footSkating.ts');
+      return { skating: footSkating(m), sliding: lowFootSliding(m), fps: m.fps, frames: m.frames, speed: Array.from(m.speed), heading: Array.from(m.heading), computeMs: Array.from(m.computeMs) };
     },
     { schedule: scenario.schedule, seed, seconds: SIM_SECONDS, gait: scenario.gait },
   );
@@ -77,6 +79,8 @@ async function main() {
             speed: rootSpeed(m),
             skating: m.skating,
             skatingBeforeLock: m.stats.skatingBeforeLock,
+            sliding: m.stats.sliding,
+            slidingBeforeLock: m.stats.slidingBeforeLock,
             freeSkating: free ? free.skating : null,
           };
           report.paths.push(row);
@@ -96,6 +100,7 @@ async function main() {
     const freeControl = [];
     for (let seed = 0; seed < SEEDS; seed++) freeControl.push((await freeOne(page, seed, SIM_SECONDS * 30)).skating);
     report.freeControlSkating = mean(freeControl);
+    report.realSliding = JSON.parse(readFileSync(path.join(OUT, 'refiner.json'), 'utf8')).real.low_foot_sliding;
     report.problems = problems;
     report.loadAfter = os.loadavg()[0];
   } finally {
@@ -123,15 +128,15 @@ function markdown(r) {
   lines.push('## Path following', '');
   lines.push(`Targets: mean error ≤ ${T.meanError} m, max ≤ ${T.maxError} m, arc progress ≥ ${T.arcProgress * 100}%, optimisation ≥ ${T.realtime}× faster than the motion lasts, skating ≤ ${T.skatingRatio}× unconstrained generation. Error = distance from the root (on the ground) to the path, every frame.`, '');
   const table = (rows, withFree) => {
-    const out = ['| path | gait | mean error (m) | max error (m) | arc progress | motion (s) | optimise (s) | × real time | speed (m/s) | skating before / after the foot lock (m/s) |' + (withFree ? ' unconstrained skating (m/s) |' : ''),
-      '|---|---|---|---|---|---|---|---|---|---|' + (withFree ? '---|' : '')];
+    const out = ['| path | gait | mean error (m) | max error (m) | arc progress | motion (s) | optimise (s) | × real time | speed (m/s) | skating before / after the foot lock (m/s) | sliding, lowest point, before / after (m/s) |' + (withFree ? ' unconstrained skating (m/s) |' : ''),
+      '|---|---|---|---|---|---|---|---|---|---|---|' + (withFree ? '---|' : '')];
     for (const name of Object.keys(PATHS)) {
       const g = rows.filter((p) => p.path === name);
       if (!g.length) continue;
       const worst = (k) => Math.max(...g.map((p) => p[k]));
       const least = (k) => Math.min(...g.map((p) => p[k]));
       out.push(
-        `| ${name} | ${g[0].gait} | ${fmt(mean(g.map((p) => p.meanError)), 3)} (worst ${fmt(worst('meanError'), 3)}) | ${fmt(worst('maxError'), 3)} | ${fmt(least('arcProgress') * 100, 1)}% (least) | ${fmt(mean(g.map((p) => p.seconds)), 1)} | ${fmt(mean(g.map((p) => p.optimizeMs)) / 1000, 1)} | ${fmt(least('realtime'), 2)} (least) | ${fmt(mean(g.map((p) => p.speed)))} | ${fmt(mean(g.map((p) => p.skatingBeforeLock)), 3)} / ${fmt(mean(g.map((p) => p.skating)), 3)} |` +
+        `| ${name} | ${g[0].gait} | ${fmt(mean(g.map((p) => p.meanError)), 3)} (worst ${fmt(worst('meanError'), 3)}) | ${fmt(worst('maxError'), 3)} | ${fmt(least('arcProgress') * 100, 1)}% (least) | ${fmt(mean(g.map((p) => p.seconds)), 1)} | ${fmt(mean(g.map((p) => p.optimizeMs)) / 1000, 1)} | ${fmt(least('realtime'), 2)} (least) | ${fmt(mean(g.map((p) => p.speed)))} | ${fmt(mean(g.map((p) => p.skatingBeforeLock)), 3)} / ${fmt(mean(g.map((p) => p.skating)), 3)} | ${fmt(mean(g.map((p) => p.slidingBeforeLock)), 3)} / ${fmt(mean(g.map((p) => p.sliding)), 3)} (worst ${fmt(Math.max(...g.map((p) => p.sliding)), 3)}) |` +
           (withFree ? ` ${fmt(mean(g.map((p) => p.freeSkating)), 3)} |` : ''),
       );
     }
@@ -143,7 +148,8 @@ function markdown(r) {
   const lockedRatio = mean(walk.map((p) => p.skating)) / mean(walk.map((p) => p.freeSkating));
   lines.push(
     `Walking: every run within the fit, progress and speed targets: ${pass(ok(walk))}. Skating of the optimised walks ÷ unconstrained generation from the same seed states (both without the foot lock): ${fmt(skateRatio, 2)} (target ≤ ${T.skatingRatio}): ${pass(skateRatio <= T.skatingRatio)}. ` +
-      `followPath returns the motion with planted feet locked (the refiner issue's contact clean-up, \`web/motion/footLock.ts\`; the root is not moved, so the path numbers hold): ${fmt(lockedRatio, 2)}× unconstrained.`,
+      `followPath returns the motion with contacts labelled on it and planted feet locked (\`web/motion/contactLabels.ts\`, \`web/motion/footLock.ts\`; the root is not moved, so the path numbers hold): ${fmt(lockedRatio, 2)}× unconstrained. ` +
+      `Sliding by the lowest foot point (no contacts needed) after the lock: ${fmt(mean(walk.map((p) => p.sliding)), 3)} m/s on average, worst run ${fmt(Math.max(...walk.map((p) => p.sliding)), 3)}, against ${fmt(r.realSliding, 3)} m/s for the real held-out clips measured the same way (refiner.md): ${pass(walk.every((p) => p.sliding <= r.realSliding))} for every run.`,
     '',
   );
   lines.push('Running (`gait: "run"`, run seed states; not part of the targets, shown for completeness):', '');
@@ -156,11 +162,11 @@ function markdown(r) {
       'Heading is the root\'s facing; speed is the root\'s mean horizontal speed over the last 0.5 s (about one step), read 1 s after the change. Compute is the optimisation time of each batch divided by its frames.',
     '',
   );
-  lines.push('| scenario | heading within 15° after (s) | speed 1 s after the change (m/s) | |speed − target| (m/s) | compute p95 / max (ms per frame) | skating (m/s) |', '|---|---|---|---|---|---|');
+  lines.push('| scenario | heading within 15° after (s) | speed 1 s after the change (m/s) | |speed − target| (m/s) | compute p95 / max (ms per frame) | skating (m/s) | sliding, lowest point (m/s) |', '|---|---|---|---|---|---|---|');
   for (const name of Object.keys(SCENARIOS)) {
     const g = r.control.filter((c) => c.scenario === name);
     const head = g[0].kind === 'heading' ? g.map((c) => fmt(c.headingResponse)).join(', ') : '—';
-    lines.push(`| ${name} | ${head} | ${g.map((c) => fmt(c.speedAt1s)).join(', ')} | ${fmt(Math.max(...g.map((c) => c.speedError)))} (worst) | ${fmt(Math.max(...g.map((c) => c.p95ms)), 1)} / ${fmt(Math.max(...g.map((c) => c.maxMs)), 1)} | ${fmt(mean(g.map((c) => c.skating)), 3)} |`);
+    lines.push(`| ${name} | ${head} | ${g.map((c) => fmt(c.speedAt1s)).join(', ')} | ${fmt(Math.max(...g.map((c) => c.speedError)))} (worst) | ${fmt(Math.max(...g.map((c) => c.p95ms)), 1)} / ${fmt(Math.max(...g.map((c) => c.maxMs)), 1)} | ${fmt(mean(g.map((c) => c.skating)), 3)} | ${fmt(mean(g.map((c) => c.sliding)), 3)} (worst ${fmt(Math.max(...g.map((c) => c.sliding)), 3)}) |`);
   }
   lines.push('');
   const heads = r.control.filter((c) => c.kind === 'heading');
@@ -171,6 +177,8 @@ function markdown(r) {
   lines.push(`- Walking speed within ${T.speedError} m/s of the target 1 s after a change in every run: ${pass(walkSpeeds.every((c) => c.speedError <= T.speedError))}.`);
   lines.push(`- Compute per model frame, p95 over each run (worst run): ${fmt(allP95, 1)} ms (target < ${T.p95ms}): ${pass(allP95 < T.p95ms)}.`);
   lines.push(`- Skating of the walking control runs (feet locked, as simulateControl returns them) ${fmt(controlSkate, 3)} m/s vs unconstrained ${fmt(r.freeControlSkating, 3)} m/s: ratio ${fmt(controlSkate / r.freeControlSkating, 2)} (target ≤ ${T.skatingRatio}).`);
+  const controlSlide = r.control.filter((c) => !c.scenario.startsWith('run')).map((c) => c.sliding);
+  lines.push(`- Sliding of the walking control runs by the lowest foot point: ${fmt(mean(controlSlide), 3)} m/s on average, worst run ${fmt(Math.max(...controlSlide), 3)}, against ${fmt(r.realSliding, 3)} m/s for the real held-out clips: ${pass(controlSlide.every((v) => v <= r.realSliding))} for every run.`);
   lines.push('');
   return lines.join('\n') + '\n';
 }

@@ -16,11 +16,19 @@ Per foot and frame (toe = LeftToeBase / RightToeBase, the point the skating meas
 2. Contact held: the toe target is (anchor x, ground height, anchor z).
 3. Contact ends: the target goes from where the locked toe was last drawn back to the raw toe over
    BLEND_OUT frames (weight smoothstep(frames left / BLEND_OUT) on the locked position), so the foot does
-   not pop.
-4. The ankle target is the toe target minus the raw foot's toe-from-ankle vector (the foot keeps its
-   raw orientation and moves rigidly: ankle, toe and toe end by the same vector). If that ankle target is
+   not pop. The raw foot may have slid far from the anchor meanwhile, so the catching-up foot is lifted by
+   4 w (1 - w) times half the horizontal gap (at most RELEASE_LIFT): it steps over the floor instead of
+   dragging along it (without the lift, path-followed feet skimmed the floor at 4-6 m/s after each contact).
+4. The heel and the toes are locked with the toe: the heading (horizontal direction) of the foot (ankle to
+   toe) and of the toes (toe to toe tip) are held at their headings when the contact started, and blended
+   back to the raw ones over the blend-out, like the toe. Both keep their raw pitch, so a heel still lifts;
+   how much of a heading is held falls from 1 to 0 as the part pitches from FLAT_PITCH to STEEP_PITCH
+   (flatness()), because a steep foot's heel is off the floor and its heading is noise. The ankle target is
+   the toe target minus the raw toe-from-ankle vector turned to the held heading (the foot moves rigidly:
+   ankle, toe and toe end turned and moved alike). If that ankle target is
    beyond the leg's reach (REACH of thigh + shin), the foot pivots about the locked toe instead, as in a
-   heel lift (pivot_foot: the nearest reachable ankle at the foot's length from the toe). Two-bone IK puts
+   heel lift (pivot_foot: the nearest reachable ankle at the foot's length from the toe), the toes staying
+   as they are. Two-bone IK puts
    the knee on the circle of valid knees, in the plane of hip, ankle target and the raw knee nudged towards
    the foot's forward direction (so the knee keeps pointing where the raw motion points it, and a nearly
    straight raw leg does not swing the knee about). If even a pivot cannot reach, the ankle stops at the
@@ -32,6 +40,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .contact_labels import label_contacts
 from .mocap.skeleton import Skeleton, canonical_skeleton
 
 # Median height (m) of the toe point (LeftToeBase/RightToeBase) in planted frames of the real training
@@ -41,6 +50,10 @@ BLEND_IN = 3    # frames (0.1 s at 30 fps) to bring a planted toe to the ground 
 BLEND_OUT = 6   # frames (0.2 s) to release a lifted foot from its anchor
 REACH = 0.999   # fraction of thigh + shin the IK may stretch to
 POLE_BIAS = 0.05  # m: how much the foot's forward direction adds to the raw knee's bend direction
+# Pitch (radians, ankle-to-toe below level) up to which a planted foot's heading is held fully, and from which it is
+# not held at all. A flat foot of the canonical skeleton pitches about 0.35 (ankle 8 cm above a toe 14 cm ahead).
+FLAT_PITCH, STEEP_PITCH = 0.6, 1.0
+RELEASE_LIFT = 0.08  # m: the most a released foot is lifted while it catches up with its raw position
 LEGS = {"left": ("LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase", "LeftToeBase_end"),
         "right": ("RightUpLeg", "RightLeg", "RightFoot", "RightToeBase", "RightToeBase_end")}
 
@@ -98,17 +111,27 @@ def pivot_foot(hip: np.ndarray, ankle_target: np.ndarray, toe_target: np.ndarray
     return centre + rho * off / n, True
 
 
-def rotation_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """The smallest rotation matrix turning direction a into direction b (Rodrigues)."""
-    a, b = a / np.linalg.norm(a), b / np.linalg.norm(b)
-    v, c = np.cross(a, b), float(np.dot(a, b))
-    if c < -1 + 1e-9:  # opposite: never for a foot turning about its toe; any half turn will do
-        axis = np.cross(a, [1.0, 0.0, 0.0])
-        axis = axis if np.linalg.norm(axis) > 1e-6 else np.cross(a, [0.0, 1.0, 0.0])
-        axis /= np.linalg.norm(axis)
-        return 2 * np.outer(axis, axis) - np.eye(3)
-    k = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-    return np.eye(3) + k + k @ k / (1 + c)
+def foot_heading(toe_from_ankle: np.ndarray) -> float:
+    """Heading (radians, 0 = +z, positive towards +x) of a foot's ankle-to-toe vector on the ground."""
+    return float(np.arctan2(toe_from_ankle[0], toe_from_ankle[2]))
+
+
+def flatness(toe_from_ankle: np.ndarray) -> float:
+    """How much the foot's heading is held: 1 while the foot is within FLAT_PITCH of level, falling smoothly to 0 at
+    STEEP_PITCH (a foot pointing down has no heading to speak of, and its heel is off the floor)."""
+    pitch = float(np.arctan2(-toe_from_ankle[1], np.hypot(toe_from_ankle[0], toe_from_ankle[2])))
+    return 1.0 - smoothstep((pitch - FLAT_PITCH) / (STEEP_PITCH - FLAT_PITCH))
+
+
+def wrap_angle(a: float) -> float:
+    """a in [-pi, pi)."""
+    return float((a + np.pi) % (2 * np.pi) - np.pi)
+
+
+def turn_about_y(angle: float) -> np.ndarray:
+    """Rotation matrix that adds `angle` to a vector's heading (foot_heading), about the vertical."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
 
 
 class FootLock:
@@ -129,57 +152,90 @@ class FootLock:
         self.locked = [None, None]      # where the locked toe was drawn in the last planted frame
         self.planted = [0, 0]           # frames since the contact started (0 = not planted)
         self.release = [0, 0]           # frames left of the blend-out
+        # Held headings (radians, from +z towards +x) of the foot (ankle -> toe) and of the toes (toe -> toe tip) of
+        # each planted foot, and the same in its last planted frame (None before any contact).
+        self.heading = [(0.0, 0.0), (0.0, 0.0)]
+        self.locked_heading = [None, None]
 
     def step(self, positions: np.ndarray, contacts) -> np.ndarray:
         """One frame: world positions (joints, 3) and contact bits (2,) -> cleaned positions (joints, 3)."""
         out = np.array(positions, dtype=np.float64, copy=True)
         for side, (hip, knee, ankle, toe, toe_end) in enumerate(self.legs):
             raw_toe = out[toe].copy()
+            raw_parts = (raw_toe - out[ankle], out[toe_end] - raw_toe)  # the foot and the toes
+            raw_heading = tuple(foot_heading(v) for v in raw_parts)
+            flat = tuple(flatness(v) for v in raw_parts)
             if contacts[side]:
-                if self.planted[side] == 0:  # contact starts where the toe is drawn now: no jump
+                if self.planted[side] == 0:  # contact starts where the foot is drawn now: no jump
                     start = self._drawn_toe(side, raw_toe)
                     self.anchor[side], self.start_y[side] = start[[0, 2]], float(start[1])
+                    self.heading[side] = self._drawn_heading(side, raw_heading, flat)
                 w = smoothstep(self.planted[side] / self.blend_in) if self.blend_in > 0 else 1.0
                 self.planted[side] += 1
                 target = np.array([self.anchor[side][0], (1 - w) * self.start_y[side] + w * self.ground,
                                    self.anchor[side][1]])
+                heading = tuple(r + f * wrap_angle(h - r) for h, r, f in zip(self.heading[side], raw_heading, flat))
             else:
                 self.planted[side] = 0
                 if self.release[side] <= 0:
                     continue  # free foot: raw pose
                 target = self._drawn_toe(side, raw_toe)
+                heading = self._drawn_heading(side, raw_heading, flat)
                 self.release[side] -= 1
-            ankle_target = target - (raw_toe - out[ankle])
+            toe_from_ankle, end_from_toe = (turn_about_y(h - r) @ v for h, r, v in zip(heading, raw_heading, raw_parts))
+            ankle_target = target - toe_from_ankle
             l1, l2 = self.lengths[side]
             ankle_target, pivot = pivot_foot(out[hip], ankle_target, target, REACH * (l1 + l2))
-            forward = raw_toe - out[ankle]
+            forward = raw_toe - out[ankle]  # the knee follows the raw foot: a steep foot's heading is noise
             forward[1] = 0.0
             forward /= max(float(np.linalg.norm(forward)), 1e-9)
             new_knee, new_ankle = two_bone_ik(out[hip], out[knee], ankle_target, l1, l2, forward=forward)
             if pivot is None:  # the foot moves rigidly with the ankle
-                out[[toe, toe_end]] += new_ankle - out[ankle]
-            else:  # the foot turns about the toe (heel lifts): ankle -> toe and toe -> toe end turned alike
-                turn = rotation_between(raw_toe - out[ankle], target - new_ankle)
-                out[toe_end] = target + turn @ (out[toe_end] - raw_toe)
+                out[toe] = new_ankle + toe_from_ankle
+                out[toe_end] = out[toe] + end_from_toe
+            else:  # the foot turns about the toe (heel lifts); the toes stay as they are
+                out[toe_end] = target + end_from_toe
                 out[toe] = target
             out[knee], out[ankle] = new_knee, new_ankle
             if contacts[side]:
                 if np.linalg.norm(new_ankle - ankle_target) > 1e-6:
                     self.anchor[side] = out[toe, [0, 2]].copy()  # out of reach: the anchor follows the body
                 self.locked[side] = out[toe].copy()
+                self.locked_heading[side] = self.heading[side]
                 self.release[side] = self.blend_out
         return out
 
+    def _drawn_heading(self, side: int, raw_heading: tuple, flat: tuple) -> tuple:
+        """The foot's and the toes' headings this frame if nothing new happens: the raw ones, or during a release the
+        blend from the last locked headings to the raw ones (the toe's weight times each part's flatness, the
+        shorter way round)."""
+        if self.release[side] <= 0 or self.locked_heading[side] is None:
+            return raw_heading
+        w = smoothstep(self.release[side] / self.blend_out)
+        return tuple(r + w * f * wrap_angle(h - r) for h, r, f in zip(self.locked_heading[side], raw_heading, flat))
+
     def _drawn_toe(self, side: int, raw_toe: np.ndarray) -> np.ndarray:
         """Where the toe is drawn this frame if nothing new happens: the raw toe, or during a release the
-        blend from the last locked position to the raw toe (weight smoothstep(frames left / BLEND_OUT))."""
+        blend from the last locked position to the raw toe (weight smoothstep(frames left / BLEND_OUT)), lifted."""
         if self.release[side] <= 0 or self.locked[side] is None:
             return raw_toe.copy()
         w = smoothstep(self.release[side] / self.blend_out)
-        return w * self.locked[side] + (1 - w) * raw_toe
+        # A foot catching up with its raw position steps over the floor rather than dragging along it: a lift of
+        # half the horizontal gap (at most RELEASE_LIFT), zero at both ends of the blend.
+        gap = float(np.hypot(self.locked[side][0] - raw_toe[0], self.locked[side][2] - raw_toe[2]))
+        out = w * self.locked[side] + (1 - w) * raw_toe
+        out[1] += 4 * w * (1 - w) * min(0.5 * gap, RELEASE_LIFT)
+        return out
 
 
 def foot_lock(positions: np.ndarray, contacts: np.ndarray, skel: Skeleton | None = None, **kw) -> np.ndarray:
     """Cleaned world positions (frames, joints, 3) of a clip with contact bits (frames, 2)."""
     lock = FootLock(skel, **kw)
     return np.stack([lock.step(p, c) for p, c in zip(positions, np.asarray(contacts) > 0)])
+
+
+def plant_feet(positions: np.ndarray, bits: np.ndarray, fps: float, skel: Skeleton | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """What every locomotion mode of the page shows: contacts labelled on the motion (contact_labels.py: the model's
+    bits with the feet's heights and speeds), then the lock on those labels. Returns (positions, labels)."""
+    labels = label_contacts(positions, bits, fps, skel)
+    return foot_lock(positions, labels, skel), labels

@@ -14,6 +14,21 @@ function followPath(page, options) {
   }, options);
 }
 
+/** [frame, side] of every foot whose lowest point (ankle, toe or toe tip) is within 4 cm of the floor and moved slower than 1 m/s since the previous frame. */
+function restingFeet(m) {
+  const J = m.joints.length, P = m.positions;
+  const feet = [['LeftFoot', 'LeftToeBase', 'LeftToeBase_end'], ['RightFoot', 'RightToeBase', 'RightToeBase_end']].map((g) => g.map((n) => m.joints.indexOf(n)));
+  const out = [];
+  for (let f = 1; f < m.frames; f++) {
+    feet.forEach((points, side) => {
+      const low = points.reduce((a, j) => (P[(f * J + j) * 3 + 1] < P[(f * J + a) * 3 + 1] ? j : a));
+      const a = ((f - 1) * J + low) * 3, b = (f * J + low) * 3;
+      if (P[b + 1] < 0.04 && Math.hypot(P[b] - P[a], P[b + 2] - P[a + 2]) * m.fps < 1) out.push([f, side]);
+    });
+  }
+  return out;
+}
+
 describe('path following and live control in the page', { timeout: 300_000 }, () => {
   const suite = usePlayground();
 
@@ -40,6 +55,14 @@ describe('path following and live control in the page', { timeout: 300_000 }, ()
     const raw = await followPath(suite.page, { points: BEND, gait: 'walk', seed: 4, footLock: false });
     assert.ok(a.stats.skating < a.stats.skatingBeforeLock, `skating ${a.stats.skating} vs ${a.stats.skatingBeforeLock} before the lock`);
     assert.ok(Math.abs(raw.stats.skating - a.stats.skatingBeforeLock) < 1e-6);
+    // The independent measure (lowest foot point near the floor, no contacts) falls too, and is the unlocked motion's before.
+    assert.ok(a.stats.sliding < 0.6 * a.stats.slidingBeforeLock, `sliding ${a.stats.sliding} vs ${a.stats.slidingBeforeLock} before the lock`);
+    assert.ok(Math.abs(raw.stats.sliding - a.stats.slidingBeforeLock) < 1e-6);
+    // The returned contacts agree with the feet: every foot resting on the floor (lowest point within 4 cm, slower
+    // than 1 m/s, in the unlocked motion) is labelled planted; the generator's own bits miss some.
+    const missed = (contacts) => restingFeet(raw).filter(([f, side]) => !contacts[f * 2 + side]).length;
+    assert.ok(missed(raw.contacts) > 0, 'the bits leave some resting feet free (the check is not vacuous)');
+    assert.equal(missed(a.contacts), 0);
     assert.notDeepEqual(raw.positions, a.positions);
     for (let f = 0; f < a.frames; f += 10) {
       const i = f * a.joints.length * 3;

@@ -233,7 +233,7 @@ describe('latent ERD in the page', { timeout: 300_000 }, () => {
       return { frames: m.frames, fps: m.fps, joints: m.joints, positions: Array.from(m.positions), contacts: m.contacts.length, stats: m.stats };
     }, o);
     const a = await run({ model: 'latent-erd', points: BEND, gait: 'walk', seed: 1 });
-    assert.deepEqual(Object.keys(a.stats).sort(), ['arcProgress', 'maxError', 'meanError', 'optimizeMs', 'skating', 'skatingBeforeLock']);
+    assert.deepEqual(Object.keys(a.stats).sort(), ['arcProgress', 'maxError', 'meanError', 'optimizeMs', 'skating', 'skatingBeforeLock', 'sliding', 'slidingBeforeLock']);
     for (const [k, v] of Object.entries(a.stats)) assert.ok(Number.isFinite(v), `${k} = ${v}`);
     assert.ok(a.frames > 0 && a.frames % ERD.pooling === 0, `${a.frames} frames, whole latent steps`);
     assert.equal(a.positions.length, a.frames * J * 3);
@@ -245,6 +245,8 @@ describe('latent ERD in the page', { timeout: 300_000 }, () => {
     assert.deepEqual(b.positions, a.positions);
     const raw = await run({ model: 'latent-erd', points: BEND, gait: 'walk', seed: 1, footLock: false });
     assert.ok(Math.abs(raw.stats.skating - a.stats.skatingBeforeLock) < 1e-6, 'skating before the lock is the unlocked motion\'s');
+    assert.ok(Math.abs(raw.stats.sliding - a.stats.slidingBeforeLock) < 1e-6, 'sliding before the lock is the unlocked motion\'s');
+    assert.ok(a.stats.sliding < a.stats.slidingBeforeLock, `sliding ${a.stats.sliding} vs ${a.stats.slidingBeforeLock} before the lock`);
     const slow = await run({ model: 'latent-erd', points: BEND, seed: 1, speed: 0.8 });
     assert.notDeepEqual(slow.positions, a.positions, 'speed changes the walk');
     console.log(`# latent ERD followPath (placeholder models): ${JSON.stringify(a.stats)}`);

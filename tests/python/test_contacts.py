@@ -46,3 +46,33 @@ def test_running_has_flight_phases(mocap):
     c = clip_contacts(load_clip(mocap, info, 30))
     assert c.mean() < 0.45
     assert (c.max(axis=1) == 0).any()  # both feet in the air at some point
+
+
+def _pose_with_left_foot(height: float, x: float) -> np.ndarray:
+    """Canonical rest-like pose: every joint at 1 m except the left foot's three points (lowest at `height`, moved
+    `x` along x) and the right foot's (0.5 m up)."""
+    from training.mocap.skeleton import canonical_skeleton
+    skel = canonical_skeleton()
+    p = np.ones((len(skel.joints), 3))
+    for k, name in enumerate(("LeftFoot", "LeftToeBase", "LeftToeBase_end")):
+        p[skel.index(name)] = [x, height + 0.04 * (2 - k), 0.1 * k]
+    for name in ("RightFoot", "RightToeBase", "RightToeBase_end"):
+        p[skel.index(name), 1] = 0.5
+    return p
+
+
+def test_shown_motion_labels_combine_the_bit_with_height_and_speed():
+    from training.contact_labels import ContactLabeller
+
+    def run(frames):
+        lab, x, out = ContactLabeller(fps=30.0), 0.0, []
+        for h, v, bit in frames:
+            x += v / 30.0
+            out.append(int(lab.step(_pose_with_left_foot(h, x), [bit, 0])[0]))
+        return out
+
+    assert run([(0.01, 0, 0), (0.01, 0.5, 0), (0.01, 2.5, 0)]) == [1, 1, 0]  # resting, bit off: planted while slow
+    assert run([(0.2, 3, 0), (0.03, 3, 0), (0.03, 3, 0)]) == [0, 0, 0]  # a swing skimming the floor
+    assert run([(0.01, 0, 0), (0.05, 0, 0), (0.01, 1.2, 0), (0.07, 0, 0)]) == [1, 1, 1, 0]  # hysteresis band
+    assert run([(0.05, 0, 0)]) == [0]
+    assert run([(0.08, 3, 1)]) == [1] and run([(0.2, 0, 1)]) == [0]  # the bit near the floor, not in the air

@@ -93,13 +93,14 @@ def test_the_check_finds_violations(tmp_path):
 
 # What each part of training/ may import of the others (docs/architecture.md): the pipeline runs one way,
 # corpus readers → datasets → networks → one folder per model; shared modules sit beside them.
-SHARED = {"paths", "runs", "metrics", "footlock", "onnx"}
+SHARED = {"paths", "runs", "metrics", "contact_labels", "footlock", "onnx"}
 MAY_IMPORT = {
     "paths": set(),
     "runs": {"paths"},
     "mocap": {"paths"},
     "metrics": {"mocap"},
-    "footlock": {"mocap"},
+    "contact_labels": {"mocap", "metrics"},
+    "footlock": {"mocap", "metrics", "contact_labels"},
     "control": set(),
     "onnx": {"paths"},
     "data": {"mocap", "paths", "metrics", "control"},

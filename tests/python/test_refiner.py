@@ -11,7 +11,7 @@ from training.paths import MODELS_DIR
 from training.refiner.exporting import FIXTURE
 from training.refiner.graph import OUTPUTS, export_onnx, parity_error, refiner_from_onnx, step_parity, stream_inputs
 from training.data.features import FeatureCodec
-from training.footlock import BLEND_IN, TOE_GROUND_HEIGHT, FootLock, foot_lock, two_bone_ik
+from training.footlock import BLEND_IN, FLAT_PITCH, TOE_GROUND_HEIGHT, FootLock, foot_lock, two_bone_ik
 from training.models.refiner import (FeatureGeometry, Refiner, RefinerStep, rotvec_to_matrix, straight_through_bits)
 from training.mocap.rotations import axis_rotation
 from training.mocap.skeleton import canonical_skeleton
@@ -244,6 +244,38 @@ def test_foot_lock_puts_planted_toes_on_the_ground_without_popping(sliding_walk)
     unblended = foot_lock(pos, contacts, blend_in=1, blend_out=1)
     assert jerk(out) < 0.12
     assert jerk(out) < 0.5 * jerk(unblended)
+
+
+def test_foot_lock_holds_the_heel_of_a_flat_planted_foot(walk):
+    """The raw feet swivel about their toes (heading +-0.3 rad) while planted: locked, a flat planted foot's heel
+    (the ankle) stays nearly where it was, as its toe does; raw, it sweeps about a centimetre per frame."""
+    codec, x = walk
+    pos = codec.positions(x)
+    contacts = (x[:, -2:] > 0.5).astype(np.uint8)
+    swivel = pos.copy()
+    t = np.arange(len(pos)) / 30.0
+    heel_steps = {"raw": [], "locked": []}
+    for side, (ankle, toe, end) in enumerate((("LeftFoot", "LeftToeBase", "LeftToeBase_end"),
+                                             ("RightFoot", "RightToeBase", "RightToeBase_end"))):
+        a, k, e = SKEL.index(ankle), SKEL.index(toe), SKEL.index(end)
+        turn = axis_rotation("y", 0.3 * np.sin(2 * np.pi * 2.0 * t + side))
+        for j in (a, e):
+            swivel[:, j] = pos[:, k] + np.einsum("fij,fj->fi", turn, pos[:, j] - pos[:, k])
+    out = foot_lock(swivel, contacts)
+    for side, (ankle, toe) in enumerate((("LeftFoot", "LeftToeBase"), ("RightFoot", "RightToeBase"))):
+        a, k = SKEL.index(ankle), SKEL.index(toe)
+        c = contacts[:, side] > 0
+        held = c[1:] & c[:-1] & np.roll(c, 1)[1:] & np.roll(c, 2)[1:] & np.roll(c, 3)[1:]  # past the blend-in
+        foot = swivel[:, k] - swivel[:, a]
+        pitch = np.arctan2(-foot[:, 1], np.hypot(foot[:, 0], foot[:, 2]))
+        flat = held & (pitch[1:] < FLAT_PITCH) & (pitch[:-1] < FLAT_PITCH)
+        for name, p in (("raw", swivel), ("locked", out)):
+            heel_steps[name].append(np.linalg.norm(np.diff(p[:, a][:, [0, 2]], axis=0), axis=-1)[flat])
+    raw, locked = (np.concatenate(heel_steps[n]) for n in ("raw", "locked"))
+    assert len(raw) > 20
+    assert raw.mean() > 0.005
+    # held: what is left is the raw foot's pitch changing the heel's reach from the toe (about a millimetre a frame)
+    assert locked.mean() < 0.15 * raw.mean()
 
 
 def test_foot_lock_leaves_free_feet_alone():

@@ -2,7 +2,7 @@
 // (tests/fixtures/footlock_reference.json, written by python -m training.fixtures.footlock), and what it
 // must do on its own: planted toes stay put and on the ground, bones keep their lengths, no popping.
 import { describe, expect, it } from 'vitest';
-import { FOOT_LOCK_DEFAULTS, FootLock, footLock, twoBoneIK } from '../../web/motion/footLock';
+import { FLAT_PITCH, FOOT_LOCK_DEFAULTS, FootLock, footLock, RELEASE_LIFT, STEEP_PITCH, twoBoneIK } from '../../web/motion/footLock';
 import { readRepoFile } from './corpus';
 
 interface Stream {
@@ -19,7 +19,7 @@ interface Fixture {
   offsets: number[];
   fps: number;
   legs: string[];
-  settings: { toe_ground_height: number; blend_in_frames: number; blend_out_frames: number; reach: number; pole_bias: number };
+  settings: { toe_ground_height: number; blend_in_frames: number; blend_out_frames: number; reach: number; pole_bias: number; flat_pitch: number; steep_pitch: number; release_lift: number };
   streams: Stream[];
 }
 
@@ -67,6 +67,7 @@ describe('foot lock parity with training/footlock.py', () => {
       reach: s.reach,
       poleBias: s.pole_bias,
     });
+    expect([FLAT_PITCH, STEEP_PITCH, RELEASE_LIFT]).toEqual([s.flat_pitch, s.steep_pitch, s.release_lift]);
     expect(refiner.footlock.toe_ground_height).toBe(s.toe_ground_height);
     expect(refiner.footlock.blend_in_frames).toBe(s.blend_in_frames);
     expect(refiner.footlock.blend_out_frames).toBe(s.blend_out_frames);

@@ -10,7 +10,8 @@ shipped ONNX models unless a row says otherwise.
 - Seams: the pose change across the boundary between two emitted 4-frame steps against the change inside a
   step and between real frames, for several look-aheads.
 - Foot sliding: by contact bits and by the lowest foot point's height (metrics.py), before and after the
-  foot lock, with the held-out real clips measured the same way.
+  foot lock (contacts labelled on the motion, then the lock: footlock.plant_feet, as the page does), with the
+  held-out real clips measured the same way.
 """
 from __future__ import annotations
 
@@ -26,7 +27,7 @@ from .. import metrics
 from ..control import random_control
 from ..data.features import heading_of
 from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, POSITION_DIM, WindowCorpus, ground_frame, motion_rows, smooth
-from ..footlock import foot_lock
+from ..footlock import plant_feet
 from ..generator.sampling import sample_mixture, snap_contacts
 from ..generator.shipped import ShippedGenerator
 from ..mocap.rotations import quat_to_matrix
@@ -261,7 +262,7 @@ def random_run(shipped: Shipped, seed: int, frames: int, lookahead: int | None =
 
 def sliding(runs: list[tuple[np.ndarray, np.ndarray]], fps: float) -> dict:
     skel = canonical_skeleton()
-    locked = [(foot_lock(p, c, skel), c) for p, c in runs]
+    locked = [plant_feet(p, c, fps, skel) for p, c in runs]  # what the page shows: labelled contacts, then the lock
     return {"contact_bits_before": round(metrics.foot_skating_clips(runs, fps, skel), 3),
             "contact_bits_after": round(metrics.foot_skating_clips(locked, fps, skel), 3),
             "low_foot_before": round(metrics.low_foot_sliding_clips([p for p, _ in runs], fps, skel), 3),

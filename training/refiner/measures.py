@@ -90,8 +90,9 @@ def variant_measures(seqs: list[DecodedMotion], fps: float, skel, real_speeds: d
     """Skating, contact share and end-effector speeds pooled over `seqs`; with real_speeds, the W1 distances to them."""
     planted = np.concatenate([metrics.planted_toe_speeds(s.positions, s.contacts, fps, skel) for s in seqs])
     speeds = {k: np.concatenate([point_speeds(s.positions, fps, skel)[k] for s in seqs]) for k in SPEED_POINTS}
+    low = np.concatenate([metrics.low_foot_speeds(s.positions, fps, skel) for s in seqs])
     m = {"foot_skating": float(planted.mean()), "planted_toe_speed_p90": float(np.percentile(planted, 90)),
-         "planted_pairs": int(len(planted)),
+         "planted_pairs": int(len(planted)), "low_foot_sliding": float(low.mean()), "low_foot_pairs": int(len(low)),
          "contact_share": np.concatenate([s.contacts for s in seqs]).mean(0).tolist(),
          "speeds": {k: metrics.summary(v) for k, v in speeds.items()}}
     if real_speeds is not None:

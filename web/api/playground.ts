@@ -100,9 +100,12 @@ export interface FollowPathStats {
   arcProgress: number;
   /** Wall-clock milliseconds the optimisation took. */
   optimizeMs: number;
-  /** Foot skating (m/s, mean planted-toe speed) of the motion, and of the optimised motion before the foot lock. */
+  /** Foot skating (m/s, mean planted-toe speed by the returned contacts) of the motion, and of the motion before the foot lock (by the model's own contact bits). */
   skating: number;
   skatingBeforeLock: number;
+  /** Foot sliding (m/s): the lowest foot point's horizontal speed while within 4 cm of the floor (no contacts needed), the same two. */
+  sliding: number;
+  slidingBeforeLock: number;
 }
 
 export type FollowedPathMotion = Motion & { contacts: Uint8Array; stats: FollowPathStats };
@@ -459,14 +462,14 @@ export function createPlayground(app: App): Playground {
           const speed = checkPathSpeed(optional(o.speed, LATENT_PATH_SPEED[gait]));
           const { client } = await app.latentErd.load();
           const m = await client.followPath({ points, gait, seed, speed, footLock: lockFeet }, { signal });
-          const { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock } = m.stats;
-          return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, stats: { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock } };
+          const { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock, sliding, slidingBeforeLock } = m.stats;
+          return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, stats: { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock, sliding, slidingBeforeLock } };
         }
         const fitSigma = checkFitSigma(optional(o.fitTolerance, 0.1), 'fitTolerance');
         const { client } = await app.generator.load();
         const m = await client.followPath({ points, gait, seed, fitSigma, footLock: lockFeet }, { signal });
-        const { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock } = m.stats;
-        return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, stats: { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock } };
+        const { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock, sliding, slidingBeforeLock } = m.stats;
+        return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, stats: { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock, sliding, slidingBeforeLock } };
       });
     },
 

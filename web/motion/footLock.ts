@@ -6,6 +6,8 @@
 // once per frame, in order, for live streams; footLock() for a whole motion), changes only the knees, ankles
 // and feet, and keeps every bone length exactly. Arithmetic is in double precision like the Python.
 
+import { ContactLabeller, labelContacts } from './contactLabels';
+
 export interface FootLockSettings {
   /** Height (m) a planted toe point is brought to. */
   groundHeight: number;
@@ -28,6 +30,12 @@ export const FOOT_LOCK_DEFAULTS: Readonly<FootLockSettings> = Object.freeze({
   poleBias: 0.05,
 });
 
+/** Foot pitch (radians, ankle-to-toe below level) up to which a planted foot's heading is held fully, and from which not at all (footlock.py FLAT_PITCH, STEEP_PITCH). */
+export const FLAT_PITCH = 0.6;
+/** The most (m) a released foot is lifted while it catches up with its raw position (footlock.py RELEASE_LIFT). */
+export const RELEASE_LIFT = 0.08;
+export const STEEP_PITCH = 1.0;
+
 /** Per leg: hip, knee, ankle, toe, toe end (footlock.py LEGS). */
 export const LEG_JOINTS = [
   ['LeftUpLeg', 'LeftLeg', 'LeftFoot', 'LeftToeBase', 'LeftToeBase_end'],
@@ -35,6 +43,7 @@ export const LEG_JOINTS = [
 ] as const;
 
 type V3 = [number, number, number];
+type Pair = [number, number];
 
 const sub = (a: V3, b: V3): V3 => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
 const add = (a: V3, b: V3): V3 => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
@@ -98,21 +107,27 @@ function pivotFoot(hip: V3, ankleTarget: V3, toeTarget: V3, reach: number): V3 |
   return add(centre, scale(off, rho / n));
 }
 
-/** `w` turned by the smallest rotation taking direction a to direction b (footlock.py rotation_between). */
-function rotateBetween(a: V3, b: V3, w: V3): V3 {
-  a = scale(a, 1 / norm(a));
-  b = scale(b, 1 / norm(b));
-  const v = cross(a, b), c = dot(a, b);
-  if (c < -1 + 1e-9) {
-    // opposite: any half turn will do
-    let axis = cross(a, [1, 0, 0]);
-    if (!(norm(axis) > 1e-6)) axis = cross(a, [0, 1, 0]);
-    axis = scale(axis, 1 / norm(axis));
-    return sub(scale(axis, 2 * dot(axis, w)), w);
-  }
-  // (I + K + K²/(1 + c)) w with K w = v × w
-  const vw = cross(v, w);
-  return add(add(w, vw), scale(cross(v, vw), 1 / (1 + c)));
+/** Heading (radians, 0 = +z, positive towards +x) of a foot's ankle-to-toe vector on the ground (footlock.py foot_heading). */
+export function footHeading(toeFromAnkle: V3): number {
+  return Math.atan2(toeFromAnkle[0], toeFromAnkle[2]);
+}
+
+/** How much of a planted foot's heading is held: 1 up to FLAT_PITCH, smoothly 0 at STEEP_PITCH (footlock.py flatness). */
+export function flatness(toeFromAnkle: V3): number {
+  const pitch = Math.atan2(-toeFromAnkle[1], Math.hypot(toeFromAnkle[0], toeFromAnkle[2]));
+  return 1 - smoothstep((pitch - FLAT_PITCH) / (STEEP_PITCH - FLAT_PITCH));
+}
+
+/** a in [−π, π) (footlock.py wrap_angle). */
+export function wrapAngle(a: number): number {
+  const t = (a + Math.PI) % (2 * Math.PI);
+  return (t < 0 ? t + 2 * Math.PI : t) - Math.PI;
+}
+
+/** `v` with `angle` added to its heading, turned about the vertical (footlock.py turn_about_y). */
+function turnAboutY(v: V3, angle: number): V3 {
+  const c = Math.cos(angle), s = Math.sin(angle);
+  return [c * v[0] + s * v[2], v[1], -s * v[0] + c * v[2]];
 }
 
 interface FootState {
@@ -126,6 +141,10 @@ interface FootState {
   planted: number;
   /** Frames left of the blend-out. */
   release: number;
+  /** Held headings (radians) of the foot (ankle → toe) and the toes (toe → toe tip), from the contact's start. */
+  heading: Pair;
+  /** The same in the last planted frame, or null before any contact. */
+  lockedHeading: Pair | null;
 }
 
 /** Streaming foot lock: `step` once per frame, in order; `reset` before a new motion. */
@@ -160,7 +179,7 @@ export class FootLock {
   }
 
   reset(): void {
-    this.feet = [0, 1].map(() => ({ anchor: null, startY: 0, locked: null, planted: 0, release: 0 }));
+    this.feet = [0, 1].map(() => ({ anchor: null, startY: 0, locked: null, planted: 0, release: 0, heading: [0, 0], lockedHeading: null }));
   }
 
   /**
@@ -183,40 +202,49 @@ export class FootLock {
       const { index, l1, l2 } = this.legs[side];
       const [hipJ, kneeJ, ankleJ, toeJ, endJ] = index;
       const rawToe = at(toeJ), rawAnkle = at(ankleJ), hip = at(hipJ);
+      const rawToeFromAnkle = sub(rawToe, rawAnkle);
+      const rawParts: [V3, V3] = [rawToeFromAnkle, sub(at(endJ), rawToe)]; // the foot and the toes
+      const rawHeading: Pair = [footHeading(rawParts[0]), footHeading(rawParts[1])];
+      const flat: Pair = [flatness(rawParts[0]), flatness(rawParts[1])];
       const planted = contacts[side] > 0;
       let target: V3;
+      let heading: Pair;
       if (planted) {
         if (foot.planted === 0) {
-          // contact starts where the toe is drawn now: no jump
+          // contact starts where the foot is drawn now: no jump
           const start = this.drawnToe(foot, rawToe);
           foot.anchor = [start[0], start[2]];
           foot.startY = start[1];
+          foot.heading = this.drawnHeading(foot, rawHeading, flat);
         }
         const w = blendIn > 0 ? smoothstep(foot.planted / blendIn) : 1;
         foot.planted++;
         target = [foot.anchor![0], (1 - w) * foot.startY + w * groundHeight, foot.anchor![1]];
+        heading = [0, 1].map((k) => rawHeading[k] + flat[k] * wrapAngle(foot.heading[k] - rawHeading[k])) as Pair;
       } else {
         foot.planted = 0;
         if (foot.release <= 0) continue; // free foot: raw pose
         target = this.drawnToe(foot, rawToe);
+        heading = this.drawnHeading(foot, rawHeading, flat);
         foot.release--;
       }
-      const toeFromAnkle = sub(rawToe, rawAnkle);
+      const toeFromAnkle = turnAboutY(rawParts[0], heading[0] - rawHeading[0]);
+      const endFromToe = turnAboutY(rawParts[1], heading[1] - rawHeading[1]);
       let ankleTarget = sub(target, toeFromAnkle);
       const pivoted = pivotFoot(hip, ankleTarget, target, reach * (l1 + l2));
       if (pivoted) ankleTarget = pivoted;
-      const flat: V3 = [toeFromAnkle[0], 0, toeFromAnkle[2]];
-      const forward = scale(flat, 1 / Math.max(norm(flat), 1e-9));
+      // the knee follows the raw foot: a steep foot's heading is noise
+      const level: V3 = [rawToeFromAnkle[0], 0, rawToeFromAnkle[2]];
+      const forward = scale(level, 1 / Math.max(norm(level), 1e-9));
       const [newKnee, newAnkle] = twoBoneIK(hip, at(kneeJ), ankleTarget, l1, l2, reach, forward, poleBias);
       let newToe: V3;
       if (!pivoted) {
         // the foot moves rigidly with the ankle
-        const shift = sub(newAnkle, rawAnkle);
-        newToe = add(rawToe, shift);
-        put(endJ, add(at(endJ), shift));
+        newToe = add(newAnkle, toeFromAnkle);
+        put(endJ, add(newToe, endFromToe));
       } else {
-        // the foot turns about the toe (heel lifts): ankle → toe and toe → toe end turned alike
-        put(endJ, add(target, rotateBetween(toeFromAnkle, sub(target, newAnkle), sub(at(endJ), rawToe))));
+        // the foot turns about the toe (heel lifts); the toes stay as they are
+        put(endJ, add(target, endFromToe));
         newToe = target;
       }
       put(toeJ, newToe);
@@ -225,17 +253,30 @@ export class FootLock {
       if (planted) {
         if (norm(sub(newAnkle, ankleTarget)) > 1e-6) foot.anchor = [newToe[0], newToe[2]]; // out of reach: the anchor follows the body
         foot.locked = newToe;
+        foot.lockedHeading = foot.heading;
         foot.release = blendOut;
       }
     }
     return out;
   }
 
-  /** Where the toe is drawn this frame if nothing new happens: the raw toe, or during a release the blend from the last locked position. */
+  /** The foot's and toes' headings this frame if nothing new happens: the raw ones, or during a release the blend from the last locked ones (the toe's weight times each part's flatness, the shorter way round). */
+  private drawnHeading(foot: FootState, rawHeading: Pair, flat: Pair): Pair {
+    const locked = foot.lockedHeading;
+    if (foot.release <= 0 || locked === null) return rawHeading;
+    const w = smoothstep(foot.release / this.settings.blendOut);
+    return [0, 1].map((k) => rawHeading[k] + w * flat[k] * wrapAngle(locked[k] - rawHeading[k])) as Pair;
+  }
+
+  /** Where the toe is drawn this frame if nothing new happens: the raw toe, or during a release the blend from the last locked position (with a lift, footlock.py _drawn_toe). */
   private drawnToe(foot: FootState, rawToe: V3): V3 {
     if (foot.release <= 0 || !foot.locked) return rawToe;
     const w = smoothstep(foot.release / this.settings.blendOut);
-    return add(scale(foot.locked, w), scale(rawToe, 1 - w));
+    // A foot catching up with its raw position steps over the floor rather than dragging along it: a lift of half
+    // the horizontal gap (at most RELEASE_LIFT), zero at both ends of the blend.
+    const gap = Math.hypot(foot.locked[0] - rawToe[0], foot.locked[2] - rawToe[2]);
+    const arc = 4 * w * (1 - w) * Math.min(0.5 * gap, RELEASE_LIFT);
+    return [w * foot.locked[0] + (1 - w) * rawToe[0], w * foot.locked[1] + (1 - w) * rawToe[1] + arc, w * foot.locked[2] + (1 - w) * rawToe[2]];
   }
 }
 
@@ -262,4 +303,45 @@ export function footLock(
     out.set(pose, f * n);
   }
   return out;
+}
+
+/**
+ * Contacts labelled on the shown motion (contactLabels.ts: the model's bit with the foot's height and speed),
+ * then the lock on those labels, frame by frame: what every locomotion mode shows.
+ */
+export class PlantedFeet {
+  private readonly labeller: ContactLabeller;
+  private readonly lock: FootLock;
+
+  constructor(joints: readonly string[], offsets: ArrayLike<number>, fps: number, settings: Partial<FootLockSettings> = {}) {
+    this.labeller = new ContactLabeller(joints, fps);
+    this.lock = new FootLock(joints, offsets, settings);
+  }
+
+  reset(): void {
+    this.labeller.reset();
+    this.lock.reset();
+  }
+
+  /** One frame: `pose` (joints × 3, world) and the model's bits → the labels in `labels` and the locked pose in `out` (may be `pose`). */
+  step(pose: Float32Array | Float64Array, bits: ArrayLike<number>, labels: Uint8Array, out: Float32Array | Float64Array = pose): void {
+    this.labeller.step(pose, bits, labels);
+    this.lock.step(pose, labels, out);
+  }
+}
+
+/**
+ * PlantedFeet over a whole motion: positions (frames × joints × 3) and the model's bits (frames × 2) → the
+ * locked positions (float32) and the labels they were locked with.
+ */
+export function plantFeet(
+  positions: Float32Array | Float64Array,
+  bits: ArrayLike<number>,
+  joints: readonly string[],
+  offsets: ArrayLike<number>,
+  fps: number,
+  settings: Partial<FootLockSettings> = {},
+): { positions: Float32Array; contacts: Uint8Array } {
+  const contacts = labelContacts(positions, bits, joints, fps);
+  return { positions: footLock(positions, contacts, joints, offsets, settings), contacts };
 }

@@ -5,13 +5,15 @@
 //
 // A stream emits one latent step (4 frames) at a time for a control; its frames are the decoded points
 // placed in the world at the stream's root, fitted to the skeleton (web/motion/fitSkeleton.ts: exact bone
-// lengths), with the decoded contacts (channel > 0.5), and foot-locked frame by frame
-// (web/motion/footLock.ts) unless the stream was made without the lock. Frames are handed out in any
+// lengths), and, unless the stream was made without the lock, contacts labelled on those frames from the
+// decoded contact channels (> 0.5) with the feet's heights and speeds (web/motion/contactLabels.ts) and
+// planted feet locked frame by frame (web/motion/footLock.ts PlantedFeet); without the lock the contacts
+// are the decoded channels as they are. Frames are handed out in any
 // chunk sizes (`take`): a step's frames not yet taken wait for the next chunk, so chunks join up exactly.
 import type { InferenceSession, TensorConstructor } from 'onnxruntime-web';
 import { randomControl, type Root } from '../motion/control';
 import { SkeletonFitter } from '../motion/fitSkeleton';
-import { FootLock } from '../motion/footLock';
+import { PlantedFeet } from '../motion/footLock';
 import { latentSeedIndex, type LatentErdInfo, type LatentErdModel, type ManifoldInfo } from '../model/latentErdInfo';
 import { LatentStream, streamLayout, type LatentBackend, type StreamLayout } from '../model/latentStream';
 import { checkpoint } from './cancellation';
@@ -62,7 +64,8 @@ export interface LatentErdStream {
   readonly params: LatentStreamParams;
   readonly seedIndex: number;
   readonly stream: LatentStream;
-  readonly lock: FootLock | null;
+  /** Contact labels and the foot lock, or null for a stream made without the lock. */
+  readonly feet: PlantedFeet | null;
   /** Frames taken so far. */
   frame: number;
   /** The per-frame control it follows when advanced without one (given, or random from the seed; frames × 3). */
@@ -203,8 +206,8 @@ export class LatentErdCore {
     const given = params.control !== undefined;
     const control = given ? Float64Array.from(params.control!) : new Float64Array(0);
     if (given && (control.length === 0 || control.length % 3 !== 0)) throw new Error(`control must hold [forward, sideways, turn] triples, got ${control.length} values`);
-    const lock = params.footLock === false ? null : new FootLock(this.skeleton.joints, this.skeleton.offsets);
-    return { params, seedIndex, stream, lock, frame: 0, control, endless: !given, pending: [] };
+    const feet = params.footLock === false ? null : new PlantedFeet(this.skeleton.joints, this.skeleton.offsets, this.erd.fps);
+    return { params, seedIndex, stream, feet, frame: 0, control, endless: !given, pending: [] };
   }
 
   streamInfo(s: LatentErdStream): LatentStreamInfo {
@@ -222,11 +225,15 @@ export class LatentErdCore {
     const out = await s.stream.step(control, future, look(signal));
     const predicted = Float32Array.from(out.positions);
     const positions = this.fitter.fit(predicted).positions;
-    if (s.lock) {
+    const contacts = out.contacts;
+    if (s.feet) {
       const n = joints * 3;
+      const bits = new Uint8Array(2);
       for (let f = 0; f < pooling; f++) {
         const pose = positions.subarray(f * n, (f + 1) * n);
-        s.lock.step(pose, out.contacts.subarray(f * 2, f * 2 + 2), pose);
+        const labels = contacts.subarray(f * 2, f * 2 + 2);
+        bits.set(labels);
+        s.feet.step(pose, bits, labels);
       }
     }
     s.pending.push({
@@ -235,7 +242,7 @@ export class LatentErdCore {
       rows: Float32Array.from(out.rows),
       predicted,
       positions,
-      contacts: out.contacts,
+      contacts,
       roots: out.roots,
       control: Float32Array.from(control),
       erdCalls: s.stream.erdCalls - calls,

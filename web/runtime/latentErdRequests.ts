@@ -7,8 +7,8 @@
 // repeated for the step's 4 frames (the look-ahead repeats it too: the future is not known). The result
 // keeps the generator's return shapes and stats (optimizerRequests.ts), measured the same way.
 import { controlAlongPath, controlTowardHeading, PolylinePath, type Control } from '../motion/control';
-import { footLock } from '../motion/footLock';
-import { footSkating } from '../motion/footSkating';
+import { plantFeet } from '../motion/footLock';
+import { footStats } from '../motion/footSkating';
 import { checkSchedule, checkTarget, SPEED_WINDOW, type ControlTarget } from '../optimizer/liveControl';
 import { checkFootLock, checkGait, checkSeconds, checkSeed, optional } from '../optimizer/options';
 import { angleDifference, checkPathPoints, GroundPath, moveBack, relativeToStart } from '../optimizer/path';
@@ -114,23 +114,22 @@ export class LatentErdRequests {
     progress(1);
     const chunk = core.take(s, core.pendingFrames(s));
     const { joints, offsets } = core.skeleton;
-    const fitted = chunk.positions;
-    const locked = lock ? footLock(fitted, chunk.contacts, joints, offsets) : fitted;
-    const skating = (positions: Float32Array) => footSkating({ fps, frames: chunk.frames, joints, parents: core.skeleton.parents, positions, contacts: chunk.contacts });
+    const fitted = { positions: chunk.positions, contacts: chunk.contacts };
+    const shown = lock ? plantFeet(fitted.positions, fitted.contacts, joints, offsets, fps) : fitted;
     const stats = {
-      ...pathErrors(ground, locked, joints.length, chunk.frames),
+      ...pathErrors(ground, shown.positions, joints.length, chunk.frames),
       optimizeMs: performance.now() - started,
       windows: s.stream.steps,
       particleSteps: s.stream.erdCalls,
-      skating: skating(locked),
-      skatingBeforeLock: skating(fitted),
+      ...footStats({ fps, skeleton: core.skeleton }, chunk.frames, shown, fitted),
     };
     const flat = new Float32Array(ground.count * 2);
     for (let i = 0; i < ground.count; i++) {
       flat[2 * i] = ground.xs[i] + origin[0];
       flat[2 * i + 1] = ground.zs[i] + origin[1];
     }
-    chunk.positions = moveBack(locked, origin);
+    chunk.positions = moveBack(shown.positions, origin);
+    chunk.contacts = shown.contacts;
     moveBack(chunk.predicted, origin);
     moveRootsBack(chunk, origin);
     chunk.computeMs = stats.optimizeMs;
@@ -208,7 +207,7 @@ export class LatentErdRequests {
       computeMsPerFrame.fill(ms / batchFrames[i], at, at + batchFrames[i]);
       at += batchFrames[i];
     });
-    if (lock) chunk.positions = footLock(chunk.positions, chunk.contacts, core.skeleton.joints, core.skeleton.offsets);
+    if (lock) ({ positions: chunk.positions, contacts: chunk.contacts } = plantFeet(chunk.positions, chunk.contacts, core.skeleton.joints, core.skeleton.offsets, fps));
     chunk.computeMs = batchMs.reduce((a, b) => a + b, 0);
     return {
       ...chunk,

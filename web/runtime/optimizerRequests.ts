@@ -8,14 +8,14 @@ import { followPath, gaitSeeds, type Gait } from '../optimizer/pathFollower';
 import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed, optional } from '../optimizer/options';
 import { checkSchedule, LiveController, simulateControl } from '../optimizer/liveControl';
 import { checkPathPoints, GroundPath, moveBack, relativeToStart } from '../optimizer/path';
-import { FootLock, footLock } from '../motion/footLock';
-import { footSkating } from '../motion/footSkating';
+import { PlantedFeet, plantFeet } from '../motion/footLock';
+import { footStats } from '../motion/footSkating';
 import type { StepFn } from '../optimizer/rollout';
 import type { GeneratorCore } from './generatorCore';
 import type { ControlChunkReply, ControlStartParams, ControlTargetParams, FollowPathChunk, FollowPathParams, SimulateControlParams, SimulatedControlChunk, StreamInfo } from './protocol';
 
 export class OptimizerRequests {
-  private live: { controller: LiveController; seedIndex: number; lock: FootLock } | undefined;
+  private live: { controller: LiveController; seedIndex: number; feet: PlantedFeet } | undefined;
 
   constructor(private readonly core: GeneratorCore) {}
 
@@ -63,22 +63,21 @@ export class OptimizerRequests {
       flat[2 * i] = path.xs[i] + origin[0];
       flat[2 * i + 1] = path.zs[i] + origin[1];
     }
-    const locked = lock ? this.lock(r.positions, r.contacts) : r.positions;
-    const skating = (pos: Float32Array) => footSkating({ fps: info.fps, frames: r.frames, joints: info.skeleton.joints, parents: info.skeleton.parents, positions: pos, contacts: r.contacts });
-    const stats = { ...r.stats, skating: skating(locked), skatingBeforeLock: skating(r.positions) };
-    return { frames: r.frames, features: r.features, positions: moveBack(locked, origin), contacts: r.contacts, rootHeading: r.rootHeading, seedIndex: r.seedIndex, startFrame: 0, stats, path: flat };
+    const shown = lock ? this.plant(r.positions, r.contacts) : { positions: r.positions, contacts: r.contacts };
+    const stats = { ...r.stats, ...footStats(this.core.info, r.frames, shown, { positions: r.positions, contacts: r.contacts }) };
+    return { frames: r.frames, features: r.features, positions: moveBack(shown.positions, origin), contacts: shown.contacts, rootHeading: r.rootHeading, seedIndex: r.seedIndex, startFrame: 0, stats, path: flat };
   }
 
-  /** The foot lock over a whole motion of the generator's skeleton (hips and above unchanged). */
-  private lock(positions: Float32Array, contacts: Uint8Array): Float32Array {
-    const { joints, offsets } = this.core.info.skeleton;
-    return footLock(positions, contacts, joints, offsets);
+  /** Contacts labelled on a whole motion of the generator's skeleton and planted feet locked (hips and above unchanged). */
+  private plant(positions: Float32Array, bits: Uint8Array): { positions: Float32Array; contacts: Uint8Array } {
+    const { skeleton, fps } = this.core.info;
+    return plantFeet(positions, bits, skeleton.joints, skeleton.offsets, fps);
   }
 
   controlStart(p: ControlStartParams): StreamInfo {
     this.live = undefined;
     const { joints, offsets } = this.core.info.skeleton;
-    this.live = { ...this.controller(checkSeed(p.seed), checkGait(p.gait)), lock: new FootLock(joints, offsets) };
+    this.live = { ...this.controller(checkSeed(p.seed), checkGait(p.gait)), feet: new PlantedFeet(joints, offsets, this.core.info.fps) };
     return { seedIndex: this.live.seedIndex, seedName: this.core.info.seeds[this.live.seedIndex].name };
   }
 
@@ -87,11 +86,15 @@ export class OptimizerRequests {
     if (!live) throw new Error('no control stream: send controlStart first');
     const startFrame = live.controller.frame;
     const chunk = await live.controller.advance({ speed: p.speed, heading: p.heading }, p.frames, p.particles);
-    // Planted feet locked frame by frame, continuing across batches (as simulateControl's whole-run lock).
+    // Contacts labelled and planted feet locked frame by frame, continuing across batches (as simulateControl's
+    // whole-run lock); the chunk's contacts become the labels.
     const n = this.core.info.skeleton.joints.length * 3;
+    const bits = new Uint8Array(2);
     for (let f = 0; f < chunk.frames; f++) {
       const pose = chunk.positions.subarray(f * n, (f + 1) * n);
-      live.lock.step(pose, chunk.contacts.subarray(f * 2, f * 2 + 2), pose);
+      const labels = chunk.contacts.subarray(f * 2, f * 2 + 2);
+      bits.set(labels);
+      live.feet.step(pose, bits, labels);
     }
     return { ...chunk, seedIndex: live.seedIndex, startFrame };
   }
@@ -135,7 +138,7 @@ export class OptimizerRequests {
       out.computeMs.fill(c.computeMs / c.frames, at, at + c.frames);
       at += c.frames;
     }
-    if (lock) out.positions = this.lock(out.positions, out.contacts);
+    if (lock) ({ positions: out.positions, contacts: out.contacts } = this.plant(out.positions, out.contacts));
     return out;
   }
 }

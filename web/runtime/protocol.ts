@@ -161,9 +161,12 @@ export interface FollowPathStatsReply {
   optimizeMs: number;
   windows: number;
   particleSteps: number;
-  /** Foot skating (m/s, planted toe speed) of the returned motion and of the optimised motion before the foot lock. */
+  /** Foot skating (m/s, planted toe speed by the contacts returned) of the returned motion and of the motion before the foot lock (by the model's bits). */
   skating: number;
   skatingBeforeLock: number;
+  /** Foot sliding (m/s, the lowest foot point's speed within 4 cm of the floor; footSkating.ts lowFootSliding), the same two. */
+  sliding: number;
+  slidingBeforeLock: number;
 }
 
 export interface FollowPathChunk extends GeneratedChunk {

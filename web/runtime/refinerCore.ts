@@ -6,7 +6,7 @@
 // the decoded positions. The generator itself is always fed its own raw frames. Independent of where it runs,
 // like GeneratorCore: the generator worker wraps it, unit tests drive it with onnxruntime-web's Node build.
 import type { InferenceSession, TensorConstructor } from 'onnxruntime-web';
-import { FootLock } from '../motion/footLock';
+import { PlantedFeet } from '../motion/footLock';
 import { decodeFeatures, type RootStart } from '../model/featureDecode';
 import type { GeneratorInfo } from '../model/generatorInfo';
 import type { RefinedFrames, RefinerStepInputs, RefinerStepOutputs } from './protocol';
@@ -21,7 +21,8 @@ export interface RefinerStream {
   endsPrev: Float32Array;
   /** Where the refined character stands after the last refined frame (it decodes its own root channels). */
   root: RootStart;
-  lock: FootLock;
+  /** Contacts labelled on the refined frames, and the lock on them. */
+  feet: PlantedFeet;
 }
 
 export class RefinerCore extends SessionCore<RefinerInfo> {
@@ -89,7 +90,7 @@ export class RefinerCore extends SessionCore<RefinerInfo> {
       c: new Float32Array(H),
       endsPrev: this.endEffectors(seedPhysical),
       root: { x: 0, z: 0, heading: 0 },
-      lock: new FootLock(joints, offsets, footLockSettings(this.info)),
+      feet: new PlantedFeet(joints, offsets, this.generator.fps, footLockSettings(this.info)),
     };
   }
 
@@ -115,14 +116,13 @@ export class RefinerCore extends SessionCore<RefinerInfo> {
     stream.root = decoded.end;
     const threshold = this.info.contact_threshold;
     const contacts = decoded.contacts;
-    for (let f = 0; f < frames; f++) {
-      for (let k = 0; k < 2; k++) contacts[f * 2 + k] = features[f * D + D - 2 + k] > threshold ? 1 : 0;
-    }
     const positions = decoded.positions;
     const n = this.generator.skeleton.joints.length * 3;
+    const bits = new Uint8Array(2);
     for (let f = 0; f < frames; f++) {
+      for (let k = 0; k < 2; k++) bits[k] = features[f * D + D - 2 + k] > threshold ? 1 : 0;
       const pose = positions.subarray(f * n, (f + 1) * n);
-      stream.lock.step(pose, contacts.subarray(f * 2, f * 2 + 2), pose);
+      stream.feet.step(pose, bits, contacts.subarray(f * 2, f * 2 + 2));
     }
     return { features, positions, contacts, rootHeading: decoded.rootHeading };
   }

@@ -1,9 +1,9 @@
 // Random walk mode: the generator runs endlessly in its worker (LiveMode), the viewer shows the last
 // ~20 s with the predicted foot contacts. With **refine** the refiner runs behind it (same worker) and the
 // figure shows the refined, foot-locked frames; **side by side** also draws the raw frames of the same
-// samples (grey, to the left). A readout shows the foot skating of what is drawn over the last seconds.
+// samples (grey, to the left). A readout shows the foot sliding of what is drawn over the last seconds.
 
-import { skatingSample } from '../../motion/footSkating';
+import { lowFootSample } from '../../motion/footSkating';
 import type { Motion } from '../../motion/types';
 import type { GeneratedMotion, GeneratorClient } from '../../runtime/generatorClient';
 import { CompanionAligner } from '../../viewer/sideBySide';
@@ -161,11 +161,15 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     return { fps: sk.fps, frames, joints: sk.joints, parents: sk.parents, positions, ...(contacts ? { contacts } : {}) };
   }
 
-  /** Mean planted-toe speed (m/s) over the last SKATING_SECONDS up to the playhead, or NaN without planted pairs. */
+  /**
+   * Foot sliding (m/s) over the last SKATING_SECONDS up to the playhead: the lowest foot point's speed while within
+   * 4 cm of the floor (footSkating.ts lowFootSample), which needs no contact labels, so raw and refined motion are
+   * measured alike; NaN when no foot came near the floor.
+   */
   private skatingOf(motion: Motion | null, playhead: number): number {
-    if (!motion?.contacts) return NaN;
+    if (!motion) return NaN;
     const to = Math.min(playhead + 1, motion.frames);
-    const { sum, count } = skatingSample(motion as Motion & { contacts: Uint8Array }, to - Math.round(SKATING_SECONDS * motion.fps), to);
+    const { sum, count } = lowFootSample(motion, to - Math.round(SKATING_SECONDS * motion.fps), to);
     return count ? sum / count : NaN;
   }
 
