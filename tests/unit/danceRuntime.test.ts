@@ -1,6 +1,7 @@
 // The dance step loop (web/runtime/danceCore.ts) on the shipped acLSTM model, run by onnxruntime-web's
 // Node build (the same wasm runtime the browser worker uses): one-step parity with the Python
-// onnxruntime fixture, determinism, streams that continue exactly, fitted frames at exact bone lengths.
+// onnxruntime fixture, determinism, streams that continue exactly, fitted frames at exact bone lengths, and
+// feet planted by their contact labels locked in place.
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { DanceCore } from '../../web/runtime/danceCore';
 import { parseDanceInfo, seedsOfStyle } from '../../web/runtime/danceModel';
@@ -79,6 +80,30 @@ describe('DanceCore', () => {
     expect(meanShift).toBeLessThan(0.05);
     // The first frame follows the seed, whose root ends over the origin.
     expect(Math.hypot(m.positions[0], m.positions[2])).toBeLessThan(0.05);
+  });
+
+  it('labels contacts from the feet and locks planted feet: the toe tips of settled contacts stay put', async () => {
+    const m = await core.generate({ style: 'indian', seed: 5, frames: 300 });
+    expect(m.contacts.length).toBe(300 * 2);
+    const toes = ['lFoot_end', 'rFoot_end'].map((n) => info.skeleton.joints.indexOf(n));
+    const settled: number[] = [], free: number[] = [], rawSettled: number[] = [];
+    for (let f = 4; f < 300; f++) {
+      for (let side = 0; side < 2; side++) {
+        const a = ((f - 1) * J + toes[side]) * 3, b = (f * J + toes[side]) * 3;
+        const step = Math.hypot(m.positions[b] - m.positions[a], m.positions[b + 2] - m.positions[a + 2]);
+        let held = true;
+        for (let k = 0; k <= 4; k++) held &&= m.contacts[(f - k) * 2 + side] === 1;
+        (held ? settled : free).push(step);
+        if (held) rawSettled.push(Math.hypot(m.predicted[b] - m.predicted[a], m.predicted[b + 2] - m.predicted[a + 2]));
+      }
+    }
+    // Both kinds occur; settled toes do not move, except where the network's root glides away from a resting foot
+    // faster than the leg can reach (here 23 of 317 frame pairs, dragged at the body's pace: footLock.ts).
+    expect(settled.length).toBeGreaterThan(100);
+    expect(free.length).toBeGreaterThan(20);
+    expect(settled.filter((d) => d > 1e-5).length).toBeLessThan(0.1 * settled.length);
+    // The network's own points do slide there (the lock is not idle).
+    expect(rawSettled.reduce((x, y) => x + y, 0) / rawSettled.length).toBeGreaterThan(0.002);
   });
 
   it('rejects unknown styles, bad seeds and bad frame counts', async () => {

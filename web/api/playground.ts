@@ -3,7 +3,6 @@
 // whose message says what is wrong, shows the same message on the page, and leaves the scene as it was.
 
 import { exportBVH as exportBVHText } from '../motion/bvh';
-import { detectContacts } from '../motion/contacts';
 import { validateMotion } from '../motion/io';
 import type { Motion } from '../motion/types';
 import type { PlaybackState } from '../viewer/playback';
@@ -306,17 +305,11 @@ async function generateLatent(app: App, o: LatentCall, signal: AbortSignal | und
   return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts };
 }
 
-/** A dance as a Motion: the fitted positions, and foot contacts detected as for imported clips. */
+/** A dance as a Motion: the fitted, foot-locked positions and the contacts they were locked with. */
 async function generateDance(app: App, o: DanceCall, signal: AbortSignal | undefined): Promise<Motion> {
   const { client } = await app.dance(o.model).load();
   const m = await client.generate({ style: o.style, seed: o.seed, frames: o.frames }, { signal });
-  const motion: Motion = { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions };
-  try {
-    motion.contacts = detectContacts(motion);
-  } catch {
-    // no recognisable feet: no contacts
-  }
-  return motion;
+  return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts };
 }
 
 /**

@@ -1,32 +1,20 @@
 // Foot contacts for the motion that is shown: the model's contact bit combined with the foot's own height and
 // speed, so a foot resting on the floor is planted (and locked) even when the bit is off, and a foot in the
-// air is not pulled down because the bit is on. A port of training/contact_labels.py (see its docstring for
+// air is not pulled down because the bit is on. A model without contact bits (the dance models) passes zeros:
+// then height and speed alone decide. A port of training/contact_labels.py (see its docstring for
 // why); tests/fixtures/contact_labels.json checks the two.
 //
 // Per foot and frame, causal (live streams label each frame as it arrives; labelContacts does a whole motion):
-//   - the lowest of the foot's ankle, toe and toe tip this frame; h = its height above the floor (y = 0);
+//   - the lowest of the foot's ankle, toe and toe tip (legs.ts footPoints) this frame; h = its height above the floor (y = 0);
 //   - v = that point's horizontal speed since the previous frame (m/s; 0 in the first frame);
 //   - planted when (h < near and v < slow) or (bit and h < bitNear); once planted it stays while
 //     (h < stayNear and v < staySlow) or (bit and h < bitNear).
 
+import { findLegs, footPoints } from './legs';
+
 /** metres and metres per second (training/contact_labels.py LABEL_THRESHOLDS). */
 export const LABEL_THRESHOLDS = Object.freeze({ near: 0.04, slow: 1.0, stayNear: 0.06, staySlow: 1.5, bitNear: 0.1 });
 
-/** Per foot: ankle, toe, toe tip (training/metrics.py FOOT_GROUP). */
-export const FOOT_GROUPS = [
-  ['LeftFoot', 'LeftToeBase', 'LeftToeBase_end'],
-  ['RightFoot', 'RightToeBase', 'RightToeBase_end'],
-] as const;
-
-/** The joint indices of FOOT_GROUPS in `joints`; throws naming the missing ones. */
-export function footGroups(joints: readonly string[]): number[][] {
-  return FOOT_GROUPS.map((names) => {
-    const index = names.map((n) => joints.indexOf(n));
-    const missing = names.filter((_, i) => index[i] < 0);
-    if (missing.length) throw new Error(`foot contacts need the joints ${names.join(', ')}; missing ${missing.join(', ')}`);
-    return index;
-  });
-}
 
 /** Streaming labels: `step` once per frame, in order; `reset` before a new motion. */
 export class ContactLabeller {
@@ -37,7 +25,7 @@ export class ContactLabeller {
 
   constructor(joints: readonly string[], private readonly fps: number) {
     if (!(fps > 0)) throw new RangeError(`contact labels: fps must be positive, got ${fps}`);
-    this.feet = footGroups(joints);
+    this.feet = findLegs(joints, 'contact labels').map(footPoints);
     this.n = joints.length * 3;
   }
 

@@ -7,6 +7,7 @@
 // and feet, and keeps every bone length exactly. Arithmetic is in double precision like the Python.
 
 import { ContactLabeller, labelContacts } from './contactLabels';
+import { findLegs } from './legs';
 
 export interface FootLockSettings {
   /** Height (m) a planted toe point is brought to. */
@@ -36,11 +37,6 @@ export const FLAT_PITCH = 0.6;
 export const RELEASE_LIFT = 0.08;
 export const STEEP_PITCH = 1.0;
 
-/** Per leg: hip, knee, ankle, toe, toe end (footlock.py LEGS). */
-export const LEG_JOINTS = [
-  ['LeftUpLeg', 'LeftLeg', 'LeftFoot', 'LeftToeBase', 'LeftToeBase_end'],
-  ['RightUpLeg', 'RightLeg', 'RightFoot', 'RightToeBase', 'RightToeBase_end'],
-] as const;
 
 type V3 = [number, number, number];
 type Pair = [number, number];
@@ -156,8 +152,8 @@ export class FootLock {
   private feet: FootState[] = [];
 
   /**
-   * `joints`: the skeleton's joint names (LEG_JOINTS must be among them); `offsets`: joints × 3 rest offsets
-   * (metres), whose lengths give thigh and shin.
+   * `joints`: the skeleton's joint names (the canonical or the dance set's legs, legs.ts); `offsets`: joints × 3
+   * rest offsets (metres), whose lengths give thigh and shin.
    */
   constructor(joints: readonly string[], offsets: ArrayLike<number>, settings: Partial<FootLockSettings> = {}) {
     this.settings = { ...FOOT_LOCK_DEFAULTS, ...settings };
@@ -169,12 +165,7 @@ export class FootLock {
     if (offsets.length !== joints.length * 3) throw new Error(`footLock: ${offsets.length} offset values for ${joints.length} joints`);
     this.joints = joints.length;
     const length = (j: number) => Math.hypot(offsets[j * 3], offsets[j * 3 + 1], offsets[j * 3 + 2]);
-    this.legs = LEG_JOINTS.map((names) => {
-      const index = names.map((n) => joints.indexOf(n));
-      const missing = names.filter((_, i) => index[i] < 0);
-      if (missing.length) throw new Error(`footLock needs the leg joints ${names.join(', ')}; missing ${missing.join(', ')}`);
-      return { index, l1: length(index[1]), l2: length(index[2]) };
-    });
+    this.legs = findLegs(joints, 'footLock').map((leg) => ({ index: [leg.hip, leg.knee, leg.ankle, leg.toe, leg.toeEnd], l1: length(leg.knee), l2: length(leg.ankle) }));
     this.reset();
   }
 
@@ -203,7 +194,8 @@ export class FootLock {
       const [hipJ, kneeJ, ankleJ, toeJ, endJ] = index;
       const rawToe = at(toeJ), rawAnkle = at(ankleJ), hip = at(hipJ);
       const rawToeFromAnkle = sub(rawToe, rawAnkle);
-      const rawParts: [V3, V3] = [rawToeFromAnkle, sub(at(endJ), rawToe)]; // the foot and the toes
+      // the foot and the toes (none on a skeleton whose feet end at the toe)
+      const rawParts: [V3, V3] = [rawToeFromAnkle, endJ >= 0 ? sub(at(endJ), rawToe) : [0, 0, 0]];
       const rawHeading: Pair = [footHeading(rawParts[0]), footHeading(rawParts[1])];
       const flat: Pair = [flatness(rawParts[0]), flatness(rawParts[1])];
       const planted = contacts[side] > 0;
@@ -241,10 +233,10 @@ export class FootLock {
       if (!pivoted) {
         // the foot moves rigidly with the ankle
         newToe = add(newAnkle, toeFromAnkle);
-        put(endJ, add(newToe, endFromToe));
+        if (endJ >= 0) put(endJ, add(newToe, endFromToe));
       } else {
         // the foot turns about the toe (heel lifts); the toes stay as they are
-        put(endJ, add(target, endFromToe));
+        if (endJ >= 0) put(endJ, add(target, endFromToe));
         newToe = target;
       }
       put(toeJ, newToe);

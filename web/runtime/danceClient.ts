@@ -6,7 +6,7 @@ import { ModelClient } from './workerClient';
 
 export type { DanceInitResult, DanceParityResult, DanceStepInputs, DanceStreamInfo, DanceStreamParams };
 
-/** Generated dance frames as a Motion (positions fitted to the skeleton), with the raw network points. */
+/** Generated dance frames as a Motion (positions fitted to the skeleton, planted feet locked, with the contacts), with the raw network points. */
 export type DanceMotion = Motion & {
   /** frames × joints × 3: the decoded network output before fitting (bone lengths drift). */
   predicted: Float32Array;
@@ -48,6 +48,7 @@ export class DanceClient extends ModelClient<DanceStreamParams, DanceInitResult,
   protected toMotion(chunk: DanceChunk): DanceMotion {
     return {
       ...this.motionOf(chunk),
+      contacts: chunk.contacts,
       predicted: chunk.predicted,
       features: chunk.features,
       seedIndex: chunk.seedIndex,

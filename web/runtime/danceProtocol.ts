@@ -62,8 +62,10 @@ export interface DanceChunk {
   features: Float32Array;
   /** frames × joints × 3: the decoded network points, bone lengths as predicted. */
   predicted: Float32Array;
-  /** frames × joints × 3: the points fitted to the skeleton (exact bone lengths). */
+  /** frames × joints × 3: the points fitted to the skeleton (exact bone lengths), planted feet locked. */
   positions: Float32Array;
+  /** frames × 2 (left, right): the foot contacts the feet were locked with (labelled from their heights and speeds). */
+  contacts: Uint8Array;
   /** Index into the model's seeds of the seed motion. */
   seedIndex: number;
   /** Index of this chunk's first frame in its stream (0 for `generate`). */
