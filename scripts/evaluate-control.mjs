@@ -149,7 +149,8 @@ function markdown(r) {
   lines.push(
     `Walking: every run within the fit, progress and speed targets: ${pass(ok(walk))}. Skating of the optimised walks ÷ unconstrained generation from the same seed states (both without the foot lock): ${fmt(skateRatio, 2)} (target ≤ ${T.skatingRatio}): ${pass(skateRatio <= T.skatingRatio)}. ` +
       `followPath returns the motion with contacts labelled on it and planted feet locked (\`web/motion/contactLabels.ts\`, \`web/motion/footLock.ts\`; the root is not moved, so the path numbers hold): ${fmt(lockedRatio, 2)}× unconstrained. ` +
-      `Sliding by the lowest foot point (no contacts needed) after the lock: ${fmt(mean(walk.map((p) => p.sliding)), 3)} m/s on average, worst run ${fmt(Math.max(...walk.map((p) => p.sliding)), 3)}, against ${fmt(r.realSliding, 3)} m/s for the real held-out clips measured the same way (refiner.md): ${pass(walk.every((p) => p.sliding <= r.realSliding))} for every run.`,
+      `Sliding by the lowest foot point (no contacts needed) after the lock: ${fmt(mean(walk.map((p) => p.sliding)), 3)} m/s on average against ${fmt(r.realSliding, 3)} m/s for the real held-out clips measured the same way (refiner.md): at most real on average ${pass(mean(walk.map((p) => p.sliding)) <= r.realSliding)}; ` +
+      `in every run ${pass(walk.every((p) => p.sliding <= r.realSliding))} (${walk.filter((p) => p.sliding > r.realSliding).length} of ${walk.length} runs above, the worst ${fmt(Math.max(...walk.map((p) => p.sliding)), 3)}).`,
     '',
   );
   lines.push('Running (`gait: "run"`, run seed states; not part of the targets, shown for completeness):', '');
@@ -178,7 +179,7 @@ function markdown(r) {
   lines.push(`- Compute per model frame, p95 over each run (worst run): ${fmt(allP95, 1)} ms (target < ${T.p95ms}): ${pass(allP95 < T.p95ms)}.`);
   lines.push(`- Skating of the walking control runs (feet locked, as simulateControl returns them) ${fmt(controlSkate, 3)} m/s vs unconstrained ${fmt(r.freeControlSkating, 3)} m/s: ratio ${fmt(controlSkate / r.freeControlSkating, 2)} (target ≤ ${T.skatingRatio}).`);
   const controlSlide = r.control.filter((c) => !c.scenario.startsWith('run')).map((c) => c.sliding);
-  lines.push(`- Sliding of the walking control runs by the lowest foot point: ${fmt(mean(controlSlide), 3)} m/s on average, worst run ${fmt(Math.max(...controlSlide), 3)}, against ${fmt(r.realSliding, 3)} m/s for the real held-out clips: ${pass(controlSlide.every((v) => v <= r.realSliding))} for every run.`);
+  lines.push(`- Sliding of the walking control runs by the lowest foot point: ${fmt(mean(controlSlide), 3)} m/s on average against ${fmt(r.realSliding, 3)} m/s for the real held-out clips: at most real on average ${pass(mean(controlSlide) <= r.realSliding)}; in every run ${pass(controlSlide.every((v) => v <= r.realSliding))} (${controlSlide.filter((v) => v > r.realSliding).length} of ${controlSlide.length} above, the worst ${fmt(Math.max(...controlSlide), 3)}).`);
   lines.push('');
   return lines.join('\n') + '\n';
 }
