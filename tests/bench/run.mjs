@@ -355,8 +355,8 @@ const PATH_MODELS = ['latent-erd', 'generator'];
 
 /**
  * followPath on each benchmark path (walk, seed 0) with the latent ERD and, in the same run, the generator
- * (the default model): path error, progress, motion and compute time, × real time, and the feet's sliding
- * after the foot lock (stats.skating: mean planted-toe speed).
+ * (the default model): path error, progress, motion and compute time, × real time, and the feet's skating and sliding
+ * after the foot lock (stats.skating: mean planted-toe speed; stats.sliding: the lowest foot point near the floor).
  */
 async function latentErdPathsBenchmark(ctx) {
   const { context, page, problems } = await openPlayground(ctx.browser, ctx.url, VIEWPORT);
@@ -382,8 +382,10 @@ async function latentErdPathsBenchmark(ctx) {
           motion_s: +r.seconds.toFixed(2),
           compute_s: +(r.optimizeMs / 1000).toFixed(2),
           realtime_factor: +((r.seconds * 1000) / r.optimizeMs).toFixed(1),
-          sliding_m_per_s: +r.skating.toFixed(3),
-          sliding_before_lock_m_per_s: +r.skatingBeforeLock.toFixed(3),
+          skating_m_per_s: +r.skating.toFixed(3),
+          skating_before_lock_m_per_s: +r.skatingBeforeLock.toFixed(3),
+          sliding_m_per_s: +r.sliding.toFixed(3),
+          sliding_before_lock_m_per_s: +r.slidingBeforeLock.toFixed(3),
         });
       }
     }
@@ -396,6 +398,7 @@ async function latentErdPathsBenchmark(ctx) {
           worst_max_error_m: Math.max(...g.map((r) => r.max_error_m)),
           least_progress: Math.min(...g.map((r) => r.progress)),
           least_realtime_factor: Math.min(...g.map((r) => r.realtime_factor)),
+          mean_skating_m_per_s: +(g.reduce((a, r) => a + r.skating_m_per_s, 0) / g.length).toFixed(3),
           mean_sliding_m_per_s: +(g.reduce((a, r) => a + r.sliding_m_per_s, 0) / g.length).toFixed(3),
         }];
       }),
@@ -408,8 +411,8 @@ async function latentErdPathsBenchmark(ctx) {
 
 /** The latent ERD's and the generator's rows of latent-erd-paths side by side, one line per path. */
 function latentPathsTable(r) {
-  const cols = ['mean error (m)', 'max error (m)', 'progress', 'motion (s)', 'compute (s)', '× real time', 'sliding (m/s)'];
-  const keys = ['mean_error_m', 'max_error_m', 'progress', 'motion_s', 'compute_s', 'realtime_factor', 'sliding_m_per_s'];
+  const cols = ['mean error (m)', 'max error (m)', 'progress', 'motion (s)', 'compute (s)', '× real time', 'skating (m/s)', 'sliding, lowest point (m/s)'];
+  const keys = ['mean_error_m', 'max_error_m', 'progress', 'motion_s', 'compute_s', 'realtime_factor', 'skating_m_per_s', 'sliding_m_per_s'];
   const lines = [`    | path | ${cols.map((c) => `${c}: latent ERD / generator`).join(' | ')} |`, `    |---|${cols.map(() => '---').join('|')}|`];
   for (const name of Object.keys(BENCHMARK_PATHS)) {
     const [a, b] = PATH_MODELS.map((model) => r.rows.find((x) => x.path === name && x.model === model));
@@ -721,7 +724,7 @@ async function main() {
       const [a, g] = PATH_MODELS.map((m) => r.summary[m]);
       console.log(
         `  ${b.name}: latent ERD mean error ${a.mean_error_m} m (worst ${a.worst_mean_error_m}, target ≤ 0.15), least progress ${(a.least_progress * 100).toFixed(1)}% (target ≥ 95%),` +
-          ` least ${a.least_realtime_factor}× real time (target ≥ 20×), sliding ${a.mean_sliding_m_per_s} m/s; generator ${g.mean_error_m} m, ${(g.least_progress * 100).toFixed(1)}%, ${g.least_realtime_factor}×, ${g.mean_sliding_m_per_s} m/s` +
+          ` least ${a.least_realtime_factor}× real time (target ≥ 20×), skating ${a.mean_skating_m_per_s} m/s, sliding ${a.mean_sliding_m_per_s} m/s; generator ${g.mean_error_m} m, ${(g.least_progress * 100).toFixed(1)}%, ${g.least_realtime_factor}×, ${g.mean_skating_m_per_s} / ${g.mean_sliding_m_per_s} m/s` +
           `\n${latentPathsTable(r)}\n    ${b.description}`,
       );
       continue;
