@@ -7,6 +7,7 @@
 //
 // Add a benchmark by appending { name, description, run(ctx) } to BENCHMARKS; run() returns an object
 // of metrics. ctx gives the browser, the served URL and corpus access.
+import { execFileSync } from 'node:child_process';
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
 import { corpusText, launchBrowser, openPlayground, ROOT, startServer } from '../e2e/harness.mjs';
@@ -358,6 +359,46 @@ const PATH_MODELS = ['latent-erd', 'generator'];
  * (the default model): path error, progress, motion and compute time, × real time, and the feet's skating and sliding
  * after the foot lock (stats.skating: mean planted-toe speed; stats.sliding: the lowest foot point near the floor).
  */
+/**
+ * The page against its peers, in one run: end-to-end `generate` throughput (the network, decoding, skeleton fit,
+ * contact labels and foot lock, and the worker's messages; best of 3, one stream, the page's default threads)
+ * for the acLSTM and the generator, and, on the same machine right after, a PyTorch eager loop of the same
+ * network and native onnxruntime on its ONNX step, one thread each (python -m training.bench.peers).
+ */
+async function peersBenchmark(ctx) {
+  const FRAMES = 2000;
+  const { context, page, problems } = await openPlayground(ctx.browser, ctx.url, VIEWPORT);
+  let pageRates;
+  try {
+    pageRates = await page.evaluate(async (frames) => {
+      const rate = async (options) => {
+        await window.playground.generate({ ...options, frames: 60 }); // load and warm up
+        let best = 0;
+        for (let k = 0; k < 3; k++) {
+          const t0 = performance.now();
+          await window.playground.generate({ ...options, frames });
+          best = Math.max(best, frames / ((performance.now() - t0) / 1000));
+        }
+        return best;
+      };
+      return { aclstm: await rate({ model: 'aclstm', style: 'salsa', seed: 0 }), generator: await rate({ model: 'generator', seed: 0 }) };
+    }, FRAMES);
+  } finally {
+    await context.close();
+  }
+  const python = path.join(ROOT, '.venv', 'bin', 'python');
+  const peers = JSON.parse(execFileSync(python, ['-m', 'training.bench.peers', '--frames', String(FRAMES)], { cwd: ROOT, encoding: 'utf8' }).trim().split('\n').pop());
+  const row = (name) => ({
+    page_frames_per_s: Math.round(pageRates[name]),
+    torch_frames_per_s: Math.round(peers[name].torch_frames_per_s),
+    ort_frames_per_s: Math.round(peers[name].ort_frames_per_s),
+    page_over_torch: +(pageRates[name] / peers[name].torch_frames_per_s).toFixed(2),
+    page_over_ort: +(pageRates[name] / peers[name].ort_frames_per_s).toFixed(2),
+    torch_loop: peers[name].torch,
+  });
+  return { frames: FRAMES, aclstm: row('aclstm'), generator: row('generator'), targets: { aclstm_over_torch: 1.5, generator_over_torch: 3 }, page_errors: problems.length };
+}
+
 async function latentErdPathsBenchmark(ctx) {
   const { context, page, problems } = await openPlayground(ctx.browser, ctx.url, VIEWPORT);
   try {
@@ -656,6 +697,12 @@ export const BENCHMARKS = [
     run: steerKeysBenchmark,
   },
   {
+    name: 'peers',
+    description: 'generate end to end in the page (acLSTM, generator; one stream) against a PyTorch eager loop of the same network and native onnxruntime, one run — targets: acLSTM ≥ 1.5× and generator ≥ 3× the PyTorch loop',
+    kind: 'peers',
+    run: peersBenchmark,
+  },
+  {
     name: 'import-50mb',
     description: 'a 50 MB BVH dropped on the page: the page thread\'s long tasks until it is shown — target: none over 100 ms',
     kind: 'import',
@@ -727,6 +774,12 @@ async function main() {
           ` least ${a.least_realtime_factor}× real time (target ≥ 20×), skating ${a.mean_skating_m_per_s} m/s, sliding ${a.mean_sliding_m_per_s} m/s; generator ${g.mean_error_m} m, ${(g.least_progress * 100).toFixed(1)}%, ${g.least_realtime_factor}×, ${g.mean_skating_m_per_s} / ${g.mean_sliding_m_per_s} m/s` +
           `\n${latentPathsTable(r)}\n    ${b.description}`,
       );
+      continue;
+    }
+    if (b.kind === 'peers') {
+      const line = (name, m, target) =>
+        `${name} ${m.page_frames_per_s} frames/s in the page = ${m.page_over_torch}× the PyTorch loop (${m.torch_frames_per_s}/s; target ≥ ${target}×), ${m.page_over_ort}× native onnxruntime (${m.ort_frames_per_s}/s)`;
+      console.log(`  ${b.name}: ${line('acLSTM', r.aclstm, r.targets.aclstm_over_torch)}; ${line('generator', r.generator, r.targets.generator_over_torch)}\n    ${b.description}`);
       continue;
     }
     if (b.kind === 'control') {

@@ -1,0 +1,1 @@
+"""Timing peers for the page's benchmarks (npm run bench -- peers)."""
