@@ -4,7 +4,10 @@
 //
 // It works on world joint positions of the canonical skeleton plus the contact bits, is causal (FootLock.step
 // once per frame, in order, for live streams; footLock() for a whole motion), changes only the knees, ankles
-// and feet, and keeps every bone length exactly. Arithmetic is in double precision like the Python.
+// and feet, and keeps every bone length exactly. Arithmetic is in double precision like the Python. The page
+// also runs it on the dance set's skeleton (legs.ts), whose feet end at the toe: there the toes' part is
+// skipped; that use has no Python counterpart. PlantedFeet / plantFeet put the contact labels
+// (contactLabels.ts) in front of the lock, as footlock.py plant_feet does.
 
 import { ContactLabeller, labelContacts } from './contactLabels';
 import { findLegs } from './legs';
