@@ -299,3 +299,28 @@ def test_streaming_foot_lock_equals_batch(sliding_walk):
     lock = FootLock()
     streamed = np.stack([lock.step(p, c) for p, c in zip(pos[:80], contacts[:80] > 0)])
     assert np.array_equal(streamed, foot_lock(pos[:80], contacts[:80]))
+
+
+def test_stronger_two_sample_classifier_sees_accelerations():
+    """The stronger classifier's input adds each frame's joint accelerations; it tells jittered windows from smooth
+    ones, and is near chance on two samples of the same process."""
+    from training.refiner.measures import two_sample_accuracy, with_accelerations
+    rng = np.random.default_rng(0)
+    joints, frames = 3, 32
+
+    def smooth(n):  # (n, T, 6J + 2): slow sines for positions and their velocities, contacts off
+        t = np.arange(frames)[None, :, None] / 30.0
+        phase = rng.uniform(0, 6.3, (n, 1, 3 * joints))
+        pos, vel = np.sin(2 * t + phase), 2 * np.cos(2 * t + phase)
+        return np.concatenate([pos, vel, np.zeros((n, frames, 2))], axis=-1).astype(np.float32)
+
+    w = smooth(4)
+    acc = with_accelerations(w, 30.0)
+    assert acc.shape == (4, frames - 1, 9 * joints + 2)
+    np.testing.assert_allclose(acc[:, :, -3 * joints:], np.diff(w[:, :, 3 * joints:6 * joints], axis=1) * 30.0, rtol=1e-6)
+    jittered = smooth(200)
+    jittered[:, :, 3 * joints:6 * joints] += rng.normal(0, 0.3, (200, frames, 3 * joints)).astype(np.float32)
+    apart = two_sample_accuracy(smooth(200), jittered[:100], smooth(100), jittered[100:], seed=0, steps=200, kind="strong")
+    same = two_sample_accuracy(smooth(200), smooth(200), smooth(200), smooth(200), seed=0, steps=200, kind="strong")
+    assert apart["balanced_accuracy"] > 0.9
+    assert same["balanced_accuracy"] < 0.75
