@@ -118,3 +118,20 @@ def variant_measures(seqs: list[DecodedMotion], fps: float, skel, real_speeds: d
     if real_speeds is not None:
         m["speed_wasserstein"] = {k: metrics.wasserstein_1d(speeds[k], real_speeds[k]) for k in SPEED_POINTS}
     return m, speeds, planted
+
+
+# Which features give generated motion away: the classifier windows' column groups (6J + 2 columns per frame).
+def feature_groups(columns: int) -> dict[str, slice]:
+    joints = (columns - 2) // 6
+    return {"pose": slice(0, 3 * joints), "velocities": slice(3 * joints, 6 * joints), "contacts": slice(6 * joints, columns)}
+
+
+def feature_group_accuracies(real_train: np.ndarray, fake_train: np.ndarray, real_test: np.ndarray, fake_test: np.ndarray,
+                             seed: int = 0) -> dict:
+    """Balanced accuracy of the window and single-frame classifiers given one feature group at a time."""
+    out = {}
+    for name, cols in feature_groups(real_train.shape[-1]).items():
+        out[name] = {kind: two_sample_accuracy(real_train[..., cols], fake_train[..., cols], real_test[..., cols],
+                                               fake_test[..., cols], seed, kind=kind)["balanced_accuracy"]
+                     for kind in ("window", "frame")}
+    return out

@@ -32,7 +32,7 @@ from ..footlock import plant_feet
 from ..generator.shipped import DecodedMotion, ShippedGenerator
 from ..mocap.skeleton import canonical_skeleton
 from ..paths import MODELS_DIR, REPORTS_DIR
-from .measures import (SPEED_POINTS, STRIDE, STRONG, WINDOW, classifier_frames, motion_windows, two_sample_accuracy,
+from .measures import (SPEED_POINTS, STRIDE, STRONG, WINDOW, classifier_frames, feature_group_accuracies, motion_windows, two_sample_accuracy,
                        variant_measures, windows)
 from .shipped import ShippedRefiner
 
@@ -395,3 +395,25 @@ def write_refiner_report(frames: int, n_seeds: int, mocap: str | None, models_di
     (REPORTS_DIR / "refiner.json").write_text(json.dumps(report, indent=1) + "\n")
     write_markdown(report)
     return report
+
+
+def feature_group_report(frames: int, mocap: str | None, models_dir: Path = MODELS_DIR) -> dict:
+    """training/refiner/diagnose.py: per variant, the two-sample accuracy from each feature group alone (the report's
+    protocol: train on real training windows against stream set B, test on the held-out clips against set A)."""
+    gen = ShippedGenerator(models_dir)
+    ref = ShippedRefiner(models_dir, gen.codec)
+    fps = gen.info["fps"]
+    seeds = list(range(len(gen.info["seeds"])))
+    seed_x = np.array([gen.info["seeds"][s]["x"] for s in seeds]) * gen.std + gen.mean
+    var_a, _ = decode_variants(gen, ref, gen.sample(seeds, frames, TEMPERATURE, np.random.default_rng(2024)), seed_x)
+    var_b, _ = decode_variants(gen, ref, gen.sample(seeds, frames, TEMPERATURE, np.random.default_rng(7)), seed_x)
+    clips = load_clips(mocap)
+    real_test = motion_windows(gen.held_out(clips), fps)
+    real_train = []
+    for s in Corpus(clips).train:
+        f = s.astype(np.float64) * gen.std + gen.mean
+        real_train.append(classifier_frames(gen.codec.positions(f), np.cumsum(f[:, 2]), (f[:, -2:] > 0.5), fps))
+    real_train_w = windows(real_train)
+    return {"frames_per_seed": frames, "seeds": len(seeds), "classifier_seed": 0,
+            "variants": {v: feature_group_accuracies(real_train_w, motion_windows(var_b[v], fps), real_test,
+                                                     motion_windows(var_a[v], fps)) for v in VARIANTS}}
