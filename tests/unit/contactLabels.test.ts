@@ -6,31 +6,10 @@ import { describe, expect, it } from 'vitest';
 import { ContactLabeller, LABEL_THRESHOLDS, labelContacts } from '../../web/motion/contactLabels';
 import { plantFeet } from '../../web/motion/footLock';
 import { lowFootSample, lowFootSliding, NEAR_FLOOR } from '../../web/motion/footSkating';
-import { readRepoFile } from './corpus';
+import { footFixture, type FootStream } from './footFixture';
 
-interface Stream {
-  seed_name: string;
-  temperature: number;
-  frames: number;
-  positions: number[];
-  contacts: number[];
-  labels: number[];
-  label_margin: number;
-  planted_legs: number[];
-  low_foot: { mean: number | null; pairs: number };
-}
-interface Fixture {
-  joints: string[];
-  parents: number[];
-  offsets: number[];
-  fps: number;
-  legs: string[];
-  label_thresholds: Record<string, number>;
-  near_floor: number;
-  streams: Stream[];
-}
-
-const fixture = JSON.parse(readRepoFile('tests/fixtures/footlock_reference.json')) as Fixture;
+type Stream = FootStream;
+const fixture = footFixture;
 const { joints, parents, offsets, fps } = fixture;
 const J = joints.length;
 const motion = (positions: ArrayLike<number>, frames: number) => ({ fps, frames, joints, parents, positions: positions as Float32Array });

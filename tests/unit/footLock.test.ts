@@ -4,26 +4,10 @@
 import { describe, expect, it } from 'vitest';
 import { FLAT_PITCH, FOOT_LOCK_DEFAULTS, FootLock, footLock, RELEASE_LIFT, STEEP_PITCH, twoBoneIK } from '../../web/motion/footLock';
 import { readRepoFile } from './corpus';
+import { footFixture, type FootStream } from './footFixture';
 
-interface Stream {
-  seed_name: string;
-  temperature: number;
-  frames: number;
-  positions: number[];
-  contacts: number[];
-  locked_legs: number[];
-}
-interface Fixture {
-  joints: string[];
-  parents: number[];
-  offsets: number[];
-  fps: number;
-  legs: string[];
-  settings: { toe_ground_height: number; blend_in_frames: number; blend_out_frames: number; reach: number; pole_bias: number; flat_pitch: number; steep_pitch: number; release_lift: number };
-  streams: Stream[];
-}
-
-const fixture = JSON.parse(readRepoFile('tests/fixtures/footlock_reference.json')) as Fixture;
+type Stream = FootStream;
+const fixture = footFixture;
 const refiner = JSON.parse(readRepoFile('public/models/refiner.json')) as { footlock: Record<string, number> };
 const { joints, parents, offsets } = fixture;
 const J = joints.length;

@@ -57,6 +57,15 @@ def decode_variants(gen: ShippedGenerator, ref: ShippedRefiner, raw: np.ndarray,
     return out, refined
 
 
+def real_training_frames(gen: ShippedGenerator, clips) -> list[np.ndarray]:
+    """Classifier frames of the generator's training clips: the two-sample tests' real training side."""
+    fps, out = gen.info["fps"], []
+    for s in Corpus(clips).train:
+        f = s.astype(np.float64) * gen.std + gen.mean
+        out.append(classifier_frames(gen.codec.positions(f), np.cumsum(f[:, 2]), (f[:, -2:] > 0.5), fps))
+    return out
+
+
 def skating_per_segment(seqs: list[DecodedMotion], frames: int, fps: float, skel, segment: int = 1000) -> list[float]:
     """Pooled skating per `segment`-frame stretch of the streams: does the refiner hold up over long streams?"""
     return [float(np.concatenate([metrics.planted_toe_speeds(s.positions[a:a + segment], s.contacts[a:a + segment], fps, skel)
@@ -136,10 +145,7 @@ def evaluate_refiner(frames: int, n_seeds: int, mocap: str | None, models_dir: P
     # Real: held-out clips for the measures and the classifier's test; training clips for its training.
     clips = load_clips(mocap)
     real = gen.held_out(clips)
-    real_train = []
-    for s in Corpus(clips).train:
-        f = s.astype(np.float64) * gen.std + gen.mean
-        real_train.append(classifier_frames(gen.codec.positions(f), np.cumsum(f[:, 2]), (f[:, -2:] > 0.5), fps))
+    real_train = real_training_frames(gen, clips)
 
     real_m, real_speeds, real_planted = variant_measures(real, fps, skel, None)
     report = {"frames_per_seed": frames, "seeds": [gen.info["seeds"][s]["name"] for s in seeds], "temperature": TEMPERATURE,
@@ -409,11 +415,7 @@ def feature_group_report(frames: int, mocap: str | None, models_dir: Path = MODE
     var_b, _ = decode_variants(gen, ref, gen.sample(seeds, frames, TEMPERATURE, np.random.default_rng(7)), seed_x)
     clips = load_clips(mocap)
     real_test = motion_windows(gen.held_out(clips), fps)
-    real_train = []
-    for s in Corpus(clips).train:
-        f = s.astype(np.float64) * gen.std + gen.mean
-        real_train.append(classifier_frames(gen.codec.positions(f), np.cumsum(f[:, 2]), (f[:, -2:] > 0.5), fps))
-    real_train_w = windows(real_train)
+    real_train_w = windows(real_training_frames(gen, clips))
     return {"frames_per_seed": frames, "seeds": len(seeds), "classifier_seed": 0,
             "variants": {v: feature_group_accuracies(real_train_w, motion_windows(var_b[v], fps), real_test,
                                                      motion_windows(var_a[v], fps)) for v in VARIANTS}}

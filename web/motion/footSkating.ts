@@ -1,6 +1,7 @@
 // Foot skating: mean horizontal speed (m/s) of each toe while its foot is labelled planted, in this
 // frame and the previous one. The same measure as training/metrics.py foot_skating, so browser readouts
 // and the Python reports compare directly.
+import { findLegs, footPoints } from './legs';
 import type { Motion } from './types';
 
 const TOES = ['LeftToeBase', 'RightToeBase'];
@@ -34,23 +35,17 @@ export function footSkating(motion: Motion & { contacts: Uint8Array }): number {
   return count ? sum / count : NaN;
 }
 
-/** Per foot: ankle, toe, toe tip, of which the lowest is followed (training/metrics.py FOOT_GROUP). */
-const LOW_FOOT_POINTS = [
-  ['LeftFoot', 'LeftToeBase', 'LeftToeBase_end'],
-  ['RightFoot', 'RightToeBase', 'RightToeBase_end'],
-];
 /** Height (m) below which a foot point counts as on or near the floor (training/metrics.py NEAR_FLOOR). */
 export const NEAR_FLOOR = 0.04;
 
 /**
  * The independent sliding measure, which needs no contact labels: per foot and frame pair, the lowest of its
- * ankle, toe and toe tip in the first frame, counted when it is within NEAR_FLOOR of the floor (y = 0) in both
- * frames; its horizontal speed (m/s). The same as training/metrics.py low_foot_speeds.
+ * ankle, toe and toe tip (legs.ts footPoints) in the first frame, counted when it is within NEAR_FLOOR of the
+ * floor (y = 0) in both frames; its horizontal speed (m/s). The same as training/metrics.py low_foot_speeds.
  */
 export function lowFootSample(motion: Motion, from = 1, to = motion.frames): SkatingSample {
   const J = motion.joints.length;
-  const feet = LOW_FOOT_POINTS.map((names) => names.map((n) => motion.joints.indexOf(n)));
-  if (feet.flat().some((j) => j < 0)) throw new Error(`foot sliding needs joints ${LOW_FOOT_POINTS.flat().join(', ')}`);
+  const feet = findLegs(motion.joints, 'foot sliding').map(footPoints);
   const P = motion.positions;
   let sum = 0, count = 0;
   for (let f = Math.max(1, from); f < to; f++) {
