@@ -137,6 +137,7 @@ class Rng:
 
     def __init__(self, seed: int):
         self.state = seed & 0xFFFFFFFF
+        self.spare: float | None = None
 
     def uniform(self) -> float:
         m = 0xFFFFFFFF
@@ -145,6 +146,17 @@ class Rng:
         t = _imul(s ^ (s >> 15), 1 | s)
         t = ((t + _imul(t ^ (t >> 7), 61 | t)) & m) ^ t
         return ((t ^ (t >> 14)) & m) / 4294967296
+
+    def normal(self) -> float:
+        """Standard normal by Box–Muller, the second value of each pair kept for the next call (as sampler.ts)."""
+        if self.spare is not None:
+            value, self.spare = self.spare, None
+            return value
+        u1 = 1 - self.uniform()
+        u2 = self.uniform()
+        radius = math.sqrt(-2 * math.log(u1))
+        self.spare = radius * math.sin(2 * math.pi * u2)
+        return radius * math.cos(2 * math.pi * u2)
 
 
 def _imul(a: int, b: int) -> int:

@@ -353,6 +353,7 @@ async function pathFollowBenchmark(ctx) {
 
 /** The models path following is compared over (followPath's `model`): the latent ERD and the generator with the MAP optimiser. */
 const PATH_MODELS = ['latent-erd', 'generator'];
+const VAE_PATH_MODELS = ['vae-lstm', 'latent-erd', 'generator'];
 
 /**
  * followPath on each benchmark path (walk, seed 0) with the latent ERD and, in the same run, the generator
@@ -399,14 +400,14 @@ async function peersBenchmark(ctx) {
   return { frames: FRAMES, aclstm: row('aclstm'), generator: row('generator'), targets: { aclstm_over_torch: 1.5, generator_over_torch: 3 }, page_errors: problems.length };
 }
 
-async function latentErdPathsBenchmark(ctx) {
+async function pathModelsBenchmark(ctx, models = PATH_MODELS) {
   const { context, page, problems } = await openPlayground(ctx.browser, ctx.url, VIEWPORT);
   try {
-    // Warm-up of both models (load, first wasm calls), as the raw-step benchmarks do.
-    for (const model of PATH_MODELS) await page.evaluate((model) => window.playground.followPath({ model, points: [[0, 0], [0, 1]], seed: 0 }), model);
+    // Warm-up of the models (load, first wasm calls), as the raw-step benchmarks do.
+    for (const model of models) await page.evaluate((model) => window.playground.followPath({ model, points: [[0, 0], [0, 1]], seed: 0 }), model);
     const rows = [];
     for (const [name, { points }] of Object.entries(BENCHMARK_PATHS)) {
-      for (const model of PATH_MODELS) {
+      for (const model of models) {
         const r = await page.evaluate(
           async ({ points, model }) => {
             const m = await window.playground.followPath({ model, points, gait: 'walk', seed: 0 });
@@ -431,7 +432,7 @@ async function latentErdPathsBenchmark(ctx) {
       }
     }
     const summary = Object.fromEntries(
-      PATH_MODELS.map((model) => {
+      models.map((model) => {
         const g = rows.filter((r) => r.model === model);
         return [model, {
           mean_error_m: +(g.reduce((a, r) => a + r.mean_error_m, 0) / g.length).toFixed(3),
@@ -444,21 +445,22 @@ async function latentErdPathsBenchmark(ctx) {
         }];
       }),
     );
-    return { rows, summary, targets: { 'latent-erd': { mean_error_m: 0.15, progress: 0.95, realtime_factor: 20 }, generator: { mean_error_m: 0.1, progress: 0.95, realtime_factor: 2 } }, page_errors: problems.length };
+    const targets = { 'vae-lstm': { mean_error_m: 0.1, realtime_factor: 100 }, 'latent-erd': { mean_error_m: 0.15, progress: 0.95, realtime_factor: 20 }, generator: { mean_error_m: 0.1, progress: 0.95, realtime_factor: 2 } };
+    return { rows, summary, targets, page_errors: problems.length };
   } finally {
     await context.close();
   }
 }
 
-/** The latent ERD's and the generator's rows of latent-erd-paths side by side, one line per path. */
-function latentPathsTable(r) {
+/** The models' rows of a paths benchmark side by side (in the order of `models`), one line per path. */
+function latentPathsTable(r, models = PATH_MODELS) {
   const cols = ['mean error (m)', 'max error (m)', 'progress', 'motion (s)', 'compute (s)', '× real time', 'skating (m/s)', 'sliding, lowest point (m/s)'];
   const keys = ['mean_error_m', 'max_error_m', 'progress', 'motion_s', 'compute_s', 'realtime_factor', 'skating_m_per_s', 'sliding_m_per_s'];
-  const lines = [`    | path | ${cols.map((c) => `${c}: latent ERD / generator`).join(' | ')} |`, `    |---|${cols.map(() => '---').join('|')}|`];
+  const lines = [`    | path | ${cols.map((c) => `${c}: ${models.join(' / ')}`).join(' | ')} |`, `    |---|${cols.map(() => '---').join('|')}|`];
   for (const name of Object.keys(BENCHMARK_PATHS)) {
-    const [a, b] = PATH_MODELS.map((model) => r.rows.find((x) => x.path === name && x.model === model));
-    if (!a || !b) continue;
-    lines.push(`    | ${name} | ${keys.map((k) => `${a[k]} / ${b[k]}`).join(' | ')} |`);
+    const found = models.map((model) => r.rows.find((x) => x.path === name && x.model === model));
+    if (found.some((x) => !x)) continue;
+    lines.push(`    | ${name} | ${keys.map((k) => found.map((x) => x[k]).join(' / ')).join(' | ')} |`);
   }
   return lines.join('\n');
 }
@@ -637,7 +639,13 @@ const OPTIMIZER_BENCHMARKS = [
     name: 'latent-erd-paths',
     description: 'followPath on the five benchmark paths (walk, seed 0) with model "latent-erd", and with the generator (default model) in the same run — latent ERD targets: mean error ≤ 0.15 m, progress ≥ 95%, ≥ 20× real time',
     kind: 'latent-paths',
-    run: latentErdPathsBenchmark,
+    run: (ctx) => pathModelsBenchmark(ctx),
+  },
+  {
+    name: 'vae-lstm-paths',
+    description: 'followPath on the five benchmark paths (walk, seed 0) with model "vae-lstm", beside the latent ERD and the generator in the same run — VAE-LSTM targets: ≥ 100× real time, mean error ≤ 0.10 m',
+    kind: 'vae-paths',
+    run: (ctx) => pathModelsBenchmark(ctx, VAE_PATH_MODELS),
   },
 ];
 
@@ -773,6 +781,16 @@ async function main() {
         `  ${b.name}: latent ERD mean error ${a.mean_error_m} m (worst ${a.worst_mean_error_m}, target ≤ 0.15), least progress ${(a.least_progress * 100).toFixed(1)}% (target ≥ 95%),` +
           ` least ${a.least_realtime_factor}× real time (target ≥ 20×), skating ${a.mean_skating_m_per_s} m/s, sliding ${a.mean_sliding_m_per_s} m/s; generator ${g.mean_error_m} m, ${(g.least_progress * 100).toFixed(1)}%, ${g.least_realtime_factor}×, ${g.mean_skating_m_per_s} / ${g.mean_sliding_m_per_s} m/s` +
           `\n${latentPathsTable(r)}\n    ${b.description}`,
+      );
+      continue;
+    }
+    if (b.kind === 'vae-paths') {
+      const v = r.summary['vae-lstm'];
+      console.log(
+        `  ${b.name}: VAE-LSTM mean error ${v.mean_error_m} m (worst path ${v.worst_mean_error_m}, target ≤ 0.10), least progress ${(v.least_progress * 100).toFixed(1)}%,` +
+          ` least ${v.least_realtime_factor}× real time (target ≥ 100×), sliding ${v.mean_sliding_m_per_s} m/s` +
+          VAE_PATH_MODELS.slice(1).map((m) => `; ${m} ${r.summary[m].mean_error_m} m, least ${r.summary[m].least_realtime_factor}×`).join('') +
+          `\n${latentPathsTable(r, VAE_PATH_MODELS)}\n    ${b.description}`,
       );
       continue;
     }

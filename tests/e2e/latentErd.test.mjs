@@ -148,7 +148,7 @@ describe('the model choice of Steer and Path modes', { timeout: 400_000 }, () =>
       };
     });
     assert.equal(done.walkedBy, 'latent-erd');
-    assert.match(done.text, /^latent ERD · /);
+    assert.match(done.text, /^latent ERD: /);
     assert.ok(STATS.test(done.text), `the stats are shown: ${done.text}`);
     assert.match(done.meta, /latent ERD · walk · \d+ frames/);
     assert.equal(done.progress, 1, 'the progress bar went to the end');

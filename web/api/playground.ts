@@ -73,19 +73,24 @@ export interface GenerateOptions extends CancellableOptions {
 
 /** The models that follow paths and take live control: the generator with the MAP optimiser (default), or the latent ERD. */
 export type ControlModel = 'generator' | 'latent-erd';
+/** The models that follow paths: those, and the VAE-LSTM (the whole walk in one pass; it takes no live control). */
+export type PathModel = ControlModel | 'vae-lstm';
 
 export interface FollowPathOptions extends CancellableOptions {
-  /** "generator" (default: the MAP optimiser over the generator) or "latent-erd" (closed-loop control, no search). */
-  model?: ControlModel;
+  /**
+   * "generator" (default: the MAP optimiser over the generator), "latent-erd" (closed-loop control, no search)
+   * or "vae-lstm" (the path becomes one control signal and the whole walk is made in one pass).
+   */
+  model?: PathModel;
   /** The path on the ground: [x, z] pairs in metres, at least 2, each x and z within ±10000 m, 0.5–200 m long. The character starts at the first point facing along the path. */
   points: [number, number][];
   /** "walk" (default) or "run": picks the seed states and the pace. */
   gait?: 'walk' | 'run';
-  /** Integer 0…2³²−1 (default 0): the same seed and path give the same motion. */
+  /** Integer 0…2³²−1 (default 0): the same seed and path give the same motion. VAE-LSTM: the seed draws z, so another seed is another variation. */
   seed?: number;
   /** Generator only. σ_fit of the path-fit term in metres, 0.02–2 (default 0.1): smaller follows tighter. */
   fitTolerance?: number;
-  /** Latent ERD only. The forward speed asked for, above 0 and at most 4 m/s (default 1.2 walking, 2.8 running). */
+  /** Latent ERD and VAE-LSTM only. The forward speed asked for, above 0 and at most 4 m/s (default 1.2 walking, 2.8 running). */
   speed?: number;
   /** Lock planted feet (the refiner issue's contact clean-up; default true). The root path is not changed. */
   footLock?: boolean;
@@ -192,7 +197,8 @@ declare global {
 
 type GeneratorCall = { kind: 'lstm-gmm'; model: string; frames: number; seed: number; temperature: number; refine: boolean };
 type DanceCall = { kind: 'aclstm'; model: string; frames: number; seed: number; style: string };
-type LatentCall = { kind: 'latent-erd'; model: string; frames: number; seed: number; control?: Float64Array };
+type ControlledCall<K> = { kind: K; model: string; frames: number; seed: number; control?: Float64Array };
+type LatentCall = ControlledCall<'latent-erd'> | ControlledCall<'vae-lstm'>;
 
 /** Checks generate's options against the model they name (`models`: the manifest); the error says what is wrong. */
 export function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorCall | DanceCall | LatentCall {
@@ -200,13 +206,14 @@ export function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorC
     throw new TypeError(`options must be an object: { model, frames, seed, temperature? } (acLSTM: { model, style, frames, seed }), got ${describeValue(options)}`);
   }
   const o = options as Partial<Record<keyof GenerateOptions, unknown>>;
-  const usable = models.filter((m) => m.kind === 'lstm-gmm' || m.kind === 'aclstm' || m.kind === 'latent-erd');
+  const usable = models.filter((m) => m.kind === 'lstm-gmm' || m.kind === 'aclstm' || m.kind === 'latent-erd' || m.kind === 'vae-lstm');
   const available = usable.map((m) => m.id).join(', ');
   if (typeof o.model !== 'string') throw new TypeError(`model must be a model id string (available: ${available || 'none'}), got ${describeValue(o.model)}`);
   const entry = usable.find((m) => m.id === o.model);
   if (!entry) throw new Error(`unknown model ${describeValue(o.model)} (available: ${available || 'none — the model list did not load'})`);
   const dance = entry.kind === 'aclstm';
-  const latent = entry.kind === 'latent-erd';
+  // The latent ERD and the VAE-LSTM take the same options: a seed and an optional control signal.
+  const latent = entry.kind === 'latent-erd' || entry.kind === 'vae-lstm';
   if (dance) {
     // Dance models have no sampling and no refiner: say so rather than silently ignoring the option.
     if ('temperature' in o) throw new TypeError(`temperature is not meaningful for acLSTM models: they are deterministic (the seed only picks the seed motion); leave it out`);
@@ -222,7 +229,7 @@ export function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorC
   const seed = checkSeed(o.seed);
   if (latent) {
     const control = o.control === undefined ? undefined : checkControlSignal(o.control, o.frames);
-    return { kind: 'latent-erd', model: entry.id, frames: o.frames, seed, ...(control ? { control } : {}) };
+    return { kind: entry.kind as 'latent-erd' | 'vae-lstm', model: entry.id, frames: o.frames, seed, ...(control ? { control } : {}) } as LatentCall;
   }
   if (dance) {
     const styles = entry.styles ?? [];
@@ -282,25 +289,30 @@ function checkSignal(options: unknown): AbortSignal | undefined {
  * The `model` option of followPath and simulateControl: "generator" when left out, else a listed model of
  * kind "lstm-gmm" or "latent-erd" (`models`: the manifest).
  */
-function checkControlModel(value: unknown, models: ModelInfo[]): ControlModel {
+function checkControlModel(value: unknown, models: ModelInfo[], live = true): PathModel {
   if (value === undefined) return 'generator';
-  const usable = models.filter((m) => (m.kind === 'lstm-gmm' && m.id === 'generator') || (m.kind === 'latent-erd' && m.id === 'latent-erd')).map((m) => m.id);
+  const kinds: Record<PathModel, string> = { generator: 'lstm-gmm', 'latent-erd': 'latent-erd', 'vae-lstm': 'vae-lstm' };
+  const usable = models.filter((m) => kinds[m.id as PathModel] === m.kind).map((m) => m.id);
   const available = usable.join(', ') || 'none — the model list did not load';
-  if (typeof value !== 'string') throw new TypeError(`model must be "generator" or "latent-erd", got ${describeValue(value)}`);
+  if (typeof value !== 'string') throw new TypeError(`model must be one of "generator", "latent-erd", "vae-lstm", got ${describeValue(value)}`);
+  if (live && value === 'vae-lstm') {
+    throw new Error('the VAE-LSTM makes the whole motion for a whole control signal and takes no live control: use followPath or generate({ model: "vae-lstm", control })');
+  }
   if (!usable.includes(value)) throw new Error(`unknown model ${describeValue(value)} (available: ${available})`);
-  return value as ControlModel;
+  return value as PathModel;
 }
 
-const FOLLOW_PATH_OPTIONS: Record<ControlModel, string[]> = {
+const FOLLOW_PATH_OPTIONS: Record<PathModel, string[]> = {
   generator: ['model', 'points', 'gait', 'seed', 'fitTolerance', 'footLock', 'signal'],
   'latent-erd': ['model', 'points', 'gait', 'seed', 'speed', 'footLock', 'signal'],
+  'vae-lstm': ['model', 'points', 'gait', 'seed', 'speed', 'footLock', 'signal'],
 };
-const FOLLOW_PATH_SHAPE = '{ points: [[x, z], …], model?, gait?, seed?, fitTolerance? (generator) or speed? (latent-erd), footLock?, signal? }';
+const FOLLOW_PATH_SHAPE = '{ points: [[x, z], …], model?, gait?, seed?, fitTolerance? (generator) or speed? (latent-erd, vae-lstm), footLock?, signal? }';
 const SIMULATE_OPTIONS = ['model', 'seconds', 'schedule', 'seed', 'gait', 'footLock', 'signal'];
 
-/** A latent ERD motion as a Motion: the fitted, foot-locked positions and the decoded contacts. */
+/** A latent ERD or VAE-LSTM motion as a Motion: the fitted, foot-locked positions and the contacts they were locked with. */
 async function generateLatent(app: App, o: LatentCall, signal: AbortSignal | undefined): Promise<Motion> {
-  const { client } = await app.latentErd.load();
+  const { client } = o.kind === 'vae-lstm' ? await app.vaeLstm.load() : await app.latentErd.load();
   const m = await client.generate({ seed: o.seed, frames: o.frames, ...(o.control ? { control: o.control } : {}) }, { signal });
   return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts };
 }
@@ -429,7 +441,7 @@ export function createPlayground(app: App): Playground {
         await ready;
         const o = checkGenerate(options, models);
         if (o.kind === 'aclstm') return generateDance(app, o, signal);
-        if (o.kind === 'latent-erd') return generateLatent(app, o, signal);
+        if (o.kind === 'latent-erd' || o.kind === 'vae-lstm') return generateLatent(app, o, signal);
         const { client } = await app.generator.load();
         const m = await client.generate({ frames: o.frames, seed: o.seed, temperature: o.temperature, ...(o.refine ? { refine: true } : {}) }, { signal });
         const shown = o.refine ? m.refined : m;
@@ -443,7 +455,7 @@ export function createPlayground(app: App): Playground {
       return cancellable('followPath', options, async (signal) => {
         checkKeys(options, Object.keys(options ?? {}), FOLLOW_PATH_SHAPE); // an object; its keys are checked once the model is known
         await ready;
-        const model = checkControlModel((options as { model?: unknown }).model, models);
+        const model = checkControlModel((options as { model?: unknown }).model, models, false);
         const o = checkKeys(options, FOLLOW_PATH_OPTIONS[model], FOLLOW_PATH_SHAPE);
         // Checked here too (the worker checks again), so bad input fails fast and without a worker prefix.
         const points = checkPathPoints(o.points);
@@ -451,9 +463,9 @@ export function createPlayground(app: App): Playground {
         const gait = checkGait(optional(o.gait, 'walk'));
         const seed = checkSeed(optional(o.seed, 0));
         const lockFeet = checkFootLock(o.footLock);
-        if (model === 'latent-erd') {
+        if (model === 'latent-erd' || model === 'vae-lstm') {
           const speed = checkPathSpeed(optional(o.speed, LATENT_PATH_SPEED[gait]));
-          const { client } = await app.latentErd.load();
+          const { client } = model === 'vae-lstm' ? await app.vaeLstm.load() : await app.latentErd.load();
           const m = await client.followPath({ points, gait, seed, speed, footLock: lockFeet }, { signal });
           const { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock, sliding, slidingBeforeLock } = m.stats;
           return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, stats: { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock, sliding, slidingBeforeLock } };

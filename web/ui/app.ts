@@ -9,6 +9,7 @@ import { DanceClient, type DanceInitResult } from '../runtime/danceClient';
 import { GeneratorClient, type InitResult } from '../runtime/generatorClient';
 import { LatentErdClient, type LatentErdInitResult } from '../runtime/latentErdClient';
 import { ImportClient } from '../runtime/importClient';
+import { VaeLstmClient, type VaeLstmInitResult } from '../runtime/vaeLstmClient';
 import { baseName, type FileImportOutcome } from '../runtime/motionFiles';
 import { ImportIndicator } from './files';
 import { $, downloadText, errorMessage } from './dom';
@@ -35,6 +36,8 @@ export class App implements ModeHost {
   readonly generator = new ModelHost<GeneratorClient, InitResult>(() => new GeneratorClient({ threads: pageThreads() }), this.busy);
   /** The latent ERD and its autoencoder's decoder (one worker), loaded on first use (playground.generate, followPath, simulateControl; Steer and Path modes). */
   readonly latentErd = new ModelHost<LatentErdClient, LatentErdInitResult>(() => new LatentErdClient({ threads: pageThreads() }), this.busy);
+  /** The VAE-LSTM (four graphs in one worker), loaded on first use (playground.generate, followPath; Path mode). */
+  readonly vaeLstm = new ModelHost<VaeLstmClient, VaeLstmInitResult>(() => new VaeLstmClient({ threads: pageThreads() }), this.busy);
   private readonly danceHosts = new Map<string, ModelHost<DanceClient, DanceInitResult>>();
   /** Parses imports off the page thread (dropped and picked files, playground.importMotion). */
   readonly importer = new ImportClient();
@@ -131,7 +134,7 @@ export class App implements ModeHost {
       this.setLiveLabel('Random walk', 'generator · 30 fps · live');
       this.exportBtn.title = 'Download the last 20 s of the walk as BVH';
     } else if (mode === 'steer') {
-      this.setLiveLabel('Steer', `${CONTROL_MODEL_SHORT[this.controlModel.value]} · 30 fps · live control`);
+      this.setLiveLabel('Steer', `${CONTROL_MODEL_SHORT[this.controlModel.steerable]} · 30 fps · live control`);
       this.exportBtn.title = 'Download the last 20 s of steering as BVH';
     } else {
       this.setLiveLabel('Dance', 'loading…');

@@ -6,6 +6,7 @@ import type { Motion } from '../../motion/types';
 import type { DanceClient, DanceInitResult } from '../../runtime/danceClient';
 import type { GeneratorClient, InitResult } from '../../runtime/generatorClient';
 import type { LatentErdClient, LatentErdInitResult } from '../../runtime/latentErdClient';
+import type { VaeLstmClient, VaeLstmInitResult } from '../../runtime/vaeLstmClient';
 import type { Viewer } from '../../viewer/viewer';
 import type { ModelHost } from '../modelHost';
 import type { ModelChoice } from './modelChoice';
@@ -29,7 +30,9 @@ export interface ModeHost {
   readonly generator: ModelHost<GeneratorClient, InitResult>;
   /** The latent ERD (Steer and Path modes' other model), loaded on first use and shared with the API. */
   readonly latentErd: ModelHost<LatentErdClient, LatentErdInitResult>;
-  /** Which of the two Steer and Path modes run (the generator or the latent ERD). */
+  /** The VAE-LSTM (Path mode's third model), loaded on first use and shared with the API. */
+  readonly vaeLstm: ModelHost<VaeLstmClient, VaeLstmInitResult>;
+  /** Which model Steer and Path modes run (the generator, the latent ERD, or in Path the VAE-LSTM). */
   readonly controlModel: ModelChoice;
   /** A dance model (`id` "aclstm" or "aclstm-vanilla"), loaded on first use. */
   dance(id: string): ModelHost<DanceClient, DanceInitResult>;

@@ -1,7 +1,10 @@
 // Path mode: draw a path on the ground (mouse, pen or touch) and the chosen model walks it (the model
 // choice, modelChoice.ts): the generator's path follower (web/optimizer) optimises the motion in the
-// generator worker, or the latent ERD follows the path in closed loop in its worker (a control signal
-// from where the character stands, every latent step: web/runtime/latentErdRequests.ts). The result plays
+// generator worker, the latent ERD follows the path in closed loop in its worker (a control signal
+// from where the character stands, every latent step: web/runtime/latentErdRequests.ts), or the VAE-LSTM
+// makes the whole walk for the whole path in one pass (web/runtime/vaeLstmRequests.ts), as soon as the path
+// is drawn; Vary draws a new latent sample for the same path. Compare has a second model walk the same path
+// beside the first (the viewer's companion figure), each with its own numbers. The result plays
 // with the path as followed (mint) and the character's root trajectory (the viewer's purple trail) on the ground.
 // Redrawing replaces the path; a stroke that is too short, or a failed optimisation, keeps what was there.
 // A new path drawn while the last one is being walked, or leaving the mode, cancels that optimisation.
@@ -11,10 +14,12 @@ import { MAX_PATH_LENGTH, MIN_PATH_LENGTH } from '../../optimizer/path';
 import type { Motion } from '../../motion/types';
 import type { FollowedPath, GeneratorClient } from '../../runtime/generatorClient';
 import type { LatentErdClient } from '../../runtime/latentErdClient';
+import type { VaeLstmClient } from '../../runtime/vaeLstmClient';
+import { LATENT_PATH_SPEED } from '../../runtime/latentErdRequests';
 import { GroundLine, TARGET_COLOR } from '../../viewer/groundPath';
 import { $, element, errorMessage, readSeed, setSliderFill } from '../dom';
 import type { ModeHost } from './host';
-import { CONTROL_MODEL_SHORT, type ControlModelId } from './modelChoice';
+import { CONTROL_MODEL_SHORT, isControlModel, type ControlModelId } from './modelChoice';
 import type { Gait } from '../../optimizer/pathFollower';
 
 type Point = [number, number];
@@ -32,16 +37,48 @@ const RISE = 1;
 const DRAWING_DISTANCE = 8;
 const DRAWING_AHEAD = 1.5;
 
-interface Result {
+/** One model's walk along the path. */
+interface Walk {
   motion: Motion;
   /** The path as followed (x, z pairs), drawn on the ground with the result. */
   path: Float32Array;
   stats: FollowedPath['stats'];
-  gait: Gait;
   /** The model that walked it. */
   model: ControlModelId;
+}
+
+interface Result extends Walk {
+  gait: Gait;
   /** The drawn points it was made from. */
   points: Point[];
+  /** Compare: the second model's walk of the same path. */
+  other?: Walk;
+}
+
+/** `motion` held at its last frame up to `frames` frames (so two walks of one path play side by side). */
+function holdTo(motion: Motion, frames: number): Motion {
+  if (motion.frames >= frames) return motion;
+  const n = motion.joints.length * 3;
+  const positions = new Float32Array(frames * n);
+  positions.set(motion.positions.subarray(0, motion.frames * n));
+  const last = motion.positions.subarray((motion.frames - 1) * n, motion.frames * n);
+  for (let f = motion.frames; f < frames; f++) positions.set(last, f * n);
+  let contacts: Uint8Array | undefined;
+  if (motion.contacts) {
+    contacts = new Uint8Array(frames * 2);
+    contacts.set(motion.contacts.subarray(0, motion.frames * 2));
+    for (let f = motion.frames; f < frames; f++) contacts.set(motion.contacts.subarray((motion.frames - 1) * 2, motion.frames * 2), f * 2);
+  }
+  return { ...motion, frames, positions, ...(contacts ? { contacts } : {}) };
+}
+
+/** A walk's numbers in one line: error, progress, time to compute, foot sliding. */
+function statsLine(w: Walk): string {
+  const s = w.stats;
+  const secs = (w.motion.frames - 1) / w.motion.fps;
+  const sliding = Number.isFinite(s.sliding) ? ` · sliding ${s.sliding.toFixed(2)} m/s` : '';
+  return `${CONTROL_MODEL_SHORT[w.model]}: error mean ${(s.meanError * 100).toFixed(1)} cm · max ${(s.maxError * 100).toFixed(1)} cm · ${Math.round(s.arcProgress * 100)} % of the path · ` +
+    `${(s.optimizeMs / 1000).toFixed(1)} s for ${secs.toFixed(1)} s of motion${sliding}`;
 }
 
 function pathLength(points: Point[]): number {
@@ -57,6 +94,10 @@ export class PathMode {
   private readonly fit = $<HTMLInputElement>('path-fit');
   private readonly fitOut = $('path-fit-out');
   private readonly seed = $<HTMLInputElement>('path-seed');
+  private readonly speed = $<HTMLInputElement>('path-speed');
+  private readonly speedOut = $('path-speed-out');
+  private readonly compare = $<HTMLSelectElement>('path-compare');
+  private readonly varyBtn = $<HTMLButtonElement>('path-vary');
   private readonly goBtn = $<HTMLButtonElement>('path-go');
   private readonly clearBtn = $<HTMLButtonElement>('path-clear');
   private readonly progress = $<HTMLProgressElement>('path-progress');
@@ -82,8 +123,20 @@ export class PathMode {
     this.fit.value = String(DEFAULT_FIT);
     this.showFit();
     this.fit.addEventListener('input', () => this.showFit());
-    // The latent ERD has no fit tolerance (no optimiser): its slider is off while it is chosen.
-    app.controlModel.onChange(() => this.showState());
+    this.showSpeed();
+    this.speed.addEventListener('input', () => this.showSpeed());
+    this.gait.addEventListener('change', () => {
+      this.speed.value = String(LATENT_PATH_SPEED[this.params().gait]);
+      this.showSpeed();
+    });
+    // Only the generator has a fit tolerance (the optimiser's), only the others a speed: the slider of the
+    // other kind is off while a model is chosen. The VAE-LSTM walks a drawn path at once.
+    app.controlModel.onChange(() => {
+      this.showState();
+      if (app.controlModel.value === 'vae-lstm' && this.points.length && !this.current()) void this.go();
+    });
+    this.compare.addEventListener('change', () => this.showState());
+    this.varyBtn.addEventListener('click', () => this.vary());
     this.goBtn.addEventListener('click', () => void this.go());
     this.clearBtn.addEventListener('click', () => this.clear());
 
@@ -146,10 +199,28 @@ export class PathMode {
     setSliderFill(this.fit, (v - Number(this.fit.min)) / (Number(this.fit.max) - Number(this.fit.min)));
   }
 
-  private params(): { gait: Gait; seed: number; fitSigma: number } {
+  private showSpeed(): void {
+    const v = Number(this.speed.value);
+    this.speedOut.textContent = `${v.toFixed(1)} m/s`;
+    setSliderFill(this.speed, (v - Number(this.speed.min)) / (Number(this.speed.max) - Number(this.speed.min)));
+  }
+
+  private params(): { gait: Gait; seed: number; fitSigma: number; speed: number } {
     const seed = readSeed(this.seed);
     const fitSigma = Math.min(Math.max(Number(this.fit.value) || DEFAULT_FIT, 0.05), 0.5);
-    return { gait: this.gait.value === 'run' ? 'run' : 'walk', seed, fitSigma };
+    const speed = Math.min(Math.max(Number(this.speed.value) || 1.2, 0.4), 3.2);
+    return { gait: this.gait.value === 'run' ? 'run' : 'walk', seed, fitSigma, speed };
+  }
+
+  /** The model Compare adds beside the chosen one, or null (off, or the same model). */
+  private compareModel(): ControlModelId | null {
+    const v = this.compare.value;
+    return isControlModel(v) && v !== this.app.controlModel.value ? v : null;
+  }
+
+  /** Whether the shown walk is of the drawn path. */
+  private current(): boolean {
+    return this.result !== null && this.result.points === this.points;
   }
 
   // ---------- drawing ----------
@@ -231,6 +302,8 @@ export class PathMode {
     // The walk being optimised is for the path just replaced.
     this.cancelOptimisation();
     this.showState();
+    // The VAE-LSTM's walk takes a fraction of a second: it appears as soon as the path is drawn.
+    if (this.app.controlModel.value === 'vae-lstm') void this.go();
   }
 
   private endStroke(s: NonNullable<PathMode['stroke']>): void {
@@ -282,6 +355,42 @@ export class PathMode {
     this.showState();
   }
 
+  /** Vary: the next seed, a new walk of the same path (the VAE-LSTM draws a new latent sample). */
+  private vary(): void {
+    if (this.busy || !this.points.length) return;
+    this.seed.value = String((readSeed(this.seed) + 1) % 2 ** 32);
+    void this.go();
+  }
+
+  /** One model's walk along `points` (loading it on first use). */
+  private async walk(model: ControlModelId, points: Point[], signal: AbortSignal, onProgress: (fraction: number) => void): Promise<Walk> {
+    const { gait, seed, fitSigma, speed } = this.params();
+    let client: GeneratorClient | LatentErdClient | VaeLstmClient | undefined;
+    try {
+      let r: Pick<FollowedPath, 'fps' | 'frames' | 'joints' | 'parents' | 'positions' | 'contacts' | 'path' | 'stats'>;
+      if (model === 'latent-erd') {
+        const erd = (client = (await this.app.latentErd.load()).client);
+        r = await erd.followPath({ points, gait, seed, speed, stroke: true }, { signal, onProgress });
+      } else if (model === 'vae-lstm') {
+        const vae = (client = (await this.app.vaeLstm.load()).client);
+        r = await vae.followPath({ points, gait, seed, speed, stroke: true }, { signal, onProgress });
+      } else {
+        const generator = (client = (await this.app.generator.load()).client);
+        r = await generator.followPath({ points, gait, seed, fitSigma, stroke: true }, { signal, onProgress });
+      }
+      const motion: Motion = { fps: r.fps, frames: r.frames, joints: r.joints, parents: r.parents, positions: r.positions, contacts: r.contacts };
+      return { motion, path: r.path, stats: r.stats, model };
+    } catch (e) {
+      // A request the worker refused leaves the worker fine; anything else (a crash) needs a new one.
+      if (client && !signal.aborted && !errorMessage(e).startsWith(`${model} followPath:`)) {
+        if (model === 'latent-erd') this.app.latentErd.reset(client as LatentErdClient);
+        else if (model === 'vae-lstm') this.app.vaeLstm.reset(client as VaeLstmClient);
+        else this.app.generator.reset(client as GeneratorClient);
+      }
+      throw e;
+    }
+  }
+
   private async go(): Promise<void> {
     if (this.busy) return;
     const points = this.points;
@@ -289,28 +398,24 @@ export class PathMode {
       this.app.reportError('Path: draw a path on the ground first (drag on the floor).');
       return;
     }
-    const { gait, seed, fitSigma } = this.params();
+    const { gait } = this.params();
     const model = this.app.controlModel.value;
+    const other = this.compareModel();
     const run = (this.optimising = new AbortController());
     this.progress.value = 0;
     this.showState();
-    let client: GeneratorClient | LatentErdClient | undefined;
     try {
-      const onProgress = (fraction: number) => {
-        this.progress.value = fraction;
-        this.status.textContent = `${model === 'latent-erd' ? 'the latent ERD follows the path' : `finding a ${gait} along the path`}… ${Math.round(fraction * 100)} %`;
+      const progressOf = (m: ControlModelId, part: number, parts: number) => (fraction: number) => {
+        this.progress.value = (part + fraction) / parts;
+        const what = m === 'generator' ? `finding a ${gait} along the path` : `the ${CONTROL_MODEL_SHORT[m]} walks the path`;
+        this.status.textContent = `${what}… ${Math.round(fraction * 100)} %`;
       };
-      let r: Pick<FollowedPath, 'fps' | 'frames' | 'joints' | 'parents' | 'positions' | 'contacts' | 'path' | 'stats'>;
-      if (model === 'latent-erd') {
-        const erd = (client = (await this.app.latentErd.load()).client);
-        r = await erd.followPath({ points, gait, seed, stroke: true }, { signal: run.signal, onProgress });
-      } else {
-        const generator = (client = (await this.app.generator.load()).client);
-        r = await generator.followPath({ points, gait, seed, fitSigma, stroke: true }, { signal: run.signal, onProgress });
-      }
+      const parts = other ? 2 : 1;
+      // One after the other, so each one's time to compute is its own.
+      const main = await this.walk(model, points, run.signal, progressOf(model, 0, parts));
+      const second = other ? await this.walk(other, points, run.signal, progressOf(other, 1, parts)) : undefined;
       if (run.signal.aborted) return;
-      const motion: Motion = { fps: r.fps, frames: r.frames, joints: r.joints, parents: r.parents, positions: r.positions, contacts: r.contacts };
-      this.result = { motion, path: r.path, stats: r.stats, gait, points, model };
+      this.result = { ...main, gait, points, ...(second ? { other: second } : {}) };
       this.optimising = null;
       // Not cancelled by a new path or by leaving the mode: the result is for the drawn path, in Path mode.
       this.display(this.result);
@@ -318,22 +423,21 @@ export class PathMode {
       // Cancelled: whatever cancelled it has already set the state, and the walk is not wanted.
       if (run.signal.aborted) return;
       this.optimising = null;
-      const message = errorMessage(e);
-      // A request the worker refused leaves the worker fine; anything else (a crash) needs a new one.
-      if (client && !message.startsWith(`${model} followPath:`)) {
-        if (model === 'latent-erd') this.app.latentErd.reset(client as LatentErdClient);
-        else this.app.generator.reset(client as GeneratorClient);
-      }
-      this.app.reportError(`Path: ${message}`);
+      this.app.reportError(`Path: ${errorMessage(e)}`);
     }
     this.showState();
   }
 
   private display(r: Result): void {
     const viewer = this.app.viewer;
-    this.app.showInMode(r.motion, `path-${r.gait}`);
+    const frames = Math.max(r.motion.frames, r.other?.motion.frames ?? 0);
+    this.app.showInMode(holdTo(r.motion, frames), `path-${r.gait}`);
+    if (r.other) {
+      viewer.setCompanion({ motion: holdTo(r.other.motion, frames), labels: { main: CONTROL_MODEL_SHORT[r.model], companion: CONTROL_MODEL_SHORT[r.other.model] } });
+    }
     const secs = (r.motion.frames - 1) / r.motion.fps;
-    this.app.setLiveLabel('Path', `${CONTROL_MODEL_SHORT[r.model]} · ${r.gait} · ${r.motion.frames} frames · ${secs.toFixed(1)} s · ${viewer.footprintCount} steps`);
+    const vs = r.other ? ` vs ${CONTROL_MODEL_SHORT[r.other.model]}` : '';
+    this.app.setLiveLabel('Path', `${CONTROL_MODEL_SHORT[r.model]}${vs} · ${r.gait} · ${r.motion.frames} frames · ${secs.toFixed(1)} s · ${viewer.footprintCount} steps`);
     this.line.set(r.points === this.points ? r.path : flat(this.points));
     viewer.frameGround(r.path, RISE);
     // Look a little lower, so the walk sits above the control bar.
@@ -360,22 +464,25 @@ export class PathMode {
     this.status.dataset.model = model;
     if (current) this.status.dataset.walkedBy = r.model;
     else delete this.status.dataset.walkedBy;
-    this.fit.disabled = model === 'latent-erd';
-    if (model === 'latent-erd') this.fit.title = 'The latent ERD follows the path in closed loop, with no optimiser: it has no fit tolerance';
+    if (current && r.other) this.status.dataset.comparedWith = r.other.model;
+    else delete this.status.dataset.comparedWith;
+    this.fit.disabled = model !== 'generator';
+    if (model !== 'generator') this.fit.title = `The ${CONTROL_MODEL_SHORT[model]} has no optimiser: it has no fit tolerance`;
     else this.fit.removeAttribute('title');
+    this.speed.disabled = model === 'generator';
+    this.varyBtn.hidden = model !== 'vae-lstm';
+    this.varyBtn.disabled = this.busy || !this.points.length;
     this.hint.hidden = this.points.length > 0 || r !== null || this.stroke !== null;
     this.status.replaceChildren();
     if (this.busy) {
       this.status.textContent = 'starting…';
     } else if (current) {
-      const s = r.stats;
-      const secs = (r.motion.frames - 1) / r.motion.fps;
-      this.status.append(
-        `${r.model === 'latent-erd' ? 'latent ERD · ' : ''}error mean ${(s.meanError * 100).toFixed(1)} cm · max ${(s.maxError * 100).toFixed(1)} cm · ${Math.round(s.arcProgress * 100)} % of the path · ` +
-          `${(s.optimizeMs / 1000).toFixed(1)} s for ${secs.toFixed(1)} s of motion`,
-        legend('path', 'drawn path'),
-        legend('walked', 'walked (root)'),
-      );
+      for (const w of r.other ? [r, r.other] : [r]) {
+        const line = element('span', 'path-stats', statsLine(w));
+        line.dataset.model = w.model;
+        this.status.append(line);
+      }
+      this.status.append(legend('path', 'drawn path'), legend('walked', 'walked (root)'));
     } else if (this.points.length) {
       this.status.textContent = `path ${pathLength(this.points).toFixed(1)} m · Go walks it${r ? ' (showing the walk along the previous path)' : ''}`;
     } else {

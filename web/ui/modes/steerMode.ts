@@ -123,8 +123,10 @@ export class SteerMode extends LiveMode<SteerChunk> {
       this.setSpeed(GAIT_SPEED[this.gaitValue]);
       this.restartIfActive();
     });
-    // Another model: a new stream at the origin.
-    app.controlModel.onChange(() => this.restartIfActive());
+    // Another model: a new stream at the origin (choosing the VAE-LSTM in Path mode changes nothing here).
+    app.controlModel.onChange(() => {
+      if (app.controlModel.steerable !== this.model) this.restartIfActive();
+    });
     // On the document, so it runs before the page's own shortcuts (on window), which it then skips.
     document.addEventListener('keydown', (e) => this.onKey(e, true));
     document.addEventListener('keyup', (e) => this.onKey(e, false));
@@ -178,7 +180,7 @@ export class SteerMode extends LiveMode<SteerChunk> {
   }
 
   protected async open(signal: AbortSignal): Promise<LiveStream<SteerChunk>> {
-    const model = (this.model = this.app.controlModel.value);
+    const model = (this.model = this.app.controlModel.steerable);
     $('steer-status').dataset.model = model;
     const started = model === 'latent-erd' ? await this.openLatent(signal) : await this.openGenerator(signal);
     // The stream starts at the origin facing +z, at the slider's speed.

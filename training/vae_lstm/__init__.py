@@ -1,0 +1,1 @@
+"""The VAE-LSTM (Habibie et al.): training, export and evaluation."""

@@ -1,0 +1,190 @@
+"""Exporting the VAE-LSTM: four ONNX graphs, their JSON, parity checked, and
+tests/fixtures/vae_lstm_reference.json for the browser's parity tests.
+
+- vae-lstm.onnx, the cell (eqs. 7–9, free mode) over one chunk of CHUNK_STEPS steps: hc (batch, 30, 128),
+  state (batch, latent) -> canvas (batch, 30, latent), state_out. The state goes in and out, so a path of any
+  length runs chunk after chunk (generation.py).
+- vae-lstm-control.onnx, the control encoder: control (batch, frames, 3) normalised, frames a multiple of 4
+  -> hc (batch, frames / 4, 128).
+- vae-lstm-decoder.onnx: canvas (batch, steps, latent) -> rows (batch, 4 × steps, 80) normalised.
+- vae-lstm-inference.onnx, the inference network: rows (batch, frames, 80) normalised -> mean and log_var
+  (batch, frames / 4, latent) of the posterior of each step.
+
+The batch dimension is dynamic in all four, and so are frames and steps in the convolutional three.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import torch
+from torch import nn
+
+from ..control import Rng
+from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, JOINTS, POSITION_DIM
+from ..mocap.skeleton import canonical_skeleton
+from ..models.vae_lstm import KERNEL, POOLING, VaeLstm
+from ..onnx.manifest import register_model
+from ..onnx.sessions import cpu_session
+from ..paths import MODELS_DIR, REPO_ROOT
+from .generation import CHUNK_STEPS, SEED_FRAMES, SEED_PAD
+
+PARITY_TOLERANCE = 1e-4
+PRIOR_FIXTURE_SEED = 3
+FIXTURE = REPO_ROOT / "tests" / "fixtures" / "vae_lstm_reference.json"
+FILES = {"cell": "vae-lstm.onnx", "control": "vae-lstm-control.onnx", "decoder": "vae-lstm-decoder.onnx",
+         "inference": "vae-lstm-inference.onnx"}
+NAMES = {"cell": (["hc", "state"], ["canvas", "state_out"]), "control": (["control"], ["hc"]),
+         "decoder": (["canvas"], ["rows"]), "inference": (["rows"], ["mean", "log_var"])}
+
+
+class CellChunk(nn.Module):
+    def __init__(self, model: VaeLstm):
+        super().__init__()
+        self.cell = model.cell
+
+    def forward(self, hc, state):
+        return self.cell.run(state, hc)
+
+
+class Wrap(nn.Module):
+    def __init__(self, fn):
+        super().__init__()
+        self.fn = fn
+
+    def forward(self, x):
+        return self.fn(x)
+
+
+def graphs(model: VaeLstm) -> dict[str, nn.Module]:
+    return {"cell": CellChunk(model), "control": Wrap(model.control_encoder), "decoder": Wrap(model.decoder),
+            "inference": Wrap(model.inference)}
+
+
+def example_inputs(model: VaeLstm, batch: int = 1, frames: int = 40) -> dict[str, tuple[torch.Tensor, ...]]:
+    hc_dim = model.cell.gates_control.in_features
+    return {"cell": (torch.zeros(batch, CHUNK_STEPS, hc_dim), torch.zeros(batch, model.latent)),
+            "control": (torch.zeros(batch, frames, model.control),),
+            "decoder": (torch.zeros(batch, frames // POOLING, model.latent),),
+            "inference": (torch.zeros(batch, frames, model.dim),)}
+
+
+def export_graphs(model: VaeLstm, out: Path) -> None:
+    b = {0: "batch"}
+    dynamic = {"cell": {"hc": b, "state": b, "canvas": b, "state_out": b},
+               "control": {"control": {0: "batch", 1: "frames"}, "hc": {0: "batch", 1: "steps"}},
+               "decoder": {"canvas": {0: "batch", 1: "steps"}, "rows": {0: "batch", 1: "frames"}},
+               "inference": {"rows": {0: "batch", 1: "frames"}, "mean": {0: "batch", 1: "steps"}, "log_var": {0: "batch", 1: "steps"}}}
+    examples = example_inputs(model)
+    for key, graph in graphs(model).items():
+        inputs, outputs = NAMES[key]
+        torch.onnx.export(graph.eval(), examples[key], str(out / FILES[key]), input_names=inputs, output_names=outputs,
+                          opset_version=17, dynamo=False, dynamic_axes=dynamic[key])
+
+
+def random_inputs(model: VaeLstm, rng: np.random.Generator, batch: int, frames: int) -> dict[str, list[np.ndarray]]:
+    hc_dim = model.cell.gates_control.in_features
+    f32 = lambda *shape: rng.normal(size=shape).astype(np.float32)
+    return {"cell": [np.abs(f32(batch, CHUNK_STEPS, hc_dim)), f32(batch, model.latent)],
+            "control": [f32(batch, frames, model.control)], "decoder": [f32(batch, frames // POOLING, model.latent)],
+            "inference": [f32(batch, frames, model.dim)]}
+
+
+def check_parity(model: VaeLstm, out: Path) -> dict[str, float]:
+    """torch against onnxruntime for every graph at batch 1 and 3 and two lengths."""
+    worst = dict.fromkeys(FILES, 0.0)
+    rng = np.random.default_rng(1)
+    modules = graphs(model)
+    for key in FILES:
+        session = cpu_session(out / FILES[key])
+        for batch, frames in ((1, 40), (3, 200)):
+            inputs = random_inputs(model, rng, batch, frames)[key]
+            with torch.no_grad():
+                ref = modules[key].eval()(*map(torch.from_numpy, inputs))
+            ref = ref if isinstance(ref, tuple) else (ref,)
+            got = session.run(NAMES[key][1], dict(zip(NAMES[key][0], inputs)))
+            for r, g in zip(ref, got):
+                worst[key] = max(worst[key], float(np.abs(r.numpy() - g).max()))
+    for key, value in worst.items():
+        if value > PARITY_TOLERANCE:
+            raise SystemExit(f"error: {key} graph parity {value:.2e} exceeds {PARITY_TOLERANCE}")
+    return worst
+
+
+def vae_lstm_info(meta: dict, model: VaeLstm, report: dict) -> dict:
+    skel = canonical_skeleton()
+    return {
+        "id": "vae-lstm", "kind": "vae-lstm", "file": FILES["cell"], "files": FILES, "fps": meta["fps"],
+        "window": meta["window"], "pooling": POOLING, "kernel": KERNEL, "chunk_steps": CHUNK_STEPS,
+        "latent": model.latent, "control_features": model.cell.gates_control.in_features,
+        "seed_frames": SEED_FRAMES, "seed_pad": SEED_PAD, "control_smoothing_frames": meta["control_sigma"],
+        "onnx": {key: {"inputs": NAMES[key][0], "outputs": NAMES[key][1]} for key in FILES},
+        "skeleton": {"joints": skel.joints, "parents": skel.parents, "offsets": skel.offsets.round(6).ravel().tolist()},
+        "rows": {"dim": model.dim, "positions": [0, POSITION_DIM], "control": [CONTROL_SLICE.start, CONTROL_SLICE.stop],
+                 "contacts": [CONTACT_SLICE.start, CONTACT_SLICE.stop], "joints": JOINTS,
+                 "positions_frame": "each frame's ground-projected root facing frame: x left, y up (height above the floor), z forward",
+                 "control_channels": ["forward m/s", "sideways m/s (+ left)", "turn rad/s (+ from +z towards +x)"]},
+        "normalisation": {"mean": [round(float(v), 6) for v in meta["row_mean"]], "std": [round(float(v), 6) for v in meta["row_std"]]},
+        "report": report,
+    }
+
+
+def generate_rows(model: VaeLstm, control: np.ndarray, z1: np.ndarray) -> np.ndarray:
+    """Normalised rows (frames, dim) for a normalised control (frames, 3), frames a multiple of 4, from z1
+    (latent,), the cell run chunk by chunk as the page runs it (the last chunk padded with its last step)."""
+    with torch.no_grad():
+        hc = model.control_encoder(torch.from_numpy(control[None].astype(np.float32)))
+        steps = hc.shape[1]
+        chunks = -(-steps // CHUNK_STEPS)
+        padded = torch.cat([hc, hc[:, -1:].expand(-1, chunks * CHUNK_STEPS - steps, -1)], dim=1)
+        state, canvas = torch.from_numpy(z1[None].astype(np.float32)), []
+        for k in range(chunks):
+            part, state = model.cell.run(state, padded[:, k * CHUNK_STEPS:(k + 1) * CHUNK_STEPS])
+            canvas.append(part)
+        return model.decoder(torch.cat(canvas, dim=1)[:, :steps]).numpy()[0]
+
+
+def write_fixture(model: VaeLstm, info: dict, path: Path = FIXTURE) -> None:
+    """Inputs and torch outputs of each graph, one whole generation over two chunks (36 steps), and the prior
+    sample of one seed (control.Rng, as the page draws z1), for the browser's parity tests."""
+    rng = np.random.default_rng(7)
+    inputs = random_inputs(model, rng, 1, 16)
+    modules = graphs(model)
+    graphs_out = {}
+    for key in FILES:
+        with torch.no_grad():
+            ref = modules[key].eval()(*map(torch.from_numpy, inputs[key]))
+        ref = ref if isinstance(ref, tuple) else (ref,)
+        graphs_out[key] = {"inputs": {n: {"dims": list(a.shape), "data": a.ravel().round(6).tolist()} for n, a in zip(NAMES[key][0], inputs[key])},
+                           "outputs": {n: r.numpy().ravel().round(6).tolist() for n, r in zip(NAMES[key][1], ref)}}
+    frames = 4 * (CHUNK_STEPS + 6)
+    t = np.arange(frames) / info["fps"]
+    physical = np.stack([1.2 + 0.2 * np.sin(t), np.zeros_like(t), 0.6 * np.sin(0.5 * t)], axis=1)
+    mean, std = np.array(info["normalisation"]["mean"])[CONTROL_SLICE], np.array(info["normalisation"]["std"])[CONTROL_SLICE]
+    z1 = rng.normal(size=model.latent).astype(np.float32)
+    rows = generate_rows(model, ((physical - mean) / std).astype(np.float32), z1)
+    rng_z = Rng(PRIOR_FIXTURE_SEED)
+    prior = [rng_z.normal() for _ in range(model.latent)]
+    fixture = {"model": info["id"], "tolerance": 2e-4, "graphs": graphs_out,
+               "prior": {"seed": PRIOR_FIXTURE_SEED, "z1": [round(v, 9) for v in prior]},
+               "generate": {"control": physical.round(6).ravel().tolist(), "frames": frames, "z1": z1.round(6).tolist(),
+                            "rows": rows.round(6).ravel().tolist()}}
+    path.write_text(json.dumps(fixture) + "\n")
+
+
+def export_vae_lstm(model: VaeLstm, meta: dict, report: dict, out: Path = MODELS_DIR) -> dict:
+    model.eval()
+    out.mkdir(parents=True, exist_ok=True)
+    export_graphs(model, out)
+    parity = check_parity(model, out)
+    info = vae_lstm_info(meta, model, report)
+    info["parity_max_abs"] = parity
+    info["bytes"] = sum((out / f).stat().st_size for f in FILES.values())
+    (out / "vae-lstm.json").write_text(json.dumps(info) + "\n")
+    if out == MODELS_DIR:
+        register_model({"id": "vae-lstm", "kind": "vae-lstm", "skeleton": "cmu-canonical", "fps": meta["fps"],
+                        "bytes": info["bytes"], "file": FILES["cell"], "files": FILES})
+        write_fixture(model, info)
+    print(f"wrote {', '.join(FILES.values())} in {out} ({info['bytes'] / 1e6:.1f} MB), parity {parity}")
+    return info

@@ -1,0 +1,34 @@
+"""How the VAE-LSTM makes motion (the page does the same with the exported graphs, web/runtime/vaeLstmCore.ts):
+
+- From the prior (Algorithm 1): z_1 ~ N(0, I) drawn from a seed, the control signal encoded in one pass, the
+  cell run on its own state for every step, the canvas decoded in one pass.
+- From the posterior: z_1 is the mean of q(z_1 | 4 initial frames). The inference network is convolutional
+  and reads about 1.2 s around the first step, so the 4 frames are padded to SEED_PAD frames by repeating the
+  last (a held pose), the same in training (free mode) and at test time.
+- Long signals: the control encoder and the decoder are convolutional along time and take any length, and the
+  cell carries its state from step to step, so a path of any length runs in one pass. The page runs the cell
+  in chunks of CHUNK_STEPS steps (the 4 s training window), carrying the state between chunks; the report
+  measures the seams at the chunk boundaries.
+"""
+from __future__ import annotations
+
+import torch
+
+SEED_FRAMES = 4
+SEED_PAD = 40  # frames: the first step's receptive field in the inference network reaches 39 frames ahead
+CHUNK_STEPS = 30  # one 4 s window of 4-frame steps
+
+
+def seed_window(frames: torch.Tensor) -> torch.Tensor:
+    """The 4 initial frames (batch, 4, dim) padded to SEED_PAD frames by repeating the last."""
+    return torch.cat([frames, frames[:, -1:].expand(-1, SEED_PAD - frames.shape[1], -1)], dim=1)
+
+
+def pad_to_steps(control: torch.Tensor) -> tuple[torch.Tensor, int]:
+    """The control (batch, frames, 3) padded by repeating its last frame to a multiple of 4 frames, and the
+    original length."""
+    n = control.shape[1]
+    extra = -n % 4
+    if extra:
+        control = torch.cat([control, control[:, -1:].expand(-1, extra, -1)], dim=1)
+    return control, n

@@ -1,0 +1,206 @@
+"""The measurements behind docs/models/vae-lstm.md (python -m training.vae_lstm.evaluate), on the shipped ONNX
+graphs as the page runs them (chunked cell, root moved by the control asked for).
+
+- Prediction (the paper's Tables 1 and 2): the latent ERD report's windows of the held-out clips (16 seed
+  frames, then 212 predicted; latent_erd/measures.py), driven by the clip's own control. From 4 initial
+  frames: z1 is the posterior mean of the last 4 seed frames (padded as in training); from the prior: z1 is
+  a draw of N(0, I). The generation starts at the first of those 4 frames, so its frame 4 + k - 1 is the
+  window's predicted frame k. The root starts where the clip's (smoothed) root is at that frame and moves by
+  the clip's own control: the model is given the control, as in the paper.
+- Long runs: random control (training/control.py) for 3,000 frames, prior samples, the cell chunk after
+  chunk; the pose change per second against the real clips' median (the latent ERD's freeze line), and the
+  seams at the chunk boundaries.
+- Diversity: prior samples for one control signal, mean pairwise joint distance relative to the hips,
+  beside the same for real held-out and training windows with similar control.
+- Foot sliding: both measures (contact bits; lowest foot point near the floor), before and after the
+  contact labels and lock (footlock.plant_feet, as the page), against the held-out real clips.
+"""
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .. import metrics
+from ..control import Rng, random_control
+from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, POSITION_DIM, WindowCorpus, ground_frame, rows_to_world
+from ..footlock import plant_feet
+from ..latent_erd.measures import FREEZE_FRACTION, HORIZONS, PREDICT_FRAMES, SEED_FRAMES, Window, prediction_errors
+from ..mocap.skeleton import canonical_skeleton
+from ..onnx.sessions import cpu_session
+from .generation import SEED_FRAMES as INITIAL_FRAMES
+from .generation import SEED_PAD
+
+LONG_RUN_FRAMES = 3000
+DIVERSITY_SAMPLES = 10
+SIMILAR_SPEED = 0.15  # m/s: real windows whose mean forward speed is this close count as similar control
+SIMILAR_TURN = 0.15  # rad/s, the same for the mean turn
+
+
+@dataclass
+class ShippedVae:
+    """The four exported graphs and the JSON, run the way the page runs them."""
+    info: dict
+    sessions: dict
+
+    @classmethod
+    def load(cls, models_dir: Path) -> "ShippedVae":
+        info = json.loads((models_dir / "vae-lstm.json").read_text())
+        return cls(info, {k: cpu_session(models_dir / f) for k, f in info["files"].items()})
+
+    @property
+    def fps(self) -> float:
+        return float(self.info["fps"])
+
+    @property
+    def mean(self) -> np.ndarray:
+        return np.array(self.info["normalisation"]["mean"])
+
+    @property
+    def std(self) -> np.ndarray:
+        return np.array(self.info["normalisation"]["std"])
+
+    def rows(self, control: np.ndarray, z1: np.ndarray) -> np.ndarray:
+        """Physical rows (frames, dim) for a physical control (frames, 3) from z1 (latent,)."""
+        frames = len(control)
+        padded = np.concatenate([control, np.repeat(control[-1:], -frames % 4, 0)])
+        c = ((padded - self.mean[CONTROL_SLICE]) / self.std[CONTROL_SLICE]).astype(np.float32)
+        hc = self.sessions["control"].run(["hc"], {"control": c[None]})[0]
+        steps, chunk = hc.shape[1], self.info["chunk_steps"]
+        n = -(-steps // chunk)
+        hc = np.concatenate([hc, np.repeat(hc[:, -1:], n * chunk - steps, 1)], axis=1)
+        state, canvas = z1[None].astype(np.float32), []
+        for k in range(n):
+            part, state = self.sessions["cell"].run(["canvas", "state_out"], {"hc": hc[:, k * chunk:(k + 1) * chunk], "state": state})
+            canvas.append(part)
+        canvas = np.concatenate(canvas, axis=1)[:, :steps]
+        rows = self.sessions["decoder"].run(["rows"], {"canvas": canvas})[0][0, :frames]
+        return rows.astype(np.float64) * self.std + self.mean
+
+    def posterior_mean(self, initial_rows: np.ndarray) -> np.ndarray:
+        """Mean of q(z1 | 4 normalised initial rows), the rows padded to SEED_PAD frames by repeating the last."""
+        x = np.concatenate([initial_rows, np.repeat(initial_rows[-1:], SEED_PAD - len(initial_rows), 0)]).astype(np.float32)
+        return self.sessions["inference"].run(["mean"], {"rows": x[None]})[0][0, 0]
+
+    def prior(self, seed: int) -> np.ndarray:
+        """z1 of a seed, drawn as the page draws it (control.Rng normal)."""
+        rng = Rng(seed)
+        return np.array([rng.normal() for _ in range(self.info["latent"])], np.float32)
+
+    def world(self, control: np.ndarray, z1: np.ndarray, start_xz=(0.0, 0.0), start_heading: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """World positions (frames, joints, 3) with the root moved by `control`, and the decoded contact bits."""
+        rows = self.rows(control, z1)
+        placed = rows.copy()
+        placed[:, CONTROL_SLICE] = control
+        return rows_to_world(placed, self.fps, start_xz, start_heading), (rows[:, CONTACT_SLICE] > 0.5).astype(np.uint8)
+
+
+# ---- prediction ---------------------------------------------------------------------------------
+
+def vae_prediction(vae: ShippedVae, corpus: WindowCorpus, w: Window, z1: np.ndarray | None) -> np.ndarray:
+    """World positions of the window's predicted frames (PREDICT_FRAMES): from 4 initial frames (z1 None) or
+    from the given prior sample."""
+    c = corpus.valid_clips[w.clip]
+    begin = w.start + SEED_FRAMES - INITIAL_FRAMES
+    frames = INITIAL_FRAMES + PREDICT_FRAMES
+    if z1 is None:
+        z1 = vae.posterior_mean(corpus.valid[w.clip][begin:begin + INITIAL_FRAMES])
+    xz, heading = ground_frame(c.positions)
+    control = c.rows[begin:begin + frames, CONTROL_SLICE]
+    positions, _ = vae.world(control, z1, xz[begin], float(heading[begin]))
+    return positions[INITIAL_FRAMES:]
+
+
+def prediction_rows(vae: ShippedVae, corpus: WindowCorpus, windows: list[Window]) -> dict:
+    real = [corpus.valid_clips[w.clip].positions[w.start + SEED_FRAMES: w.start + SEED_FRAMES + PREDICT_FRAMES] for w in windows]
+    posterior = [vae_prediction(vae, corpus, w, None) for w in windows]
+    prior = [vae_prediction(vae, corpus, w, vae.prior(i)) for i, w in enumerate(windows)]
+    return {"VAE-LSTM, 4 initial frames": prediction_errors(posterior, real),
+            "VAE-LSTM, prior sample": prediction_errors(prior, real)}
+
+
+# ---- long runs and seams --------------------------------------------------------------------------
+
+def pose_change(positions: np.ndarray, fps: float) -> np.ndarray:
+    return metrics.pose_change_per_second(positions, fps)
+
+
+def long_run(vae: ShippedVae, seed: int, frames: int = LONG_RUN_FRAMES) -> dict:
+    control = random_control(seed, frames, vae.fps)
+    t0 = time.perf_counter()
+    positions, bits = vae.world(control, vae.prior(seed))
+    seconds = time.perf_counter() - t0
+    return {"seed": seed, "positions": positions, "bits": bits, "control": control, "seconds": seconds}
+
+
+def chunk_seams(positions: np.ndarray, chunk_frames: int) -> dict:
+    """Mean joint displacement relative to the hips between consecutive frames (cm/frame): across a chunk
+    boundary of the cell (every chunk_frames frames) and elsewhere."""
+    local = positions - positions[:, :1]
+    d = np.linalg.norm(np.diff(local, axis=0), axis=-1).mean(axis=1) * 100
+    boundary = (np.arange(1, len(positions)) % chunk_frames) == 0
+    return {"boundary_cm": round(float(d[boundary].mean()), 3), "elsewhere_cm": round(float(d[~boundary].mean()), 3),
+            "ratio": round(float(d[boundary].mean() / d[~boundary].mean()), 3), "boundaries": int(boundary.sum())}
+
+
+# ---- diversity --------------------------------------------------------------------------------------
+
+def mean_pairwise(motions: list[np.ndarray]) -> float:
+    """Mean over pairs of the mean joint distance (cm) between two motions of equal length, each relative to
+    its hips (root aligned) in its own facing frame."""
+    d = [np.linalg.norm(motions[i] - motions[j], axis=-1).mean() for i in range(len(motions)) for j in range(i + 1, len(motions))]
+    return round(float(np.mean(d)) * 100, 2)
+
+
+def local_positions(rows: np.ndarray) -> np.ndarray:
+    local = rows[:, :POSITION_DIM].reshape(len(rows), -1, 3)
+    return local - local[:, :1]
+
+
+def diversity(vae: ShippedVae, corpus: WindowCorpus, window: int = 120) -> dict:
+    """Prior samples for the control of each held-out window against the real windows of similar control."""
+    out = []
+    all_clips = corpus.valid_clips + corpus.train_clips[::6]  # the training clips unaugmented: every 6th copy
+    real_windows = [(c.rows[a:a + window]) for c in all_clips for a in range(0, len(c.rows) - window + 1, window // 2)]
+    stats = np.array([[r[:, CONTROL_SLICE.start].mean(), r[:, CONTROL_SLICE.start + 2].mean()] for r in real_windows])
+    for c in corpus.valid_clips:
+        for a in range(0, len(c.rows) - window + 1, window):
+            control = c.rows[a:a + window, CONTROL_SLICE]
+            samples = [local_positions(vae.rows(control, vae.prior(1000 + k))) for k in range(DIVERSITY_SAMPLES)]
+            fwd, turn = control[:, 0].mean(), control[:, 2].mean()
+            similar = [local_positions(real_windows[i]) for i in np.flatnonzero((np.abs(stats[:, 0] - fwd) < SIMILAR_SPEED) & (np.abs(stats[:, 1] - turn) < SIMILAR_TURN))]
+            out.append({"clip": c.file, "start": a, "forward": round(float(fwd), 2), "turn": round(float(turn), 2),
+                        "prior_samples_cm": mean_pairwise(samples), "real_similar_cm": mean_pairwise(similar[:20]) if len(similar) > 1 else None,
+                        "real_similar_windows": len(similar)})
+    return {"windows": out, "samples": DIVERSITY_SAMPLES,
+            "prior_samples_cm": round(float(np.mean([o["prior_samples_cm"] for o in out])), 2),
+            "real_similar_cm": round(float(np.mean([o["real_similar_cm"] for o in out if o["real_similar_cm"] is not None])), 2)}
+
+
+# ---- sliding ----------------------------------------------------------------------------------------
+
+def sliding(runs: list[tuple[np.ndarray, np.ndarray]], fps: float) -> dict:
+    skel = canonical_skeleton()
+    locked = [plant_feet(p, c, fps, skel) for p, c in runs]
+    return {"contact_bits_before": round(metrics.foot_skating_clips(runs, fps, skel), 3),
+            "contact_bits_after": round(metrics.foot_skating_clips(locked, fps, skel), 3),
+            "low_foot_before": round(metrics.low_foot_sliding_clips([p for p, _ in runs], fps, skel), 3),
+            "low_foot_after": round(metrics.low_foot_sliding_clips([p for p, _ in locked], fps, skel), 3)}
+
+
+def held_out_control_runs(vae: ShippedVae, corpus: WindowCorpus) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Each held-out clip's own control, a prior sample per clip: positions and decoded bits."""
+    return [vae.world(c.rows[:, CONTROL_SLICE], vae.prior(i)) for i, c in enumerate(corpus.valid_clips)]
+
+
+def freeze_stats(positions: np.ndarray, fps: float, median: float) -> dict:
+    changes = pose_change(positions, fps)
+    return {"lowest_second": round(float(changes.min() / median), 3), "median_second": round(float(np.median(changes) / median), 3),
+            "share_below": round(float((changes < FREEZE_FRACTION * median).mean()), 4)}
+
+
+__all__ = ["HORIZONS", "ShippedVae", "chunk_seams", "diversity", "freeze_stats", "held_out_control_runs", "long_run",
+           "prediction_rows", "sliding"]

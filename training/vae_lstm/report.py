@@ -1,0 +1,173 @@
+"""docs/models/vae-lstm.{md,json}: the VAE-LSTM measured as training/vae_lstm/measures.py describes, beside the
+latent ERD report's rows on the same windows (docs/models/latent-erd.json) and the page's numbers on the
+benchmark paths (docs/models/vae-lstm-browser.json, npm run evaluate:vae-lstm).
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from .. import metrics
+from ..data.locomotion import load_clips
+from ..data.windows import WindowCorpus
+from ..latent_erd import measures as erd_measures
+from ..paths import MODELS_DIR, REPO_ROOT, REPORTS_DIR
+from . import measures as m
+
+REPORT_JSON = REPORTS_DIR / "vae-lstm.json"
+BROWSER_JSON = REPORTS_DIR / "vae-lstm-browser.json"
+ERD_JSON = REPORTS_DIR / "latent-erd.json"
+NOTES_JSON = REPORTS_DIR / "vae-lstm-notes.json"
+TRAINING_RUNS = ("vae-lstm",)
+LONG_RUN_SEEDS = 5
+
+
+def evaluate(mocap: str | None, previous: dict, models_dir: Path = MODELS_DIR) -> dict:
+    corpus = WindowCorpus(load_clips(mocap))
+    vae = m.ShippedVae.load(models_dir)
+    fps = vae.fps
+    report: dict = {"fps": fps, "chunk_frames": vae.info["chunk_steps"] * vae.info["pooling"], "window_frames": vae.info["window"]}
+
+    windows = erd_measures.prediction_windows(corpus)
+    rows = m.prediction_rows(vae, corpus, windows)
+    if ERD_JSON.exists():
+        erd = json.loads(ERD_JSON.read_text()).get("prediction", {})
+        if erd.get("windows") == len(windows):
+            rows.update({name: row for name, row in erd["rows"].items()})
+    report["prediction"] = {"windows": len(windows), "clips": sorted({corpus.valid_clips[w.clip].file for w in windows}),
+                            "rows": {name: {kind: {int(k): v for k, v in e.items()} for kind, e in row.items()} for name, row in rows.items()}}
+
+    median = erd_measures.real_pose_change_median(corpus, fps)
+    runs, long_outputs = [], []
+    for seed in range(LONG_RUN_SEEDS):
+        r = m.long_run(vae, seed)
+        runs.append({"seed": seed, "frames": len(r["positions"]), "finite": bool(np.isfinite(r["positions"]).all()),
+                     **m.freeze_stats(r["positions"], fps, median), "native_seconds": round(r["seconds"], 3),
+                     "x_real_time_native": round(len(r["positions"]) / fps / r["seconds"], 1),
+                     "seams": m.chunk_seams(r["positions"], report["chunk_frames"])})
+        long_outputs.append((r["positions"], r["bits"]))
+    report["long_runs"] = {"real_median_pose_change": round(median, 4), "runs": runs,
+                           "real_share_below": erd_measures.real_share_below(corpus, fps, median),
+                           "real_frame_change_cm": erd_measures.real_frame_change(corpus)}
+    report["diversity"] = m.diversity(vae, corpus)
+    held_out = m.held_out_control_runs(vae, corpus)
+    report["energy"] = {"held_out_control": round(float(np.mean([metrics.pose_change_per_second(p, fps).mean() for p, _ in held_out]) / median), 3),
+                        "real": round(float(np.mean([metrics.pose_change_per_second(c.positions, fps).mean() for c in corpus.valid_clips]) / median), 3)}
+    report["sliding_held_out_control"] = m.sliding(held_out, fps)
+    report["sliding_random_control"] = m.sliding(long_outputs, fps)
+    report["sliding_real"] = erd_measures.real_sliding(corpus, fps)
+    if BROWSER_JSON.exists():
+        report["browser"] = json.loads(BROWSER_JSON.read_text())
+    report["sizes_bytes"] = {f: (models_dir / f).stat().st_size for f in vae.info["files"].values()}
+    report["training"] = dict(previous.get("training", {}))
+    for name in TRAINING_RUNS:
+        summary = REPO_ROOT / "runs" / name / "summary.json"
+        if summary.exists():
+            report["training"][name] = json.loads(summary.read_text())
+    return report
+
+
+def _row(cells) -> str:
+    return "| " + " | ".join(str(c) for c in cells) + " |"
+
+
+def prediction_table(pred: dict, kind: str) -> list[str]:
+    horizons = m.HORIZONS
+    out = [_row(["model", "initial frames", "control signal", *[f"frame {h}" for h in horizons]]), _row(["---"] * (3 + len(horizons)))]
+    seeds = {"VAE-LSTM, 4 initial frames": "4", "VAE-LSTM, prior sample": "0", "latent ERD": "16", "pose-space ERD": "16",
+             "generator (free-running)": "16"}
+    for name, row in pred["rows"].items():
+        control = "no" if name.startswith("generator") else "yes"
+        out.append(_row([name, seeds.get(name, "?"), control, *[row[kind].get(h, row[kind].get(str(h))) for h in horizons]]))
+    return out
+
+
+def browser_table(browser: dict) -> list[str]:
+    out = [_row(["path", "gait", "model", "mean error (m)", "worst run's mean (m)", "max error (m)", "arc progress (least)",
+                 "× real time (least)", "sliding after lock (m/s)", "sliding before lock (m/s)"]), _row(["---"] * 10)]
+    for r in browser.get("paths", []):
+        out.append(_row([r["path"], r["gait"], r["model"], f"{r['meanError']:.3f}", f"{r['worstMeanError']:.3f}", f"{r['maxError']:.3f}",
+                         f"{r['leastProgress'] * 100:.1f}%", f"{r['leastRealTime']:.1f}", f"{r['sliding']:.3f}", f"{r['slidingBeforeLock']:.3f}"]))
+    return out
+
+
+def write_markdown(r: dict, notes: dict, path: Path) -> None:
+    pred = r["prediction"]
+    lines = ["# VAE-LSTM (Habibie et al.): motion for a whole control signal in one pass", ""]
+    lines += notes.get("summary", [])
+    lines += ["", "## Prediction from held-out clips (the paper's Tables 1 and 2)", "",
+              f"{pred['windows']} windows of the held-out clips ({', '.join(pred['clips'])}), the latent ERD report's windows: 16 seed frames, "
+              "then the error at predicted frames 70 to 210 (30 fps, so frame 210 is 7 s on). Every model is given the clip's own "
+              "control signal except the generator, which has no control input and free-runs from the same 16 frames. The VAE-LSTM's "
+              "root moves by that control (as the page moves it by the drawn path's); the ERDs move by their decoded control. "
+              "Rows other than the VAE-LSTM's are the latent ERD report's (docs/models/latent-erd.json), measured on the same windows.", "",
+              "Table 1 form: mean joint position error in the world (cm).", ""]
+    lines += prediction_table(pred, "with_root_cm")
+    lines += ["", "Table 2 form: mean joint position error relative to the root (hips), ignoring translation (cm).", ""]
+    lines += prediction_table(pred, "relative_cm")
+    lines += [""] + notes.get("prediction", [])
+    lr = r["long_runs"]
+    lines += ["", "## Long runs: 3,000 frames of chained chunks", "",
+              f"Random control (`random_control`, new target speed 0.4–2.0 m/s and turn ±1.2 rad/s every 2 s), one prior sample "
+              f"per seed, the cell run chunk after chunk ({r['chunk_frames']} frames each, the state carried). The freeze line is 20% of "
+              f"the real clips' median pose change ({lr['real_median_pose_change']} m/s); real clips spend {lr['real_share_below'] * 100:.1f}% of their seconds below it. "
+              f"Seams: mean joint displacement relative to the hips between consecutive frames across a chunk boundary and elsewhere "
+              f"(real held-out clips: {lr['real_frame_change_cm']} cm per frame).", "",
+              _row(["seed", "frames", "finite", "lowest second / real median", "median second / real median", "seconds below 20%",
+                    "across a chunk boundary (cm)", "elsewhere (cm)", "× real time (native, 1 thread)"]), _row(["---"] * 9)]
+    for run in lr["runs"]:
+        s = run["seams"]
+        lines.append(_row([run["seed"], run["frames"], run["finite"], run["lowest_second"], run["median_second"], f"{run['share_below'] * 100:.1f}%",
+                           s["boundary_cm"], s["elsewhere_cm"], run["x_real_time_native"]]))
+    d = r["diversity"]
+    lines += ["", "## Variations from the prior", "",
+              f"For the control signal of each 4 s held-out window, {d['samples']} prior samples: mean pairwise joint distance relative to "
+              f"the hips (each in its own facing frame), beside the same between real windows (held-out and training clips) whose mean "
+              f"forward speed is within {m.SIMILAR_SPEED} m/s and mean turn within {m.SIMILAR_TURN} rad/s of it.", "",
+              f"Mean over windows: prior samples {d['prior_samples_cm']} cm; real windows with similar control {d['real_similar_cm']} cm.", "",
+              _row(["clip", "start", "forward (m/s)", "turn (rad/s)", "prior samples (cm)", "real, similar control (cm)", "similar real windows"]),
+              _row(["---"] * 7)]
+    for w in d["windows"]:
+        lines.append(_row([w["clip"], w["start"], w["forward"], w["turn"], w["prior_samples_cm"], w["real_similar_cm"], w["real_similar_windows"]]))
+    lines += [""] + notes.get("diversity", [])
+    e = r["energy"]
+    lines += ["", "## Foot sliding", "",
+              "Two measures, each clip or run on its own: the toe's horizontal speed while its contact bit is on (contact-bit measure) and "
+              "the horizontal speed of each foot's lowest point while within 4 cm of the floor (no contact bits needed). After the lock: "
+              "contacts labelled on the motion from the decoded channels, then the foot lock (`training/footlock.py` = `web/motion/footLock.ts`), "
+              "as the page shows it. The root comes straight from the control signal, not from the body.", "",
+              _row(["motion", "contact-bit measure before / after lock (m/s)", "lowest-point measure before / after lock (m/s)"]), _row(["---"] * 3),
+              _row(["real held-out clips", r["sliding_real"]["contact_bits"], r["sliding_real"]["low_foot"]])]
+    for key, name in (("sliding_held_out_control", "VAE-LSTM, held-out clips' control, prior samples"),
+                      ("sliding_random_control", "VAE-LSTM, random control (the long runs)")):
+        s = r[key]
+        lines.append(_row([name, f"{s['contact_bits_before']} / {s['contact_bits_after']}", f"{s['low_foot_before']} / {s['low_foot_after']}"]))
+    lines += ["", f"Motion energy (mean pose change per second against the real median): real held-out clips {e['real']}, the VAE-LSTM driven by their control {e['held_out_control']}."]
+    if "browser" in r:
+        b = r["browser"]
+        lines += ["", "## The five benchmark paths in the page", "",
+                  f"`npm run evaluate:vae-lstm` ({b.get('date', '?')}, headless Chromium, {b.get('seeds', '?')} seeds per case, cross-origin isolated: "
+                  f"{b.get('isolated', '?')}, load average {b.get('load_before', '?')} before). `tests/fixtures/benchmark_paths.json`, each model through "
+                  "`playground.followPath` as the page runs it; × real time is the motion's seconds over the seconds it took to compute.", ""]
+        lines += browser_table(b)
+    lines += ["", "## Model and training", ""] + notes.get("model", [])
+    lines += ["", _row(["file", "bytes"]), _row(["---", "---"])] + [_row([f, n]) for f, n in r["sizes_bytes"].items()]
+    lines += [f"", f"In all {sum(r['sizes_bytes'].values()) / 1e6:.2f} MB."]
+    if r.get("training"):
+        lines += ["", _row(["run", "minutes", "iterations", "best held-out error from 4 frames (cm)", "parameters"]), _row(["---"] * 5)]
+        for name, t in r["training"].items():
+            lines.append(_row([name, round(t["minutes"], 1), t["iterations"], round(t["best_valid_cm"], 2), t["parameters"]]))
+    lines += ["", "## Pilots", ""] + notes.get("pilots", [])
+    lines += ["", "## Where it falls short", ""] + notes.get("short", [])
+    path.write_text("\n".join(lines) + "\n")
+
+
+def write_report(mocap: str | None) -> dict:
+    previous = json.loads(REPORT_JSON.read_text()) if REPORT_JSON.exists() else {}
+    notes = json.loads(NOTES_JSON.read_text()) if NOTES_JSON.exists() else {}
+    report = evaluate(mocap, previous)
+    REPORT_JSON.write_text(json.dumps(report, indent=1) + "\n")
+    write_markdown(report, notes, REPORTS_DIR / "vae-lstm.md")
+    return report

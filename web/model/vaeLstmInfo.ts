@@ -1,0 +1,100 @@
+// The VAE-LSTM's description file, public/models/vae-lstm.json, written by `python -m training.vae_lstm.export`:
+// its four ONNX graphs (the cell over one chunk of steps, the control encoder, the canvas decoder, the
+// inference network) and their input and output names, the skeleton, the 80-value row layout and its
+// normalisation. The parse checks what the runtime relies on and names the file and the first bad field.
+import { modelInfoFormat } from './modelInfo';
+
+export const VAE_LSTM_GRAPHS = {
+  cell: { inputs: ['hc', 'state'], outputs: ['canvas', 'state_out'] },
+  control: { inputs: ['control'], outputs: ['hc'] },
+  decoder: { inputs: ['canvas'], outputs: ['rows'] },
+  inference: { inputs: ['rows'], outputs: ['mean', 'log_var'] },
+} as const;
+
+export type VaeLstmGraph = keyof typeof VAE_LSTM_GRAPHS;
+
+export interface VaeLstmInfo {
+  id: string;
+  kind: string;
+  /** The cell graph's ONNX file (the model's main file), relative to the JSON. */
+  file: string;
+  files: Record<VaeLstmGraph, string>;
+  fps: number;
+  /** Frames of the training window (120: 4 s). */
+  window: number;
+  /** Frames per step (4). */
+  pooling: number;
+  /** Steps the cell graph runs per call (30: one window). */
+  chunk_steps: number;
+  /** Size of the latent code and of the cell state. */
+  latent: number;
+  /** Size of the control encoding per step. */
+  control_features: number;
+  /** Initial frames the posterior reads (4), padded to seed_pad frames by repeating the last. */
+  seed_frames: number;
+  seed_pad: number;
+  onnx: Record<VaeLstmGraph, { inputs: string[]; outputs: string[] }>;
+  skeleton: { joints: string[]; parents: number[]; offsets: number[] };
+  rows: {
+    dim: number;
+    /** [start, end) of the joint positions (root facing frame: x left, y up, z forward), the control and the contacts. */
+    positions: [number, number];
+    control: [number, number];
+    contacts: [number, number];
+    joints: string[];
+  };
+  normalisation: { mean: number[]; std: number[] };
+  parity_max_abs?: Record<string, number>;
+  report?: Record<string, unknown>;
+}
+
+const format = modelInfoFormat<VaeLstmInfo>('VaeLstmInfoError', 'vae-lstm.json', (check, root) => {
+  const { fail, obj, posInt, strings } = check;
+  const files = obj(root.files, 'files');
+  const onnx = obj(root.onnx, 'onnx');
+  for (const [graph, names] of Object.entries(VAE_LSTM_GRAPHS)) {
+    if (typeof files[graph] !== 'string' || !files[graph]) fail(`files.${graph} must name the ${graph} ONNX file`);
+    const io = obj(onnx[graph], `onnx.${graph}`);
+    check.names(io.inputs, `onnx.${graph}.inputs`, names.inputs);
+    check.names(io.outputs, `onnx.${graph}.outputs`, names.outputs);
+  }
+  if (root.file !== files.cell) fail(`file must be files.cell (${String(files.cell)}), got ${String(root.file)}`);
+  const pooling = posInt(root.pooling, 'pooling');
+  if (pooling !== 4) fail(`pooling must be 4 (two max-poolings of 2), got ${pooling}`);
+  posInt(root.window, 'window');
+  posInt(root.chunk_steps, 'chunk_steps');
+  posInt(root.latent, 'latent');
+  posInt(root.control_features, 'control_features');
+  const seedFrames = posInt(root.seed_frames, 'seed_frames');
+  if (posInt(root.seed_pad, 'seed_pad') < seedFrames) fail(`seed_pad must be at least seed_frames (${seedFrames})`);
+  const J = check.skeleton(root.skeleton);
+  const rows = obj(root.rows, 'rows');
+  const dim = posInt(rows.dim, 'rows.dim');
+  const range = (name: 'positions' | 'control' | 'contacts', size: number) => {
+    const [a, b] = check.numbers(rows[name], `rows.${name}`, 2);
+    if (!(Number.isInteger(a) && Number.isInteger(b) && a >= 0 && b <= dim && b - a === size)) fail(`rows.${name} is [${a}, ${b}], expected ${size} channels within the ${dim}-value row`);
+  };
+  range('positions', 3 * J);
+  range('control', 3);
+  range('contacts', 2);
+  const joints = strings(rows.joints, 'rows.joints');
+  if (joints.join() !== (root.skeleton as { joints: string[] }).joints.join()) fail('rows.joints must list skeleton.joints in the same order');
+  check.normalisation(root.normalisation, dim);
+});
+
+export const VaeLstmInfoError = format.InfoError;
+/** Checks a parsed vae-lstm.json; throws VaeLstmInfoError naming the file and the first bad field. */
+export const parseVaeLstmInfo = format.parse;
+export const loadVaeLstmInfo = format.load;
+
+/** The model as the worker loads it: its JSON and the URLs of its other three graphs. */
+export interface VaeLstmModel {
+  info: VaeLstmInfo;
+  urls: Record<VaeLstmGraph, string>;
+}
+
+export async function loadVaeLstmModel(url: string): Promise<VaeLstmModel> {
+  const info = await loadVaeLstmInfo(url);
+  const urls = Object.fromEntries(Object.entries(info.files).map(([k, f]) => [k, new URL(f, url).href])) as Record<VaeLstmGraph, string>;
+  return { info, urls };
+}
