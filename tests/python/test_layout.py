@@ -110,6 +110,7 @@ MAY_IMPORT = {
     "refiner": {"mocap", "data", "models", "generator"} | SHARED,
     "autoencoder": {"mocap", "data", "models"} | SHARED,
     "latent_erd": {"mocap", "data", "models", "autoencoder", "control", "generator"} | SHARED,
+    "vae_lstm": {"mocap", "data", "models", "control", "latent_erd"} | SHARED,
     "bench": {"models"} | SHARED,
     "fixtures": {"mocap", "data", "models", "generator", "refiner", "aclstm", "control", "autoencoder", "latent_erd"} | SHARED,
 }

@@ -1,0 +1,103 @@
+"""The VAE-LSTM's pieces: the cell of eqs. 7-9 in its two modes, generation chunk by chunk against one pass, the
+4-frame posterior seed, the shipped export against its fixture, the page's z1 draws (control.Rng.normal), and a
+training step that lowers the loss on a fixed batch."""
+import json
+
+import numpy as np
+import pytest
+import torch
+
+from conftest import REPO
+from training.control import Rng
+from training.data.windows import ROW_DIM
+from training.models.vae_lstm import POOLING, VaeLstm
+from training.vae_lstm.exporting import PRIOR_FIXTURE_SEED, generate_rows
+from training.vae_lstm.generation import SEED_FRAMES, SEED_PAD, seed_window
+from training.vae_lstm.measures import ShippedVae
+from training.vae_lstm.training import energy_loss, kl_per_step, losses
+
+FIXTURE = REPO / "tests" / "fixtures" / "vae_lstm_reference.json"
+
+
+@pytest.fixture(scope="module")
+def model() -> VaeLstm:
+    torch.manual_seed(0)
+    return VaeLstm(ROW_DIM, latent=16, control_features=8, inference_features=12, decoder_hidden=8).eval()
+
+
+def test_teacher_mode_reads_the_latents_and_free_mode_its_own_state(model):
+    hc = torch.randn(2, 6, 8)
+    z = torch.randn(2, 6, 16)
+    with torch.no_grad():
+        teacher, _ = model.cell.run(z[:, 0], hc, latents=z)
+        free, last = model.cell.run(z[:, 0], hc)
+    # The first step is the same in both (its previous state is z1 either way); later steps differ.
+    torch.testing.assert_close(teacher[:, 0], free[:, 0])
+    assert float((teacher[:, 1:] - free[:, 1:]).abs().max()) > 1e-3
+    torch.testing.assert_close(last, free[:, -1])
+    # Free mode: step t's content is step t-1's output, so rerunning from any state continues the canvas.
+    with torch.no_grad():
+        again, _ = model.cell.run(free[:, 2], hc[:, 3:])
+    torch.testing.assert_close(again, free[:, 3:])
+
+
+def test_generation_in_chunks_equals_one_pass(model):
+    frames = 4 * 70  # 70 steps: more than two chunks of 30
+    control = np.random.default_rng(0).normal(size=(frames, 3)).astype(np.float32)
+    z1 = np.random.default_rng(1).normal(size=16).astype(np.float32)
+    chunked = generate_rows(model, control, z1)
+    with torch.no_grad():
+        whole = model.generate(torch.from_numpy(control[None]), torch.from_numpy(z1[None])).numpy()[0]
+    assert chunked.shape == (frames, ROW_DIM)
+    np.testing.assert_allclose(chunked, whole, atol=1e-5)
+
+
+def test_the_posterior_seed_repeats_the_fourth_frame():
+    frames = torch.randn(3, SEED_FRAMES, ROW_DIM)
+    padded = seed_window(frames)
+    assert padded.shape == (3, SEED_PAD, ROW_DIM)
+    torch.testing.assert_close(padded[:, :SEED_FRAMES], frames)
+    assert bool((padded[:, SEED_FRAMES:] == frames[:, -1:]).all())
+
+
+def test_kl_is_zero_at_the_prior_and_energy_sees_a_frozen_window():
+    assert float(kl_per_step(torch.zeros(2, 3, 5), torch.zeros(2, 3, 5)).abs().max()) == 0
+    assert float(kl_per_step(torch.ones(1, 1, 5), torch.zeros(1, 1, 5))) == pytest.approx(2.5)
+    t = torch.arange(120, dtype=torch.float32)
+    stride = torch.sin(2 * np.pi * t / 30)[None, :, None].repeat(2, 1, 4)
+    assert float(energy_loss(torch.roll(stride, 7, dims=1), stride)) < 1e-3  # out of phase, the same energy
+    assert float(energy_loss(torch.zeros_like(stride), stride)) > 0.01
+
+
+def test_a_training_step_lowers_the_loss_on_a_fixed_batch():
+    torch.manual_seed(1)
+    net = VaeLstm(ROW_DIM, latent=16, control_features=8, inference_features=12, decoder_hidden=8, dropout=0.0)
+    x = torch.randn(4, 40, ROW_DIM) * 0.3
+    c = torch.randn(4, 40, 3) * 0.3
+    opt = torch.optim.Adam(net.parameters(), lr=3e-3)
+    first = None
+    for _ in range(30):
+        t = losses(net, x, c)
+        loss = t["teacher"] + t["free"] + 0.01 * (t["kl"] + t["kl_first"]) / (POOLING * ROW_DIM)
+        first = float(loss) if first is None else first
+        opt.zero_grad()
+        loss.backward()
+        opt.step()
+    assert float(loss) < 0.8 * first
+
+
+def test_the_page_draws_z1_as_the_fixture_says():
+    fixture = json.loads(FIXTURE.read_text())
+    rng = Rng(fixture["prior"]["seed"])
+    assert fixture["prior"]["seed"] == PRIOR_FIXTURE_SEED
+    np.testing.assert_allclose([rng.normal() for _ in fixture["prior"]["z1"]], fixture["prior"]["z1"], atol=1e-8)
+
+
+def test_the_shipped_graphs_reproduce_the_fixture_generation():
+    fixture = json.loads(FIXTURE.read_text())
+    vae = ShippedVae.load(REPO / "public" / "models")
+    g = fixture["generate"]
+    control = np.array(g["control"]).reshape(-1, 3)
+    rows = vae.rows(control, np.array(g["z1"], np.float32))
+    normalised = (rows - vae.mean) / vae.std
+    np.testing.assert_allclose(normalised.ravel(), g["rows"], atol=fixture["tolerance"])
