@@ -12,7 +12,7 @@ from training.control import Rng
 from training.data.windows import ROW_DIM
 from training.models.vae_lstm import POOLING, VaeLstm
 from training.vae_lstm.exporting import PRIOR_FIXTURE_SEED, generate_rows
-from training.vae_lstm.generation import SEED_FRAMES, SEED_PAD, seed_window
+from training.vae_lstm.generation import SEED_FRAMES, SEED_PAD, prior_latents, seed_window
 from training.vae_lstm.measures import ShippedVae
 from training.vae_lstm.training import energy_loss, kl_per_step, losses
 
@@ -86,11 +86,17 @@ def test_a_training_step_lowers_the_loss_on_a_fixed_batch():
     assert float(loss) < 0.8 * first
 
 
-def test_the_page_draws_z1_as_the_fixture_says():
-    fixture = json.loads(FIXTURE.read_text())
-    rng = Rng(fixture["prior"]["seed"])
-    assert fixture["prior"]["seed"] == PRIOR_FIXTURE_SEED
-    np.testing.assert_allclose([rng.normal() for _ in fixture["prior"]["z1"]], fixture["prior"]["z1"], atol=1e-8)
+def test_the_prior_draws_are_the_fixture_s_and_correlated_as_asked():
+    p = json.loads(FIXTURE.read_text())["prior"]
+    assert p["seed"] == PRIOR_FIXTURE_SEED
+    rng = Rng(p["seed"])
+    np.testing.assert_allclose([rng.normal() for _ in p["z1"]], p["z1"], atol=1e-6)
+    z1, zs = prior_latents(p["seed"], len(p["z1"]), len(p["steps"]), p["rho"])
+    np.testing.assert_allclose(zs, p["steps"], atol=1e-6)
+    np.testing.assert_array_equal(zs[0], z1)
+    _, long = prior_latents(5, 64, 400, 0.9)
+    lag1 = float((long[1:] * long[:-1]).mean() / (long ** 2).mean())
+    assert abs(lag1 - 0.9) < 0.03 and abs(float(long.std()) - 1) < 0.1
 
 
 def test_the_shipped_graphs_reproduce_the_fixture_generation():
@@ -101,3 +107,6 @@ def test_the_shipped_graphs_reproduce_the_fixture_generation():
     rows = vae.rows(control, np.array(g["z1"], np.float32))
     normalised = (rows - vae.mean) / vae.std
     np.testing.assert_allclose(normalised.ravel(), g["rows"], atol=fixture["tolerance"])
+    zs = np.array(fixture["generate_steps"]["zs"], np.float32).reshape(-1, len(g["z1"]))
+    teacher = (vae.rows(control, np.array(g["z1"], np.float32), zs) - vae.mean) / vae.std
+    np.testing.assert_allclose(teacher.ravel(), fixture["generate_steps"]["rows"], atol=fixture["tolerance"])

@@ -6,7 +6,7 @@
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { integrateControl, PolylinePath } from '../../web/motion/control';
 import { parseVaeLstmInfo, VAE_LSTM_GRAPHS, type VaeLstmGraph, type VaeLstmModel } from '../../web/model/vaeLstmInfo';
-import { priorSample, VaeLstmCore } from '../../web/runtime/vaeLstmCore';
+import { priorLatents, VaeLstmCore } from '../../web/runtime/vaeLstmCore';
 import { controlForPath, followPathVae } from '../../web/runtime/vaeLstmRequests';
 import { readRepoFile } from './corpus';
 import { bytes, maxAbsDiff, ort, shippedSession } from './shippedModel';
@@ -19,7 +19,8 @@ interface Fixture {
   tolerance: number;
   graphs: Record<VaeLstmGraph, GraphCase>;
   generate: { control: number[]; frames: number; z1: number[]; rows: number[] };
-  prior: { seed: number; z1: number[] };
+  prior: { seed: number; z1: number[]; rho: number; steps: number[][] };
+  generate_steps: { zs: number[]; rows: number[] };
 }
 
 const json = JSON.parse(readRepoFile('public/models/vae-lstm.json'));
@@ -58,11 +59,23 @@ describe('VAE-LSTM parity with the Python reference', () => {
     console.log(`# VAE-LSTM generation parity: ${err.toExponential(2)} (normalised rows, ${g.frames} frames)`);
     expect(err).toBeLessThan(fixture.tolerance);
   });
+
+  it('the same generation in teacher mode on per-step latents matches torch, and differs from the free mode', async () => {
+    const g = fixture.generate;
+    const { rows } = await core.parity({ generate: { control: g.control, z1: g.z1, zs: fixture.generate_steps.zs } });
+    const normalised = Float64Array.from(rows!, (v, i) => (v - info.normalisation.mean[i % D]) / info.normalisation.std[i % D]);
+    expect(maxAbsDiff(normalised, fixture.generate_steps.rows)).toBeLessThan(fixture.tolerance);
+    expect(maxAbsDiff(normalised, g.rows)).toBeGreaterThan(100 * fixture.tolerance);
+  });
 });
 
 describe('VAE-LSTM generation', () => {
-  it('a seed draws the same z1 as the Python side (control.Rng normal)', () => {
-    expect(maxAbsDiff(priorSample(fixture.prior.seed, info.latent), fixture.prior.z1)).toBeLessThan(1e-6);
+  it('a seed draws the same z1 and per-step latents as the Python side (generation.prior_latents)', () => {
+    const p = fixture.prior;
+    expect(maxAbsDiff(priorLatents(p.seed, info.latent).z1, p.z1)).toBeLessThan(1e-6);
+    const { z1, zs } = priorLatents(p.seed, info.latent, p.steps.length, p.rho);
+    expect(maxAbsDiff(z1, p.z1)).toBeLessThan(1e-6);
+    expect(maxAbsDiff(zs!, p.steps.flat())).toBeLessThan(1e-6);
   });
 
   it('the seed draws z1: the same seed gives the same motion, another seed another one', async () => {
@@ -71,7 +84,7 @@ describe('VAE-LSTM generation', () => {
     const b = await core.generate({ seed: 4, frames: 90, control });
     const c = await core.generate({ seed: 5, frames: 90, control });
     expect(bytes(b.positions)).toEqual(bytes(a.positions));
-    expect(maxAbsDiff(a.z1, priorSample(4, info.latent))).toBe(0);
+    expect(maxAbsDiff(a.z1, priorLatents(4, info.latent).z1)).toBe(0);
     expect(maxAbsDiff(c.rows, a.rows)).toBeGreaterThan(1e-3);
   });
 
@@ -114,6 +127,7 @@ describe('VAE-LSTM generation', () => {
   it('refuses a control shorter than the motion and a z1 of the wrong size', async () => {
     await expect(core.generate({ seed: 0, frames: 10, control: [1, 0, 0] })).rejects.toThrow(/control has 1 frames; it needs at least 10/);
     await expect(core.generate({ seed: 0, frames: 8 }, undefined, { z1: [1, 2] })).rejects.toThrow(/z1 has 2 values/);
+    await expect(core.generate({ seed: 0, frames: 40 }, undefined, { z1: new Float32Array(info.latent), zs: new Float32Array(info.latent) })).rejects.toThrow(/zs has 1 steps; the control needs 10/);
   });
 });
 
@@ -143,8 +157,10 @@ describe('VAE-LSTM paths', () => {
 describe('vae-lstm.json checks', () => {
   it('names the file and the first bad field', () => {
     expect(() => parseVaeLstmInfo({ ...json, files: { ...json.files, decoder: '' } }, 'x.json')).toThrow(/x\.json: files\.decoder must name/);
-    expect(() => parseVaeLstmInfo({ ...json, onnx: { ...json.onnx, cell: { inputs: ['hc'], outputs: ['canvas', 'state_out'] } } })).toThrow(/onnx\.cell\.inputs is \[hc\], expected \[hc,state\]/);
+    expect(() => parseVaeLstmInfo({ ...json, onnx: { ...json.onnx, cell: { inputs: ['hc'], outputs: ['canvas', 'state_out'] } } })).toThrow(/onnx\.cell\.inputs is \[hc\], expected \[hc,state,z,mix\]/);
     expect(() => parseVaeLstmInfo({ ...json, pooling: 2 })).toThrow(/pooling must be 4/);
+    expect(() => parseVaeLstmInfo({ ...json, sampling: { mode: 'steps', rho: 1 } })).toThrow(/sampling\.rho must be in \[0, 1\)/);
+    expect(() => parseVaeLstmInfo({ ...json, sampling: { mode: 'many' } })).toThrow(/sampling\.mode must be "z1" or "steps"/);
     expect(() => parseVaeLstmInfo({ ...json, rows: { ...json.rows, control: [75, 77] } })).toThrow(/rows\.control is \[75, 77\]/);
   });
 });

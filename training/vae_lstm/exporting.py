@@ -1,9 +1,11 @@
 """Exporting the VAE-LSTM: four ONNX graphs, their JSON, parity checked, and
 tests/fixtures/vae_lstm_reference.json for the browser's parity tests.
 
-- vae-lstm.onnx, the cell (eqs. 7–9, free mode) over one chunk of CHUNK_STEPS steps: hc (batch, 30, 128),
-  state (batch, latent) -> canvas (batch, 30, latent), state_out. The state goes in and out, so a path of any
-  length runs chunk after chunk (generation.py).
+- vae-lstm.onnx, the cell (eqs. 7–9) over one chunk of CHUNK_STEPS steps: hc (batch, 30, 128), state (batch,
+  latent), z (batch, 30, latent), mix (1,) -> canvas (batch, 30, latent), state_out. Step t's content is
+  mix · z_t + (1 − mix) · the previous state: mix 0 is the free mode of Algorithm 1 (z unused), mix 1 the
+  teacher mode with a latent per step (the paper's other way to sample). The state goes in and out, so a path
+  of any length runs chunk after chunk (generation.py).
 - vae-lstm-control.onnx, the control encoder: control (batch, frames, 3) normalised, frames a multiple of 4
   -> hc (batch, frames / 4, 128).
 - vae-lstm-decoder.onnx: canvas (batch, steps, latent) -> rows (batch, 4 × steps, 80) normalised.
@@ -21,21 +23,21 @@ import numpy as np
 import torch
 from torch import nn
 
-from ..control import Rng
 from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, JOINTS, POSITION_DIM
 from ..mocap.skeleton import canonical_skeleton
 from ..models.vae_lstm import KERNEL, POOLING, VaeLstm
 from ..onnx.manifest import register_model
 from ..onnx.sessions import cpu_session
 from ..paths import MODELS_DIR, REPO_ROOT
-from .generation import CHUNK_STEPS, SEED_FRAMES, SEED_PAD
+from .generation import CHUNK_STEPS, SEED_FRAMES, SEED_PAD, prior_latents
 
 PARITY_TOLERANCE = 1e-4
 PRIOR_FIXTURE_SEED = 3
+PRIOR_FIXTURE_RHO = 0.9
 FIXTURE = REPO_ROOT / "tests" / "fixtures" / "vae_lstm_reference.json"
 FILES = {"cell": "vae-lstm.onnx", "control": "vae-lstm-control.onnx", "decoder": "vae-lstm-decoder.onnx",
          "inference": "vae-lstm-inference.onnx"}
-NAMES = {"cell": (["hc", "state"], ["canvas", "state_out"]), "control": (["control"], ["hc"]),
+NAMES = {"cell": (["hc", "state", "z", "mix"], ["canvas", "state_out"]), "control": (["control"], ["hc"]),
          "decoder": (["canvas"], ["rows"]), "inference": (["rows"], ["mean", "log_var"])}
 
 
@@ -44,8 +46,12 @@ class CellChunk(nn.Module):
         super().__init__()
         self.cell = model.cell
 
-    def forward(self, hc, state):
-        return self.cell.run(state, hc)
+    def forward(self, hc, state, z, mix):
+        canvas = []
+        for t in range(hc.shape[1]):
+            state = self.cell(state, mix * z[:, t] + (1 - mix) * state, hc[:, t])
+            canvas.append(state)
+        return torch.stack(canvas, dim=1), state
 
 
 class Wrap(nn.Module):
@@ -64,7 +70,7 @@ def graphs(model: VaeLstm) -> dict[str, nn.Module]:
 
 def example_inputs(model: VaeLstm, batch: int = 1, frames: int = 40) -> dict[str, tuple[torch.Tensor, ...]]:
     hc_dim = model.cell.gates_control.in_features
-    return {"cell": (torch.zeros(batch, CHUNK_STEPS, hc_dim), torch.zeros(batch, model.latent)),
+    return {"cell": (torch.zeros(batch, CHUNK_STEPS, hc_dim), torch.zeros(batch, model.latent), torch.zeros(batch, CHUNK_STEPS, model.latent), torch.zeros(1)),
             "control": (torch.zeros(batch, frames, model.control),),
             "decoder": (torch.zeros(batch, frames // POOLING, model.latent),),
             "inference": (torch.zeros(batch, frames, model.dim),)}
@@ -72,7 +78,7 @@ def example_inputs(model: VaeLstm, batch: int = 1, frames: int = 40) -> dict[str
 
 def export_graphs(model: VaeLstm, out: Path) -> None:
     b = {0: "batch"}
-    dynamic = {"cell": {"hc": b, "state": b, "canvas": b, "state_out": b},
+    dynamic = {"cell": {"hc": b, "state": b, "z": b, "canvas": b, "state_out": b},
                "control": {"control": {0: "batch", 1: "frames"}, "hc": {0: "batch", 1: "steps"}},
                "decoder": {"canvas": {0: "batch", 1: "steps"}, "rows": {0: "batch", 1: "frames"}},
                "inference": {"rows": {0: "batch", 1: "frames"}, "mean": {0: "batch", 1: "steps"}, "log_var": {0: "batch", 1: "steps"}}}
@@ -86,7 +92,8 @@ def export_graphs(model: VaeLstm, out: Path) -> None:
 def random_inputs(model: VaeLstm, rng: np.random.Generator, batch: int, frames: int) -> dict[str, list[np.ndarray]]:
     hc_dim = model.cell.gates_control.in_features
     f32 = lambda *shape: rng.normal(size=shape).astype(np.float32)
-    return {"cell": [np.abs(f32(batch, CHUNK_STEPS, hc_dim)), f32(batch, model.latent)],
+    mix = np.array([float(rng.integers(0, 2))], np.float32)
+    return {"cell": [np.abs(f32(batch, CHUNK_STEPS, hc_dim)), f32(batch, model.latent), f32(batch, CHUNK_STEPS, model.latent), mix],
             "control": [f32(batch, frames, model.control)], "decoder": [f32(batch, frames // POOLING, model.latent)],
             "inference": [f32(batch, frames, model.dim)]}
 
@@ -112,13 +119,14 @@ def check_parity(model: VaeLstm, out: Path) -> dict[str, float]:
     return worst
 
 
-def vae_lstm_info(meta: dict, model: VaeLstm, report: dict) -> dict:
+def vae_lstm_info(meta: dict, model: VaeLstm, report: dict, sampling: dict) -> dict:
     skel = canonical_skeleton()
     return {
         "id": "vae-lstm", "kind": "vae-lstm", "file": FILES["cell"], "files": FILES, "fps": meta["fps"],
         "window": meta["window"], "pooling": POOLING, "kernel": KERNEL, "chunk_steps": CHUNK_STEPS,
         "latent": model.latent, "control_features": model.cell.gates_control.in_features,
         "seed_frames": SEED_FRAMES, "seed_pad": SEED_PAD, "control_smoothing_frames": meta["control_sigma"],
+        "sampling": sampling,
         "onnx": {key: {"inputs": NAMES[key][0], "outputs": NAMES[key][1]} for key in FILES},
         "skeleton": {"joints": skel.joints, "parents": skel.parents, "offsets": skel.offsets.round(6).ravel().tolist()},
         "rows": {"dim": model.dim, "positions": [0, POSITION_DIM], "control": [CONTROL_SLICE.start, CONTROL_SLICE.stop],
@@ -130,24 +138,29 @@ def vae_lstm_info(meta: dict, model: VaeLstm, report: dict) -> dict:
     }
 
 
-def generate_rows(model: VaeLstm, control: np.ndarray, z1: np.ndarray) -> np.ndarray:
+def generate_rows(model: VaeLstm, control: np.ndarray, z1: np.ndarray, zs: np.ndarray | None = None) -> np.ndarray:
     """Normalised rows (frames, dim) for a normalised control (frames, 3), frames a multiple of 4, from z1
-    (latent,), the cell run chunk by chunk as the page runs it (the last chunk padded with its last step)."""
+    (latent,), the cell run chunk by chunk as the page runs it (the last chunk padded with its last step); with
+    `zs` (steps, latent) in teacher mode on those latents."""
     with torch.no_grad():
         hc = model.control_encoder(torch.from_numpy(control[None].astype(np.float32)))
         steps = hc.shape[1]
         chunks = -(-steps // CHUNK_STEPS)
-        padded = torch.cat([hc, hc[:, -1:].expand(-1, chunks * CHUNK_STEPS - steps, -1)], dim=1)
-        state, canvas = torch.from_numpy(z1[None].astype(np.float32)), []
+        pad = lambda x: torch.cat([x, x[:, -1:].expand(-1, chunks * CHUNK_STEPS - steps, -1)], dim=1)
+        padded = pad(hc)
+        z = pad(torch.from_numpy(zs[None].astype(np.float32))) if zs is not None else torch.zeros(1, chunks * CHUNK_STEPS, model.latent)
+        mix = torch.tensor([1.0 if zs is not None else 0.0])
+        state, canvas, chunk = torch.from_numpy(z1[None].astype(np.float32)), [], CellChunk(model)
         for k in range(chunks):
-            part, state = model.cell.run(state, padded[:, k * CHUNK_STEPS:(k + 1) * CHUNK_STEPS])
+            part, state = chunk(padded[:, k * CHUNK_STEPS:(k + 1) * CHUNK_STEPS], state, z[:, k * CHUNK_STEPS:(k + 1) * CHUNK_STEPS], mix)
             canvas.append(part)
         return model.decoder(torch.cat(canvas, dim=1)[:, :steps]).numpy()[0]
 
 
 def write_fixture(model: VaeLstm, info: dict, path: Path = FIXTURE) -> None:
-    """Inputs and torch outputs of each graph, one whole generation over two chunks (36 steps), and the prior
-    sample of one seed (control.Rng, as the page draws z1), for the browser's parity tests."""
+    """Inputs and torch outputs of each graph; one whole generation over two chunks (36 steps) in free mode from
+    z1, and the same in teacher mode on given per-step latents; and the prior draws of one seed
+    (generation.prior_latents, as the page draws them), for the browser's parity tests."""
     rng = np.random.default_rng(7)
     inputs = random_inputs(model, rng, 1, 16)
     modules = graphs(model)
@@ -160,25 +173,28 @@ def write_fixture(model: VaeLstm, info: dict, path: Path = FIXTURE) -> None:
                            "outputs": {n: r.numpy().ravel().round(6).tolist() for n, r in zip(NAMES[key][1], ref)}}
     frames = 4 * (CHUNK_STEPS + 6)
     t = np.arange(frames) / info["fps"]
-    physical = np.stack([1.2 + 0.2 * np.sin(t), np.zeros_like(t), 0.6 * np.sin(0.5 * t)], axis=1)
+    physical = np.stack([1.2 + 0.2 * np.sin(t), np.zeros_like(t), 0.6 * np.sin(0.5 * t)], axis=1).round(6)
     mean, std = np.array(info["normalisation"]["mean"])[CONTROL_SLICE], np.array(info["normalisation"]["std"])[CONTROL_SLICE]
-    z1 = rng.normal(size=model.latent).astype(np.float32)
+    z1 = rng.normal(size=model.latent).round(6).astype(np.float32)
     rows = generate_rows(model, ((physical - mean) / std).astype(np.float32), z1)
-    rng_z = Rng(PRIOR_FIXTURE_SEED)
-    prior = [rng_z.normal() for _ in range(model.latent)]
+    prior, prior_steps = prior_latents(PRIOR_FIXTURE_SEED, model.latent, 5, PRIOR_FIXTURE_RHO)
+    steps = frames // POOLING
+    zs = rng.normal(size=(steps, model.latent)).round(6).astype(np.float32)
+    rows_steps = generate_rows(model, ((physical - mean) / std).astype(np.float32), z1, zs)
     fixture = {"model": info["id"], "tolerance": 2e-4, "graphs": graphs_out,
-               "prior": {"seed": PRIOR_FIXTURE_SEED, "z1": [round(v, 9) for v in prior]},
+               "prior": {"seed": PRIOR_FIXTURE_SEED, "z1": prior.tolist(), "rho": PRIOR_FIXTURE_RHO, "steps": prior_steps.tolist()},
+               "generate_steps": {"zs": zs.round(6).ravel().tolist(), "rows": rows_steps.round(6).ravel().tolist()},
                "generate": {"control": physical.round(6).ravel().tolist(), "frames": frames, "z1": z1.round(6).tolist(),
                             "rows": rows.round(6).ravel().tolist()}}
     path.write_text(json.dumps(fixture) + "\n")
 
 
-def export_vae_lstm(model: VaeLstm, meta: dict, report: dict, out: Path = MODELS_DIR) -> dict:
+def export_vae_lstm(model: VaeLstm, meta: dict, report: dict, sampling: dict, out: Path = MODELS_DIR) -> dict:
     model.eval()
     out.mkdir(parents=True, exist_ok=True)
     export_graphs(model, out)
     parity = check_parity(model, out)
-    info = vae_lstm_info(meta, model, report)
+    info = vae_lstm_info(meta, model, report, sampling)
     info["parity_max_abs"] = parity
     info["bytes"] = sum((out / f).stat().st_size for f in FILES.values())
     (out / "vae-lstm.json").write_text(json.dumps(info) + "\n")

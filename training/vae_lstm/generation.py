@@ -2,6 +2,10 @@
 
 - From the prior (Algorithm 1): z_1 ~ N(0, I) drawn from a seed, the control signal encoded in one pass, the
   cell run on its own state for every step, the canvas decoded in one pass.
+- Or (the paper's other way, §3.3: "we could also consider sampling a latent variable z_t for each frame"):
+  a latent per step in teacher mode, drawn as an AR(1) sequence with N(0, I) marginals and lag-one
+  correlation rho (the posterior's own latents are correlated from step to step). Which of the two a shipped
+  model uses is in its JSON (`sampling`), chosen by measurement (docs/models/vae-lstm.md).
 - From the posterior: z_1 is the mean of q(z_1 | 4 initial frames). The inference network is convolutional
   and reads about 1.2 s around the first step, so the 4 frames are padded to SEED_PAD frames by repeating the
   last (a held pose), the same in training (free mode) and at test time.
@@ -12,7 +16,12 @@
 """
 from __future__ import annotations
 
+import math
+
+import numpy as np
 import torch
+
+from ..control import Rng
 
 SEED_FRAMES = 4
 SEED_PAD = 40  # frames: the first step's receptive field in the inference network reaches 39 frames ahead
@@ -32,3 +41,19 @@ def pad_to_steps(control: torch.Tensor) -> tuple[torch.Tensor, int]:
     if extra:
         control = torch.cat([control, control[:, -1:].expand(-1, extra, -1)], dim=1)
     return control, n
+
+
+def prior_latents(seed: int, latent: int, steps: int = 0, rho: float = 0.0) -> tuple[np.ndarray, np.ndarray | None]:
+    """z1 (latent,) drawn from `seed` by the page's random source (control.Rng normal), and with `steps` the
+    per-step latents (steps, latent): z1 first, then rho · previous + sqrt(1 − rho²) · a new draw, in the
+    same stream (web/runtime/vaeLstmCore.ts priorLatents draws the same)."""
+    rng = Rng(seed)
+    z1 = np.array([rng.normal() for _ in range(latent)], np.float32)
+    if not steps:
+        return z1, None
+    zs = np.empty((steps, latent), np.float32)
+    zs[0] = z1
+    keep, new = rho, math.sqrt(1 - rho * rho)
+    for t in range(1, steps):
+        zs[t] = [keep * float(zs[t - 1, i]) + new * rng.normal() for i in range(latent)]
+    return z1, zs

@@ -25,14 +25,14 @@ from pathlib import Path
 import numpy as np
 
 from .. import metrics
-from ..control import Rng, random_control
+from ..control import random_control
 from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, POSITION_DIM, WindowCorpus, ground_frame, rows_to_world
 from ..footlock import plant_feet
 from ..latent_erd.measures import FREEZE_FRACTION, HORIZONS, PREDICT_FRAMES, SEED_FRAMES, Window, prediction_errors
 from ..mocap.skeleton import canonical_skeleton
 from ..onnx.sessions import cpu_session
 from .generation import SEED_FRAMES as INITIAL_FRAMES
-from .generation import SEED_PAD
+from .generation import SEED_PAD, prior_latents
 
 LONG_RUN_FRAMES = 3000
 DIVERSITY_SAMPLES = 10
@@ -63,8 +63,9 @@ class ShippedVae:
     def std(self) -> np.ndarray:
         return np.array(self.info["normalisation"]["std"])
 
-    def rows(self, control: np.ndarray, z1: np.ndarray) -> np.ndarray:
-        """Physical rows (frames, dim) for a physical control (frames, 3) from z1 (latent,)."""
+    def rows(self, control: np.ndarray, z1: np.ndarray, zs: np.ndarray | None = None) -> np.ndarray:
+        """Physical rows (frames, dim) for a physical control (frames, 3) from z1 (latent,), in teacher mode on
+        the per-step latents `zs` (steps, latent) when given."""
         frames = len(control)
         padded = np.concatenate([control, np.repeat(control[-1:], -frames % 4, 0)])
         c = ((padded - self.mean[CONTROL_SLICE]) / self.std[CONTROL_SLICE]).astype(np.float32)
@@ -72,9 +73,16 @@ class ShippedVae:
         steps, chunk = hc.shape[1], self.info["chunk_steps"]
         n = -(-steps // chunk)
         hc = np.concatenate([hc, np.repeat(hc[:, -1:], n * chunk - steps, 1)], axis=1)
+        latent = self.info["latent"]
+        z = np.zeros((1, n * chunk, latent), np.float32)
+        if zs is not None:
+            z[0, :steps] = zs[:steps]
+            z[0, steps:] = zs[steps - 1]
+        mix = np.array([0.0 if zs is None else 1.0], np.float32)
         state, canvas = z1[None].astype(np.float32), []
         for k in range(n):
-            part, state = self.sessions["cell"].run(["canvas", "state_out"], {"hc": hc[:, k * chunk:(k + 1) * chunk], "state": state})
+            part, state = self.sessions["cell"].run(["canvas", "state_out"], {"hc": hc[:, k * chunk:(k + 1) * chunk], "state": state,
+                                                                              "z": z[:, k * chunk:(k + 1) * chunk], "mix": mix})
             canvas.append(part)
         canvas = np.concatenate(canvas, axis=1)[:, :steps]
         rows = self.sessions["decoder"].run(["rows"], {"canvas": canvas})[0][0, :frames]
@@ -85,14 +93,18 @@ class ShippedVae:
         x = np.concatenate([initial_rows, np.repeat(initial_rows[-1:], SEED_PAD - len(initial_rows), 0)]).astype(np.float32)
         return self.sessions["inference"].run(["mean"], {"rows": x[None]})[0][0, 0]
 
-    def prior(self, seed: int) -> np.ndarray:
-        """z1 of a seed, drawn as the page draws it (control.Rng normal)."""
-        rng = Rng(seed)
-        return np.array([rng.normal() for _ in range(self.info["latent"])], np.float32)
+    def prior(self, seed: int, frames: int, sampling: dict | None = None) -> tuple[np.ndarray, np.ndarray | None]:
+        """A seed's prior sample for `frames` frames, drawn as the page draws it: z1, and per-step latents when
+        the sampling (default the JSON's) is "steps"."""
+        sampling = sampling or self.info["sampling"]
+        if sampling["mode"] == "z1":
+            return prior_latents(seed, self.info["latent"])
+        return prior_latents(seed, self.info["latent"], -(-frames // 4), sampling["rho"])
 
-    def world(self, control: np.ndarray, z1: np.ndarray, start_xz=(0.0, 0.0), start_heading: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    def world(self, control: np.ndarray, z1: np.ndarray, zs: np.ndarray | None = None, start_xz=(0.0, 0.0),
+              start_heading: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """World positions (frames, joints, 3) with the root moved by `control`, and the decoded contact bits."""
-        rows = self.rows(control, z1)
+        rows = self.rows(control, z1, zs)
         placed = rows.copy()
         placed[:, CONTROL_SLICE] = control
         return rows_to_world(placed, self.fps, start_xz, start_heading), (rows[:, CONTACT_SLICE] > 0.5).astype(np.uint8)
@@ -100,26 +112,29 @@ class ShippedVae:
 
 # ---- prediction ---------------------------------------------------------------------------------
 
-def vae_prediction(vae: ShippedVae, corpus: WindowCorpus, w: Window, z1: np.ndarray | None) -> np.ndarray:
-    """World positions of the window's predicted frames (PREDICT_FRAMES): from 4 initial frames (z1 None) or
-    from the given prior sample."""
+def vae_prediction(vae: ShippedVae, corpus: WindowCorpus, w: Window, prior: tuple | None, sampling: dict | None = None) -> np.ndarray:
+    """World positions of the window's predicted frames (PREDICT_FRAMES): from 4 initial frames (prior None:
+    z1 the posterior mean, Algorithm 1) or from the given prior sample (z1, per-step latents or None)."""
     c = corpus.valid_clips[w.clip]
     begin = w.start + SEED_FRAMES - INITIAL_FRAMES
     frames = INITIAL_FRAMES + PREDICT_FRAMES
-    if z1 is None:
-        z1 = vae.posterior_mean(corpus.valid[w.clip][begin:begin + INITIAL_FRAMES])
+    z1, zs = prior if prior is not None else (vae.posterior_mean(corpus.valid[w.clip][begin:begin + INITIAL_FRAMES]), None)
     xz, heading = ground_frame(c.positions)
     control = c.rows[begin:begin + frames, CONTROL_SLICE]
-    positions, _ = vae.world(control, z1, xz[begin], float(heading[begin]))
+    positions, _ = vae.world(control, z1, zs, xz[begin], float(heading[begin]))
     return positions[INITIAL_FRAMES:]
 
 
-def prediction_rows(vae: ShippedVae, corpus: WindowCorpus, windows: list[Window]) -> dict:
+def prediction_rows(vae: ShippedVae, corpus: WindowCorpus, windows: list[Window], samplings: dict[str, dict]) -> dict:
+    """Rows of the tables: from 4 initial frames (Algorithm 1 from the posterior's z1), and from prior samples
+    drawn each way in `samplings` (name: sampling)."""
     real = [corpus.valid_clips[w.clip].positions[w.start + SEED_FRAMES: w.start + SEED_FRAMES + PREDICT_FRAMES] for w in windows]
-    posterior = [vae_prediction(vae, corpus, w, None) for w in windows]
-    prior = [vae_prediction(vae, corpus, w, vae.prior(i)) for i, w in enumerate(windows)]
-    return {"VAE-LSTM, 4 initial frames": prediction_errors(posterior, real),
-            "VAE-LSTM, prior sample": prediction_errors(prior, real)}
+    frames = INITIAL_FRAMES + PREDICT_FRAMES
+    out = {"VAE-LSTM, 4 initial frames": prediction_errors([vae_prediction(vae, corpus, w, None) for w in windows], real)}
+    for name, sampling in samplings.items():
+        made = [vae_prediction(vae, corpus, w, vae.prior(i, frames, sampling)) for i, w in enumerate(windows)]
+        out[f"VAE-LSTM, prior sample ({name})"] = prediction_errors(made, real)
+    return out
 
 
 # ---- long runs and seams --------------------------------------------------------------------------
@@ -128,10 +143,10 @@ def pose_change(positions: np.ndarray, fps: float) -> np.ndarray:
     return metrics.pose_change_per_second(positions, fps)
 
 
-def long_run(vae: ShippedVae, seed: int, frames: int = LONG_RUN_FRAMES) -> dict:
+def long_run(vae: ShippedVae, seed: int, frames: int = LONG_RUN_FRAMES, sampling: dict | None = None) -> dict:
     control = random_control(seed, frames, vae.fps)
     t0 = time.perf_counter()
-    positions, bits = vae.world(control, vae.prior(seed))
+    positions, bits = vae.world(control, *vae.prior(seed, frames, sampling))
     seconds = time.perf_counter() - t0
     return {"seed": seed, "positions": positions, "bits": bits, "control": control, "seconds": seconds}
 
@@ -160,7 +175,7 @@ def local_positions(rows: np.ndarray) -> np.ndarray:
     return local - local[:, :1]
 
 
-def diversity(vae: ShippedVae, corpus: WindowCorpus, window: int = 120) -> dict:
+def diversity(vae: ShippedVae, corpus: WindowCorpus, window: int = 120, sampling: dict | None = None) -> dict:
     """Prior samples for the control of each held-out window against the real windows of similar control."""
     out = []
     all_clips = corpus.valid_clips + corpus.train_clips[::6]  # the training clips unaugmented: every 6th copy
@@ -169,7 +184,7 @@ def diversity(vae: ShippedVae, corpus: WindowCorpus, window: int = 120) -> dict:
     for c in corpus.valid_clips:
         for a in range(0, len(c.rows) - window + 1, window):
             control = c.rows[a:a + window, CONTROL_SLICE]
-            samples = [local_positions(vae.rows(control, vae.prior(1000 + k))) for k in range(DIVERSITY_SAMPLES)]
+            samples = [local_positions(vae.rows(control, *vae.prior(1000 + k, window, sampling))) for k in range(DIVERSITY_SAMPLES)]
             fwd, turn = control[:, 0].mean(), control[:, 2].mean()
             similar = [local_positions(real_windows[i]) for i in np.flatnonzero((np.abs(stats[:, 0] - fwd) < SIMILAR_SPEED) & (np.abs(stats[:, 1] - turn) < SIMILAR_TURN))]
             out.append({"clip": c.file, "start": a, "forward": round(float(fwd), 2), "turn": round(float(turn), 2),
@@ -191,9 +206,15 @@ def sliding(runs: list[tuple[np.ndarray, np.ndarray]], fps: float) -> dict:
             "low_foot_after": round(metrics.low_foot_sliding_clips([p for p, _ in locked], fps, skel), 3)}
 
 
-def held_out_control_runs(vae: ShippedVae, corpus: WindowCorpus) -> list[tuple[np.ndarray, np.ndarray]]:
+def held_out_control_runs(vae: ShippedVae, corpus: WindowCorpus, sampling: dict | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
     """Each held-out clip's own control, a prior sample per clip: positions and decoded bits."""
-    return [vae.world(c.rows[:, CONTROL_SLICE], vae.prior(i)) for i, c in enumerate(corpus.valid_clips)]
+    return [vae.world(c.rows[:, CONTROL_SLICE], *vae.prior(i, len(c.rows), sampling)) for i, c in enumerate(corpus.valid_clips)]
+
+
+def jitter_cm(motions: list[np.ndarray]) -> float:
+    """RMS second difference (cm per frame²) of the joints relative to the hips, over all frames of all motions."""
+    sq = [(np.diff(p - p[:, :1], n=2, axis=0) ** 2).sum(-1).ravel() for p in motions]
+    return round(float(np.sqrt(np.concatenate(sq).mean()) * 100), 3)
 
 
 def freeze_stats(positions: np.ndarray, fps: float, median: float) -> dict:

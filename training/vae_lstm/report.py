@@ -20,8 +20,11 @@ REPORT_JSON = REPORTS_DIR / "vae-lstm.json"
 BROWSER_JSON = REPORTS_DIR / "vae-lstm-browser.json"
 ERD_JSON = REPORTS_DIR / "latent-erd.json"
 NOTES_JSON = REPORTS_DIR / "vae-lstm-notes.json"
-TRAINING_RUNS = ("vae-lstm",)
+TRAINING_RUNS = ("vae-lstm", "vae-lstm-e100")
 LONG_RUN_SEEDS = 5
+# The ways of drawing a prior sample compared (generation.py); the shipped one is vae-lstm.json's `sampling`.
+SAMPLINGS = {"one z1 (Algorithm 1)": {"mode": "z1"}, "a latent per step, rho 0": {"mode": "steps", "rho": 0.0},
+             "a latent per step, rho 0.9": {"mode": "steps", "rho": 0.9}}
 
 
 def evaluate(mocap: str | None, previous: dict, models_dir: Path = MODELS_DIR) -> dict:
@@ -30,8 +33,9 @@ def evaluate(mocap: str | None, previous: dict, models_dir: Path = MODELS_DIR) -
     fps = vae.fps
     report: dict = {"fps": fps, "chunk_frames": vae.info["chunk_steps"] * vae.info["pooling"], "window_frames": vae.info["window"]}
 
+    report["sampling"] = vae.info["sampling"]
     windows = erd_measures.prediction_windows(corpus)
-    rows = m.prediction_rows(vae, corpus, windows)
+    rows = m.prediction_rows(vae, corpus, windows, SAMPLINGS)
     if ERD_JSON.exists():
         erd = json.loads(ERD_JSON.read_text()).get("prediction", {})
         if erd.get("windows") == len(windows):
@@ -52,6 +56,18 @@ def evaluate(mocap: str | None, previous: dict, models_dir: Path = MODELS_DIR) -
                            "real_share_below": erd_measures.real_share_below(corpus, fps, median),
                            "real_frame_change_cm": erd_measures.real_frame_change(corpus)}
     report["diversity"] = m.diversity(vae, corpus)
+    report["samplings"] = {}
+    for name, sampling in SAMPLINGS.items():
+        stats = [m.freeze_stats(m.long_run(vae, seed, sampling=sampling)["positions"], fps, median) for seed in range(LONG_RUN_SEEDS)]
+        runs_s = m.held_out_control_runs(vae, corpus, sampling)
+        report["samplings"][name] = {
+            "sampling": sampling, "diversity_cm": m.diversity(vae, corpus, sampling=sampling)["prior_samples_cm"],
+            "lowest_second": min(x["lowest_second"] for x in stats), "median_second": round(float(np.mean([x["median_second"] for x in stats])), 3),
+            "share_below": round(float(np.mean([x["share_below"] for x in stats])), 4),
+            "energy_held_out": round(float(np.mean([metrics.pose_change_per_second(p, fps).mean() for p, _ in runs_s]) / median), 3),
+            "jitter_cm": m.jitter_cm([p for p, _ in runs_s]),
+            "sliding_held_out_control": m.sliding(runs_s, fps)}
+    report["jitter_real_cm"] = m.jitter_cm([c.positions for c in corpus.valid_clips])
     held_out = m.held_out_control_runs(vae, corpus)
     report["energy"] = {"held_out_control": round(float(np.mean([metrics.pose_change_per_second(p, fps).mean() for p, _ in held_out]) / median), 3),
                         "real": round(float(np.mean([metrics.pose_change_per_second(c.positions, fps).mean() for c in corpus.valid_clips]) / median), 3)}
@@ -76,11 +92,10 @@ def _row(cells) -> str:
 def prediction_table(pred: dict, kind: str) -> list[str]:
     horizons = m.HORIZONS
     out = [_row(["model", "initial frames", "control signal", *[f"frame {h}" for h in horizons]]), _row(["---"] * (3 + len(horizons)))]
-    seeds = {"VAE-LSTM, 4 initial frames": "4", "VAE-LSTM, prior sample": "0", "latent ERD": "16", "pose-space ERD": "16",
-             "generator (free-running)": "16"}
+    seeds = {"VAE-LSTM, 4 initial frames": "4", "latent ERD": "16", "pose-space ERD": "16", "generator (free-running)": "16"}
     for name, row in pred["rows"].items():
         control = "no" if name.startswith("generator") else "yes"
-        out.append(_row([name, seeds.get(name, "?"), control, *[row[kind].get(h, row[kind].get(str(h))) for h in horizons]]))
+        out.append(_row([name, seeds.get(name, "0" if "prior" in name else "?"), control, *[row[kind].get(h, row[kind].get(str(h))) for h in horizons]]))
     return out
 
 
@@ -132,6 +147,17 @@ def write_markdown(r: dict, notes: dict, path: Path) -> None:
     for w in d["windows"]:
         lines.append(_row([w["clip"], w["start"], w["forward"], w["turn"], w["prior_samples_cm"], w["real_similar_cm"], w["real_similar_windows"]]))
     lines += [""] + notes.get("diversity", [])
+    lines += ["", "### Ways of drawing a prior sample", "",
+              "The same measures for each way of drawing a prior sample (generation.py): one z1 and the cell on its own state "
+              "(Algorithm 1), or a latent per step in teacher mode (the paper's other way), independent (rho 0) or correlated "
+              f"from step to step (AR(1), rho 0.9). The page uses `{json.dumps(r['sampling'])}` (vae-lstm.json). Jitter: RMS second "
+              f"difference of the joints relative to the hips, real held-out clips {r['jitter_real_cm']} cm per frame².", "",
+              _row(["prior sample", "diversity (cm)", "long runs: lowest second / median", "mean median second / median", "seconds below 20%",
+                    "energy, held-out control", "jitter (cm/frame²)", "sliding after lock: contact bits / lowest point (m/s)"]), _row(["---"] * 8)]
+    for name, x in r["samplings"].items():
+        sl = x["sliding_held_out_control"]
+        lines.append(_row([name, x["diversity_cm"], x["lowest_second"], x["median_second"], f"{x['share_below'] * 100:.1f}%", x["energy_held_out"],
+                           x["jitter_cm"], f"{sl['contact_bits_after']} / {sl['low_foot_after']}"]))
     e = r["energy"]
     lines += ["", "## Foot sliding", "",
               "Two measures, each clip or run on its own: the toe's horizontal speed while its contact bit is on (contact-bit measure) and "

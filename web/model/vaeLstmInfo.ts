@@ -5,7 +5,7 @@
 import { modelInfoFormat } from './modelInfo';
 
 export const VAE_LSTM_GRAPHS = {
-  cell: { inputs: ['hc', 'state'], outputs: ['canvas', 'state_out'] },
+  cell: { inputs: ['hc', 'state', 'z', 'mix'], outputs: ['canvas', 'state_out'] },
   control: { inputs: ['control'], outputs: ['hc'] },
   decoder: { inputs: ['canvas'], outputs: ['rows'] },
   inference: { inputs: ['rows'], outputs: ['mean', 'log_var'] },
@@ -33,6 +33,11 @@ export interface VaeLstmInfo {
   /** Initial frames the posterior reads (4), padded to seed_pad frames by repeating the last. */
   seed_frames: number;
   seed_pad: number;
+  /**
+   * How a seed's prior sample is drawn (training/vae_lstm/generation.py): "z1", one latent and the cell on its
+   * own state (Algorithm 1), or "steps", a latent per step in teacher mode, AR(1) with lag-one correlation rho.
+   */
+  sampling: { mode: 'z1' } | { mode: 'steps'; rho: number };
   onnx: Record<VaeLstmGraph, { inputs: string[]; outputs: string[] }>;
   skeleton: { joints: string[]; parents: number[]; offsets: number[] };
   rows: {
@@ -67,6 +72,11 @@ const format = modelInfoFormat<VaeLstmInfo>('VaeLstmInfoError', 'vae-lstm.json',
   posInt(root.control_features, 'control_features');
   const seedFrames = posInt(root.seed_frames, 'seed_frames');
   if (posInt(root.seed_pad, 'seed_pad') < seedFrames) fail(`seed_pad must be at least seed_frames (${seedFrames})`);
+  const sampling = obj(root.sampling, 'sampling');
+  if (sampling.mode === 'steps') {
+    const rho = check.num(sampling.rho, 'sampling.rho');
+    if (!(rho >= 0 && rho < 1)) fail(`sampling.rho must be in [0, 1), got ${rho}`);
+  } else if (sampling.mode !== 'z1') fail(`sampling.mode must be "z1" or "steps", got ${JSON.stringify(sampling.mode)}`);
   const J = check.skeleton(root.skeleton);
   const rows = obj(root.rows, 'rows');
   const dim = posInt(rows.dim, 'rows.dim');

@@ -3,9 +3,10 @@
 // (Habibie et al., Algorithm 1; training/vae_lstm/generation.py):
 //   1. the control signal (frames × [forward, sideways, turn], padded to a multiple of 4 frames by repeating
 //      the last) is normalised and encoded in one call (vae-lstm-control.onnx);
-//   2. z1 is drawn from N(0, I) by the seed (Rng, so the same seed gives the same motion), or given;
-//   3. the cell runs on its own state chunk after chunk of chunk_steps steps (vae-lstm.onnx: the state goes
-//      in and out), its states forming the motion canvas;
+//   2. the prior sample is drawn by the seed (Rng, so the same seed gives the same motion; priorLatents): z1,
+//      and when the model's `sampling` is "steps" a latent per step, or given;
+//   3. the cell runs chunk after chunk of chunk_steps steps (vae-lstm.onnx: the state goes in and out), on its
+//      own state from z1 (Algorithm 1) or in teacher mode on the per-step latents; its states form the canvas;
 //   4. the canvas is decoded in one call (vae-lstm-decoder.onnx) into rows: joint positions in the root's
 //      facing frame, the decoded control and the contact channels;
 //   5. the root moves by the control signal that was asked for (integrateControl), not by the decoded one,
@@ -34,19 +35,32 @@ class GraphSession extends SessionCore<GraphInfo> {
   }
 }
 
-/** z1 of a seed: `latent` draws of N(0, 1) from the page's Rng (the same seed, the same motion). */
-export function priorSample(seed: number, latent: number): Float32Array {
+/**
+ * A seed's prior draws (training/vae_lstm/generation.py prior_latents, the same numbers): z1, `latent` draws
+ * of N(0, 1) from the page's Rng, and with `steps` the per-step latents (steps × latent): z1 first, then
+ * rho · previous + sqrt(1 − rho²) · a new draw, in the same stream.
+ */
+export function priorLatents(seed: number, latent: number, steps = 0, rho = 0): { z1: Float32Array; zs?: Float32Array } {
   const rng = new Rng(seed);
-  const z = new Float32Array(latent);
-  for (let i = 0; i < latent; i++) z[i] = rng.normal();
-  return z;
+  const z1 = new Float32Array(latent);
+  for (let i = 0; i < latent; i++) z1[i] = rng.normal();
+  if (!steps) return { z1 };
+  const zs = new Float32Array(steps * latent);
+  zs.set(z1);
+  const keep = rho, fresh = Math.sqrt(1 - rho * rho);
+  for (let t = 1; t < steps; t++) {
+    for (let i = 0; i < latent; i++) zs[t * latent + i] = keep * zs[(t - 1) * latent + i] + fresh * rng.normal();
+  }
+  return { z1, zs };
 }
 
 export interface GenerateOptions {
   /** Where the root starts (default the origin facing +z). */
   root?: Root;
-  /** z1 itself (latent values) instead of a draw from the seed. */
+  /** z1 itself (latent values) instead of a draw from the seed (then Algorithm 1, or teacher mode on `zs`). */
   z1?: ArrayLike<number>;
+  /** With `z1`: per-step latents (steps × latent) for teacher mode. */
+  zs?: ArrayLike<number>;
 }
 
 export class VaeLstmCore {
@@ -94,7 +108,7 @@ export class VaeLstmCore {
       throw err;
     });
     await this.loading;
-    await this.rowsFor(new Float64Array(8 * 3), new Float32Array(this.info.latent));
+    await this.rowsFor(new Float64Array(8 * 3), new Float32Array(this.info.latent), new Float32Array(2 * this.info.latent));
   }
 
   async release(): Promise<void> {
@@ -126,19 +140,26 @@ export class VaeLstmCore {
     return read('hc', (frames / pooling) * F);
   }
 
-  /** The canvas (steps × latent) over control encodings (steps × control_features) from `state`, chunk by chunk. */
-  async runCell(hc: Float32Array, state: Float32Array, signal?: AbortSignal): Promise<{ canvas: Float32Array; state: Float32Array; calls: number }> {
+  /**
+   * The canvas (steps × latent) over control encodings (steps × control_features) from `state`, chunk by chunk:
+   * on its own state (Algorithm 1), or with `zs` (steps × latent) in teacher mode on those latents.
+   */
+  async runCell(hc: Float32Array, state: Float32Array, zs?: Float32Array, signal?: AbortSignal): Promise<{ canvas: Float32Array; state: Float32Array; calls: number }> {
     const { chunk_steps: K, latent: Z, control_features: F } = this.info;
     const steps = hc.length / F;
+    if (zs && zs.length < steps * Z) throw new Error(`zs has ${zs.length / Z} steps; the control needs ${steps}`);
     const canvas = new Float32Array(steps * Z);
+    const mix = Float32Array.of(zs ? 1 : 0);
     let calls = 0;
     for (let at = 0; at < steps; at += K) {
       const part = new Float32Array(K * F);
+      const z = new Float32Array(K * Z);
       for (let k = 0; k < K; k++) {
-        const src = Math.min(at + k, steps - 1); // the last chunk repeats the last step's encoding
+        const src = Math.min(at + k, steps - 1); // the last chunk repeats the last step
         part.set(hc.subarray(src * F, (src + 1) * F), k * F);
+        if (zs) z.set(zs.subarray(src * Z, (src + 1) * Z), k * Z);
       }
-      const read = await this.graph('cell').call({ hc: [part, [1, K, F]], state: [state, [1, Z]] }, signal);
+      const read = await this.graph('cell').call({ hc: [part, [1, K, F]], state: [state, [1, Z]], z: [z, [1, K, Z]], mix: [mix, [1]] }, signal);
       const out = read('canvas', K * Z);
       canvas.set(out.subarray(0, Math.min(K, steps - at) * Z), at * Z);
       // The state after the last real step (the padded steps only fill the chunk).
@@ -156,15 +177,15 @@ export class VaeLstmCore {
     return read('rows', pooling * steps * rows.dim);
   }
 
-  /** Physical rows (frames × dim) for a physical control (frames × 3) from z1, and the cell calls made. */
-  async rowsFor(control: ArrayLike<number>, z1: Float32Array, signal?: AbortSignal): Promise<{ rows: Float64Array; cellCalls: number }> {
+  /** Physical rows (frames × dim) for a physical control (frames × 3) from z1 (teacher mode on `zs` when given), and the cell calls made. */
+  async rowsFor(control: ArrayLike<number>, z1: Float32Array, zs?: Float32Array, signal?: AbortSignal): Promise<{ rows: Float64Array; cellCalls: number }> {
     const { pooling, rows: layout, normalisation } = this.info;
     const frames = control.length / 3;
     const padded = new Float64Array(Math.ceil(frames / pooling) * pooling * 3);
     padded.set(control);
     for (let f = frames; f < padded.length / 3; f++) padded.set(padded.subarray((frames - 1) * 3, frames * 3), f * 3);
     const hc = await this.encodeControl(padded, signal);
-    const { canvas, calls } = await this.runCell(hc, z1, signal);
+    const { canvas, calls } = await this.runCell(hc, z1, zs, signal);
     const normalised = await this.decode(canvas, signal);
     const D = layout.dim;
     const rows = new Float64Array(frames * D);
@@ -185,9 +206,13 @@ export class VaeLstmCore {
       if (params.control.length < frames * 3) throw new Error(`control has ${Math.floor(params.control.length / 3)} frames; it needs at least ${frames}`);
       control = Float64Array.from(params.control).subarray(0, frames * 3);
     }
-    const z1 = options.z1 ? Float32Array.from(options.z1) : priorSample(seed, latent);
+    const steps = Math.ceil(frames / this.info.pooling);
+    const sampling = this.info.sampling;
+    const drawn = options.z1 ? { z1: Float32Array.from(options.z1), zs: options.zs ? Float32Array.from(options.zs) : undefined }
+      : sampling.mode === 'steps' ? priorLatents(seed, latent, steps, sampling.rho) : priorLatents(seed, latent);
+    const { z1, zs } = drawn;
     if (z1.length !== latent) throw new Error(`z1 has ${z1.length} values, the model's latent has ${latent}`);
-    const { rows, cellCalls } = await this.rowsFor(control, z1, signal);
+    const { rows, cellCalls } = await this.rowsFor(control, z1, zs, signal);
     const J = this.skeleton.joints.length;
     const { xz, heading } = integrateControl(control, fps, options.root);
     const predicted = new Float32Array(frames * J * 3);
@@ -224,8 +249,10 @@ export class VaeLstmCore {
       const { chunk_steps: K, latent: Z, control_features: F } = this.info;
       const hc = new Float32Array(batch * K * F);
       let state: Float32Array = new Float32Array(batch * Z);
+      const z = new Float32Array(batch * K * Z);
+      const mix = Float32Array.of(0);
       return async () => {
-        const read = await this.graph('cell').call({ hc: [hc, [batch, K, F]], state: [state, [batch, Z]] });
+        const read = await this.graph('cell').call({ hc: [hc, [batch, K, F]], state: [state, [batch, Z]], z: [z, [batch, K, Z]], mix: [mix, [1]] });
         state = read('state_out', batch * Z);
       };
     });
@@ -246,8 +273,8 @@ export class VaeLstmCore {
       out[graph] = Object.fromEntries(names.outputs.map((n) => [n, read(n, sizes[n])]));
     }
     if (inputs?.generate) {
-      const { control, z1 } = inputs.generate;
-      out.rows = (await this.rowsFor(control, Float32Array.from(z1))).rows;
+      const { control, z1, zs } = inputs.generate;
+      out.rows = (await this.rowsFor(control, Float32Array.from(z1), zs ? Float32Array.from(zs) : undefined)).rows;
     }
     return out;
   }

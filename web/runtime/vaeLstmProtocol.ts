@@ -50,7 +50,7 @@ export interface VaeLstmChunk {
   rootHeading: Float32Array;
   /** frames × 3: the control the motion was made for. */
   control: Float32Array;
-  /** The latent sample the motion hangs on. */
+  /** The latent sample the motion hangs on (its first step's, when there is one per step). */
   z1: Float32Array;
   seed: number;
   /** Cell chunk calls made. */
@@ -79,7 +79,7 @@ export interface VaeLstmFollowPathChunk extends VaeLstmChunk {
 /** Parity inputs: one call of any of the graphs (flattened data with dims), and/or a whole generation from z1. */
 export interface VaeLstmParityInputs {
   graphs?: Partial<Record<VaeLstmGraph, Record<string, { dims: number[]; data: ArrayLike<number> }>>>;
-  generate?: { control: ArrayLike<number>; z1: ArrayLike<number> };
+  generate?: { control: ArrayLike<number>; z1: ArrayLike<number>; zs?: ArrayLike<number> };
 }
 
 export type VaeLstmParityResult = Partial<Record<VaeLstmGraph, Record<string, Float32Array>>> & {
