@@ -3,21 +3,67 @@
 // Path mode runs): mean and max error, arc progress, × real time (the motion's seconds over the seconds it
 // took), foot sliding before and after the lock (footSkating.ts lowFootSliding) and skating by the contacts,
 // walk and run, SEEDS seeds each. Also what Vary shows: VAE-LSTM walks of one path from several seeds,
-// their mean pairwise joint distance relative to the hips. Writes docs/models/vae-lstm-browser.json for
-// docs/models/vae-lstm.md (python -m training.vae_lstm.evaluate).
+// their mean pairwise joint distance relative to the hips. And, when cache/vae-lstm-map-windows.json is there
+// (python -m training.vae_lstm.evaluate --map-windows), the report's prediction row of the generator with the
+// MAP follower given each held-out window's true root path: its joint position error at the same horizons,
+// in the world and relative to the hips. Writes docs/models/vae-lstm-browser.json for docs/models/vae-lstm.md
+// (python -m training.vae_lstm.evaluate).
 //
 //   npm run evaluate:vae-lstm            # 3 seeds per case
 //   SEEDS=1 npm run evaluate:vae-lstm
-import { readFileSync, writeFileSync } from 'node:fs';
+//   ONLY=map OUT=/tmp/x.json npm run evaluate:vae-lstm   # only the MAP prediction row (a check of the script)
+import { existsSync, readFileSync, writeFileSync } from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { launchBrowser, openPlayground, ROOT, startServer } from '../tests/e2e/harness.mjs';
 
 const SEEDS = Number(process.env.SEEDS ?? 3);
-const OUT = path.join(ROOT, 'docs/models/vae-lstm-browser.json');
+const OUT = process.env.OUT ?? path.join(ROOT, 'docs/models/vae-lstm-browser.json');
 const PATHS = JSON.parse(readFileSync(path.join(ROOT, 'tests/fixtures/benchmark_paths.json'), 'utf8')).paths;
 const MODELS = ['vae-lstm', 'latent-erd', 'generator'];
 const VARY_SEEDS = 6;
+const MAP_WINDOWS = path.join(ROOT, 'cache/vae-lstm-map-windows.json');
+
+/** The MAP follower on each window's true root path: errors (cm) at the horizons, in the world and relative to the hips. */
+async function mapPrediction(page, spec) {
+  const out = { windows: spec.windows.length, followed: 0, refused: [], with_root_cm: {}, relative_cm: {} };
+  const sums = Object.fromEntries(spec.horizons.map((k) => [k, { world: 0, rel: 0, n: 0 }]));
+  for (const w of spec.windows) {
+    const r = await page.evaluate(async ({ points, horizons }) => {
+      try {
+        const m = await window.playground.followPath({ points, gait: 'walk', seed: 0 });
+        const J = m.joints.length;
+        return { frames: m.frames, poses: horizons.map((k) => Array.from(m.positions.subarray(Math.min(k, m.frames - 1) * J * 3, (Math.min(k, m.frames - 1) + 1) * J * 3))) };
+      } catch (e) {
+        return { error: e.message };
+      }
+    }, { points: w.points, horizons: spec.horizons });
+    if (r.error) {
+      out.refused.push(`${w.clip} @${w.start}: ${r.error}`);
+      continue;
+    }
+    out.followed++;
+    spec.horizons.forEach((k, i) => {
+      const made = r.poses[i], real = w.real[String(k)].flat();
+      const J = real.length / 3;
+      let world = 0, rel = 0;
+      for (let j = 0; j < J; j++) {
+        const d = [0, 1, 2].map((c) => made[j * 3 + c] - real[j * 3 + c]);
+        const dr = [0, 1, 2].map((c) => made[j * 3 + c] - made[c] - (real[j * 3 + c] - real[c]));
+        world += Math.hypot(...d);
+        rel += Math.hypot(...dr);
+      }
+      sums[k].world += world / J;
+      sums[k].rel += rel / J;
+      sums[k].n++;
+    });
+  }
+  for (const k of spec.horizons) {
+    out.with_root_cm[k] = +((sums[k].world / sums[k].n) * 100).toFixed(1);
+    out.relative_cm[k] = +((sums[k].rel / sums[k].n) * 100).toFixed(1);
+  }
+  return out;
+}
 
 async function followOne(page, model, points, gait, seed) {
   return page.evaluate(
@@ -71,7 +117,7 @@ async function main() {
     const { page, problems } = await openPlayground(browser, url);
     report.isolated = await page.evaluate(() => globalThis.crossOriginIsolated);
     for (const model of MODELS) await followOne(page, model, [[0, 0], [0, 1]], 'walk', 0); // warm-up: load, first wasm calls
-    for (const gait of ['walk', 'run']) {
+    for (const gait of process.env.ONLY === 'map' ? [] : ['walk', 'run']) {
       for (const [name, { points }] of Object.entries(PATHS)) {
         for (const model of MODELS) {
           const runs = [];
@@ -95,6 +141,10 @@ async function main() {
         }
       }
     }
+    if (existsSync(MAP_WINDOWS)) {
+      report.map_prediction = await mapPrediction(page, JSON.parse(readFileSync(MAP_WINDOWS, 'utf8')));
+      console.log(JSON.stringify(report.map_prediction));
+    } else console.log(`no ${MAP_WINDOWS}: the MAP prediction row is left out (python -m training.vae_lstm.evaluate --map-windows writes it)`);
     report.vary = {};
     for (const [name, { points }] of Object.entries(PATHS)) report.vary[name] = await varyOne(page, points);
     console.log(JSON.stringify(report.vary));

@@ -1,6 +1,7 @@
 """Measure the shipped VAE-LSTM and write docs/models/vae-lstm.{md,json}.
 
     python -m training.vae_lstm.evaluate
+    python -m training.vae_lstm.evaluate --map-windows     # cache/vae-lstm-map-windows.json for npm run evaluate:vae-lstm
 
 Run npm run evaluate:vae-lstm first for the page's numbers on the benchmark paths; the measures are described in
 training/vae_lstm/measures.py, the prose around them is docs/models/vae-lstm-notes.json.
@@ -9,14 +10,28 @@ from __future__ import annotations
 
 import argparse
 
-from ..paths import REPORTS_DIR, add_mocap_argument
+import json
+
+from ..data.locomotion import load_clips
+from ..data.windows import WindowCorpus
+from ..paths import DEFAULT_CACHE, REPORTS_DIR, add_mocap_argument
+from .measures import map_follow_windows
 from .report import write_report
+
+MAP_WINDOWS = DEFAULT_CACHE / "vae-lstm-map-windows.json"
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_mocap_argument(parser)
+    parser.add_argument("--map-windows", action="store_true",
+                        help=f"write only {MAP_WINDOWS}: the prediction windows' root paths for the MAP follower in the page")
     args = parser.parse_args(argv)
+    if args.map_windows:
+        MAP_WINDOWS.parent.mkdir(parents=True, exist_ok=True)
+        MAP_WINDOWS.write_text(json.dumps(map_follow_windows(WindowCorpus(load_clips(args.mocap)))))
+        print(f"wrote {MAP_WINDOWS}")
+        return
     report = write_report(args.mocap)
     rows = report["prediction"]["rows"]
     print(f"wrote {REPORTS_DIR / 'vae-lstm.md'}: at 120 frames (relative) " +

@@ -29,6 +29,7 @@ from ..control import random_control
 from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, POSITION_DIM, WindowCorpus, ground_frame, rows_to_world
 from ..footlock import plant_feet
 from ..latent_erd.measures import FREEZE_FRACTION, HORIZONS, PREDICT_FRAMES, SEED_FRAMES, Window, prediction_errors
+from ..latent_erd.measures import prediction_windows as erd_prediction_windows
 from ..mocap.skeleton import canonical_skeleton
 from ..onnx.sessions import cpu_session
 from .generation import SEED_FRAMES as INITIAL_FRAMES
@@ -225,3 +226,20 @@ def freeze_stats(positions: np.ndarray, fps: float, median: float) -> dict:
 
 __all__ = ["HORIZONS", "ShippedVae", "chunk_seams", "diversity", "freeze_stats", "held_out_control_runs", "long_run",
            "prediction_rows", "sliding"]
+
+
+# ---- the MAP follower on the clips' own root paths (run in the page: npm run evaluate:vae-lstm) ----------
+
+def map_follow_windows(corpus: WindowCorpus) -> dict:
+    """For each prediction window: the clip's (smoothed) root path over the predicted frames, as the ground path
+    the generator's MAP follower walks in the page, and the real joint positions at each horizon, so the page
+    measures its error the same way as the rows computed here."""
+    out = []
+    for w in erd_prediction_windows(corpus):
+        c = corpus.valid_clips[w.clip]
+        start = w.start + SEED_FRAMES
+        xz, _ = ground_frame(c.positions)
+        real = c.positions[start:start + PREDICT_FRAMES]
+        out.append({"clip": c.file, "start": start, "points": xz[start - 1:start + PREDICT_FRAMES].round(4).tolist(),
+                    "real": {str(k): real[k - 1].round(4).tolist() for k in HORIZONS}})
+    return {"horizons": list(HORIZONS), "windows": out}

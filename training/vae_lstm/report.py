@@ -40,6 +40,10 @@ def evaluate(mocap: str | None, previous: dict, models_dir: Path = MODELS_DIR) -
         erd = json.loads(ERD_JSON.read_text()).get("prediction", {})
         if erd.get("windows") == len(windows):
             rows.update({name: row for name, row in erd["rows"].items()})
+    browser = json.loads(BROWSER_JSON.read_text()) if BROWSER_JSON.exists() else {}
+    if browser.get("map_prediction", {}).get("followed"):
+        mp = browser["map_prediction"]
+        rows["generator + MAP optimiser, true root path"] = {"with_root_cm": mp["with_root_cm"], "relative_cm": mp["relative_cm"]}
     report["prediction"] = {"windows": len(windows), "clips": sorted({corpus.valid_clips[w.clip].file for w in windows}),
                             "rows": {name: {kind: {int(k): v for k, v in e.items()} for kind, e in row.items()} for name, row in rows.items()}}
 
@@ -92,9 +96,10 @@ def _row(cells) -> str:
 def prediction_table(pred: dict, kind: str) -> list[str]:
     horizons = m.HORIZONS
     out = [_row(["model", "initial frames", "control signal", *[f"frame {h}" for h in horizons]]), _row(["---"] * (3 + len(horizons)))]
-    seeds = {"VAE-LSTM, 4 initial frames": "4", "latent ERD": "16", "pose-space ERD": "16", "generator (free-running)": "16"}
+    seeds = {"VAE-LSTM, 4 initial frames": "4", "latent ERD": "16", "pose-space ERD": "16", "generator (free-running)": "16",
+             "generator + MAP optimiser, true root path": "its seed states"}
     for name, row in pred["rows"].items():
-        control = "no" if name.startswith("generator") else "yes"
+        control = "no" if name.startswith("generator (") else "the root path" if "MAP" in name else "yes"
         out.append(_row([name, seeds.get(name, "0" if "prior" in name else "?"), control, *[row[kind].get(h, row[kind].get(str(h))) for h in horizons]]))
     return out
 
