@@ -281,7 +281,7 @@ describe('latent ERD in the page', { timeout: 300_000 }, () => {
       ['generate', { model: 'latent-erd', frames: 2, seed: 0, temperature: 0.5 }, /^generate: unknown option "temperature" for model "latent-erd" \(known: model, frames, seed, control, signal\)$/],
       ['generate', { model: 'manifold', frames: 2, seed: 0 }, /^generate: unknown model "manifold" \(available: .*latent-erd/],
       ['generate', { model: 'generator', frames: 2, seed: 0, control: [[1, 0, 0], [1, 0, 0]] }, /^generate: unknown option "control" for model "generator"/],
-      ['followPath', { model: 'walker', points: BEND }, /^followPath: unknown model "walker" \(available: generator, latent-erd\)$/],
+      ['followPath', { model: 'walker', points: BEND }, /^followPath: unknown model "walker" \(available: generator, latent-erd, vae-lstm\)$/],
       ['followPath', { model: 'latent-erd', points: BEND, fitTolerance: 0.2 }, /^followPath: unknown option "fitTolerance" \(known: model, points, gait, seed, speed, footLock, signal\)$/],
       ['followPath', { model: 'latent-erd', points: BEND, speed: 12 }, /^followPath: speed must be a number above 0 and at most 4 m\/s, got 12$/],
       ['followPath', { points: BEND, speed: 1 }, /^followPath: unknown option "speed" \(known: model, points, gait, seed, fitTolerance, footLock, signal\)$/],

@@ -294,7 +294,9 @@ function checkControlModel(value: unknown, models: ModelInfo[], live = true): Pa
   const kinds: Record<PathModel, string> = { generator: 'lstm-gmm', 'latent-erd': 'latent-erd', 'vae-lstm': 'vae-lstm' };
   const usable = models.filter((m) => kinds[m.id as PathModel] === m.kind).map((m) => m.id);
   const available = usable.join(', ') || 'none — the model list did not load';
-  if (typeof value !== 'string') throw new TypeError(`model must be one of "generator", "latent-erd", "vae-lstm", got ${describeValue(value)}`);
+  if (typeof value !== 'string') {
+    throw new TypeError(`model must be ${live ? '"generator" or "latent-erd"' : 'one of "generator", "latent-erd", "vae-lstm"'}, got ${describeValue(value)}`);
+  }
   if (live && value === 'vae-lstm') {
     throw new Error('the VAE-LSTM makes the whole motion for a whole control signal and takes no live control: use followPath or generate({ model: "vae-lstm", control })');
   }
