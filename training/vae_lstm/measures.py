@@ -27,10 +27,9 @@ import numpy as np
 from .. import metrics
 from ..control import random_control
 from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, POSITION_DIM, WindowCorpus, ground_frame, rows_to_world
-from ..footlock import plant_feet
 from ..latent_erd.measures import FREEZE_FRACTION, HORIZONS, PREDICT_FRAMES, SEED_FRAMES, Window, prediction_errors
 from ..latent_erd.measures import prediction_windows as erd_prediction_windows
-from ..mocap.skeleton import canonical_skeleton
+from ..latent_erd.measures import sliding
 from ..onnx.sessions import cpu_session
 from .generation import SEED_FRAMES as INITIAL_FRAMES
 from .generation import SEED_PAD, prior_latents
@@ -196,16 +195,7 @@ def diversity(vae: ShippedVae, corpus: WindowCorpus, window: int = 120, sampling
             "real_similar_cm": round(float(np.mean([o["real_similar_cm"] for o in out if o["real_similar_cm"] is not None])), 2)}
 
 
-# ---- sliding ----------------------------------------------------------------------------------------
-
-def sliding(runs: list[tuple[np.ndarray, np.ndarray]], fps: float) -> dict:
-    skel = canonical_skeleton()
-    locked = [plant_feet(p, c, fps, skel) for p, c in runs]
-    return {"contact_bits_before": round(metrics.foot_skating_clips(runs, fps, skel), 3),
-            "contact_bits_after": round(metrics.foot_skating_clips(locked, fps, skel), 3),
-            "low_foot_before": round(metrics.low_foot_sliding_clips([p for p, _ in runs], fps, skel), 3),
-            "low_foot_after": round(metrics.low_foot_sliding_clips([p for p, _ in locked], fps, skel), 3)}
-
+# ---- held-out control ----------------------------------------------------------------------------------------
 
 def held_out_control_runs(vae: ShippedVae, corpus: WindowCorpus, sampling: dict | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
     """Each held-out clip's own control, a prior sample per clip: positions and decoded bits."""

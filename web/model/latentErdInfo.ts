@@ -7,7 +7,7 @@
 // worker share (the per-frame control signal, the seed's seed state).
 import { describeValue } from '../motion/describe';
 import { MAX_FRAMES } from '../motion/text';
-import { modelInfoFormat } from './modelInfo';
+import { modelInfoFormat, type FieldChecks } from './modelInfo';
 
 export const LATENT_ERD_INPUTS = ['z', 'control', 'h', 'c'] as const;
 export const LATENT_ERD_OUTPUTS = ['z_next', 'h_out', 'c_out'] as const;
@@ -135,19 +135,26 @@ const manifoldFormat = modelInfoFormat<ManifoldInfo>('ManifoldInfoError', 'manif
   });
   if (!Array.isArray(skeleton.offsets) || skeleton.offsets.length !== J) fail(`skeleton.offsets must hold ${J} [x, y, z] offsets`);
   (skeleton.offsets as unknown[]).forEach((o, j) => numbers(o, `skeleton.offsets[${j}]`, 3));
-  const rows = obj(root.rows, 'rows');
-  const dim = posInt(rows.dim, 'rows.dim');
+  check.normalisation(root.normalisation, checkRowLayout(check, root.rows, joints));
+});
+
+/**
+ * The 80-value row layout of manifold.json and vae-lstm.json (`rows`: dim, the [start, end) of the joint
+ * positions, control and contacts, the joints in the skeleton's order); returns the row's dim.
+ */
+export function checkRowLayout(check: FieldChecks, value: unknown, joints: readonly string[]): number {
+  const rows = check.obj(value, 'rows');
+  const dim = check.posInt(rows.dim, 'rows.dim');
   const range = (name: 'positions' | 'control' | 'contacts', size: number) => {
-    const [a, b] = numbers(rows[name], `rows.${name}`, 2);
-    if (!(Number.isInteger(a) && Number.isInteger(b) && a >= 0 && b <= dim && b - a === size)) fail(`rows.${name} is [${a}, ${b}], expected ${size} channels within the ${dim}-value row`);
+    const [a, b] = check.numbers(rows[name], `rows.${name}`, 2);
+    if (!(Number.isInteger(a) && Number.isInteger(b) && a >= 0 && b <= dim && b - a === size)) check.fail(`rows.${name} is [${a}, ${b}], expected ${size} channels within the ${dim}-value row`);
   };
-  range('positions', 3 * J);
+  range('positions', 3 * joints.length);
   range('control', 3);
   range('contacts', 2);
-  const rowJoints = strings(rows.joints, 'rows.joints');
-  if (rowJoints.join() !== joints.join()) fail('rows.joints must list skeleton.joints in the same order');
-  check.normalisation(root.normalisation, dim);
-});
+  if (check.strings(rows.joints, 'rows.joints').join() !== joints.join()) check.fail('rows.joints must list skeleton.joints in the same order');
+  return dim;
+}
 
 export const LatentErdInfoError = erdFormat.InfoError;
 export const ManifoldInfoError = manifoldFormat.InfoError;

@@ -2,6 +2,7 @@
 // its four ONNX graphs (the cell over one chunk of steps, the control encoder, the canvas decoder, the
 // inference network) and their input and output names, the skeleton, the 80-value row layout and its
 // normalisation. The parse checks what the runtime relies on and names the file and the first bad field.
+import { checkRowLayout } from './latentErdInfo';
 import { modelInfoFormat } from './modelInfo';
 
 export const VAE_LSTM_GRAPHS = {
@@ -54,7 +55,7 @@ export interface VaeLstmInfo {
 }
 
 const format = modelInfoFormat<VaeLstmInfo>('VaeLstmInfoError', 'vae-lstm.json', (check, root) => {
-  const { fail, obj, posInt, strings } = check;
+  const { fail, obj, posInt } = check;
   const files = obj(root.files, 'files');
   const onnx = obj(root.onnx, 'onnx');
   for (const [graph, names] of Object.entries(VAE_LSTM_GRAPHS)) {
@@ -77,19 +78,8 @@ const format = modelInfoFormat<VaeLstmInfo>('VaeLstmInfoError', 'vae-lstm.json',
     const rho = check.num(sampling.rho, 'sampling.rho');
     if (!(rho >= 0 && rho < 1)) fail(`sampling.rho must be in [0, 1), got ${rho}`);
   } else if (sampling.mode !== 'z1') fail(`sampling.mode must be "z1" or "steps", got ${JSON.stringify(sampling.mode)}`);
-  const J = check.skeleton(root.skeleton);
-  const rows = obj(root.rows, 'rows');
-  const dim = posInt(rows.dim, 'rows.dim');
-  const range = (name: 'positions' | 'control' | 'contacts', size: number) => {
-    const [a, b] = check.numbers(rows[name], `rows.${name}`, 2);
-    if (!(Number.isInteger(a) && Number.isInteger(b) && a >= 0 && b <= dim && b - a === size)) fail(`rows.${name} is [${a}, ${b}], expected ${size} channels within the ${dim}-value row`);
-  };
-  range('positions', 3 * J);
-  range('control', 3);
-  range('contacts', 2);
-  const joints = strings(rows.joints, 'rows.joints');
-  if (joints.join() !== (root.skeleton as { joints: string[] }).joints.join()) fail('rows.joints must list skeleton.joints in the same order');
-  check.normalisation(root.normalisation, dim);
+  check.skeleton(root.skeleton);
+  check.normalisation(root.normalisation, checkRowLayout(check, root.rows, (root.skeleton as { joints: string[] }).joints));
 });
 
 export const VaeLstmInfoError = format.InfoError;

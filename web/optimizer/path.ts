@@ -194,6 +194,16 @@ export class GroundPath {
   points(): GroundPoint[] {
     return Array.from(this.xs, (x, i) => [x, this.zs[i]]);
   }
+
+  /** The points moved by `origin` (relativeToStart's, back to where the user drew), as flat x, z pairs for the page. */
+  flatAt(origin: GroundPoint): Float32Array {
+    const flat = new Float32Array(this.count * 2);
+    for (let i = 0; i < this.count; i++) {
+      flat[2 * i] = this.xs[i] + origin[0];
+      flat[2 * i + 1] = this.zs[i] + origin[1];
+    }
+    return flat;
+  }
 }
 
 /** Angle a − b wrapped to (−π, π]. */

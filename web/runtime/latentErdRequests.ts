@@ -123,17 +123,12 @@ export class LatentErdRequests {
       particleSteps: s.stream.erdCalls,
       ...footStats({ fps, skeleton: core.skeleton }, chunk.frames, shown, fitted),
     };
-    const flat = new Float32Array(ground.count * 2);
-    for (let i = 0; i < ground.count; i++) {
-      flat[2 * i] = ground.xs[i] + origin[0];
-      flat[2 * i + 1] = ground.zs[i] + origin[1];
-    }
     chunk.positions = moveBack(shown.positions, origin);
     chunk.contacts = shown.contacts;
     moveBack(chunk.predicted, origin);
     moveRootsBack(chunk, origin);
     chunk.computeMs = stats.optimizeMs;
-    return { ...chunk, stats, path: flat };
+    return { ...chunk, stats, path: ground.flatAt(origin) };
   }
 
   async controlStart(p: LatentControlStartParams, signal?: AbortSignal): Promise<LatentStreamInfo> {
@@ -222,7 +217,7 @@ export class LatentErdRequests {
 }
 
 /** Adds `origin` to the x and z of every root (x, z, heading triples). */
-function moveRootsBack(chunk: LatentChunk, origin: [number, number]): void {
+export function moveRootsBack(chunk: { roots: Float64Array }, origin: [number, number]): void {
   for (let i = 0; i < chunk.roots.length; i += 3) {
     chunk.roots[i] += origin[0];
     chunk.roots[i + 1] += origin[1];

@@ -58,14 +58,9 @@ export class OptimizerRequests {
     const path = p.stroke ? GroundPath.fromStroke(local) : GroundPath.fromPoints(local);
     const info = this.core.info;
     const r = await followPath({ step: this.stepFn(signal), info, mean: this.core.mean, std: this.core.std, path, gait, seed, fitSigma, onProgress: progress });
-    const flat = new Float32Array(path.count * 2);
-    for (let i = 0; i < path.count; i++) {
-      flat[2 * i] = path.xs[i] + origin[0];
-      flat[2 * i + 1] = path.zs[i] + origin[1];
-    }
     const shown = lock ? this.plant(r.positions, r.contacts) : { positions: r.positions, contacts: r.contacts };
     const stats = { ...r.stats, ...footStats(this.core.info, r.frames, shown, { positions: r.positions, contacts: r.contacts }) };
-    return { frames: r.frames, features: r.features, positions: moveBack(shown.positions, origin), contacts: shown.contacts, rootHeading: r.rootHeading, seedIndex: r.seedIndex, startFrame: 0, stats, path: flat };
+    return { frames: r.frames, features: r.features, positions: moveBack(shown.positions, origin), contacts: shown.contacts, rootHeading: r.rootHeading, seedIndex: r.seedIndex, startFrame: 0, stats, path: path.flatAt(origin) };
   }
 
   /** Contacts labelled on a whole motion of the generator's skeleton and planted feet locked (hips and above unchanged). */

@@ -68,6 +68,7 @@ export class VaeLstmCore {
   readonly threads: number;
   readonly skeleton: { joints: string[]; parents: number[]; offsets: Float32Array };
   private readonly graphs: Partial<Record<VaeLstmGraph, GraphSession>> = {};
+  private readonly urls: VaeLstmModel['urls'];
   private loading: Promise<void> | undefined;
   private readonly fitter: SkeletonFitter;
 
@@ -90,8 +91,6 @@ export class VaeLstmCore {
     this.skeleton = { joints: sk.joints, parents: sk.parents, offsets: Float32Array.from(sk.offsets) };
     this.fitter = new SkeletonFitter(this.skeleton);
   }
-
-  private readonly urls: VaeLstmModel['urls'];
 
   get fps(): number {
     return this.info.fps;

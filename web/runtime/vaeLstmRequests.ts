@@ -9,7 +9,7 @@ import { footStats } from '../motion/footSkating';
 import { checkFootLock, checkGait, checkSeed, optional } from '../optimizer/options';
 import { checkPathPoints, GroundPath, moveBack, relativeToStart } from '../optimizer/path';
 import { pathErrors } from '../optimizer/pathFollower';
-import { ARRIVED_SECONDS, checkPathSpeed, LATENT_PATH_SPEED } from './latentErdRequests';
+import { ARRIVED_SECONDS, checkPathSpeed, LATENT_PATH_SPEED, moveRootsBack } from './latentErdRequests';
 import type { VaeLstmCore } from './vaeLstmCore';
 import type { VaeLstmFollowPathChunk, VaeLstmFollowPathParams } from './vaeLstmProtocol';
 
@@ -58,16 +58,8 @@ export async function followPathVae(core: VaeLstmCore, p: VaeLstmFollowPathParam
     particleSteps: Math.ceil(frames / core.info.pooling),
     ...footStats({ fps, skeleton: core.skeleton }, frames, chunk, { positions: chunk.fitted, contacts: chunk.decodedContacts }),
   };
-  const flat = new Float32Array(ground.count * 2);
-  for (let i = 0; i < ground.count; i++) {
-    flat[2 * i] = ground.xs[i] + origin[0];
-    flat[2 * i + 1] = ground.zs[i] + origin[1];
-  }
   for (const positions of [chunk.positions, chunk.fitted, chunk.predicted]) moveBack(positions, origin);
-  for (let i = 0; i < chunk.roots.length; i += 3) {
-    chunk.roots[i] += origin[0];
-    chunk.roots[i + 1] += origin[1];
-  }
+  moveRootsBack(chunk, origin);
   chunk.computeMs = stats.optimizeMs;
-  return { ...chunk, stats, path: flat };
+  return { ...chunk, stats, path: ground.flatAt(origin) };
 }
