@@ -182,6 +182,8 @@ export interface LatentErdModel {
   manifold: ManifoldInfo;
   /** The decoder ONNX file's URL (manifold.json's files.decoder, relative to it). */
   decoderUrl: string;
+  /** The encoder ONNX file's URL (manifold.json's files.encoder, relative to it): the `manifold` clean-up. */
+  encoderUrl?: string;
 }
 
 /** Fetches latent-erd.json, then the manifold.json it names, and checks both and their pair. */
@@ -190,7 +192,12 @@ export async function loadLatentErdModel(url: string): Promise<LatentErdModel> {
   const manifoldUrl = new URL(erd.manifold, url).href;
   const manifold = await loadManifoldInfo(manifoldUrl);
   checkLatentErdPair(erd, manifold, url, manifoldUrl);
-  return { erd, manifold, decoderUrl: new URL(manifold.files.decoder, manifoldUrl).href };
+  return {
+    erd,
+    manifold,
+    decoderUrl: new URL(manifold.files.decoder, manifoldUrl).href,
+    ...(typeof manifold.files.encoder === 'string' && manifold.files.encoder ? { encoderUrl: new URL(manifold.files.encoder, manifoldUrl).href } : {}),
+  };
 }
 
 /** Index into `seeds` of `seed`'s seed state: seed mod the count, among the `category` ones when given ("walk", "run"). */

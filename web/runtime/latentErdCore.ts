@@ -1,7 +1,9 @@
 // The latent ERD's runtime, independent of where it runs: the ERD step session (latent-erd.onnx), the
 // autoencoder's unpadded decoder session (manifold-decoder.onnx) and streams of the online algorithm
 // (web/model/latentStream.ts, the port of training/latent_erd/streaming.py). latentErd.worker.ts wraps it in
-// messages; unit tests drive it directly with onnxruntime-web's Node build.
+// messages; unit tests drive it directly with onnxruntime-web's Node build. The autoencoder's encoder session
+// (manifold-encoder.onnx), loaded on first use, serves the `manifold` clean-up (projectManifold:
+// manifoldProjection.ts).
 //
 // A stream emits one latent step (4 frames) at a time for a control; its frames are the decoded points
 // placed in the world at the stream's root, fitted to the skeleton (web/motion/fitSkeleton.ts: exact bone
@@ -17,6 +19,7 @@ import { PlantedFeet } from '../motion/footLock';
 import { latentSeedIndex, type LatentErdInfo, type LatentErdModel, type ManifoldInfo } from '../model/latentErdInfo';
 import { LatentStream, streamLayout, type LatentBackend, type StreamLayout } from '../model/latentStream';
 import { checkpoint } from './cancellation';
+import { projectOnManifold, type ManifoldProjection } from './manifoldProjection';
 import type {
   LatentChunk,
   LatentErdInitResult,
@@ -56,6 +59,20 @@ class DecoderSession extends SessionCore<{ id: string; file: string; onnx: { inp
     if (steps <= 2 * radius) throw new Error(`the decoder needs more than ${2 * radius} latent steps, got ${steps}`);
     const read = await this.run({ latent: [latent, [1, steps, Z]] }, signal);
     return read('rows', pooling * (steps - 2 * radius) * rows);
+  }
+}
+
+/** The encoder: rows (1, frames, dim) normalised → latent (1, frames / pooling, latent) physical, zero-padded at the ends as in training. */
+class EncoderSession extends SessionCore<{ id: string; file: string; onnx: { inputs: string[]; outputs: string[] }; normalisation: { mean: number[]; std: number[] } }> {
+  constructor(session: InferenceSession, private readonly manifold: ManifoldInfo, Tensor: TensorConstructor, threads: number) {
+    super(session, { id: manifold.id, file: manifold.files.encoder, onnx: { inputs: ['rows'], outputs: ['latent'] }, normalisation: manifold.normalisation }, Tensor, threads);
+  }
+
+  async encode(frames: number, rows: Float32Array, signal?: AbortSignal): Promise<Float32Array> {
+    const { latent: Z, pooling } = this.manifold;
+    if (frames % pooling !== 0) throw new Error(`the encoder needs a multiple of ${pooling} frames, got ${frames}`);
+    const read = await this.run({ rows: [rows, [1, frames, this.manifold.rows.dim]] }, signal);
+    return read('latent', (frames / pooling) * Z);
   }
 }
 
@@ -107,11 +124,14 @@ export class LatentErdCore {
   private readonly erdSession: ErdSession;
   private decoder: DecoderSession | undefined;
   private decoderLoading: Promise<DecoderSession> | undefined;
+  private encoder: EncoderSession | undefined;
+  private encoderLoading: Promise<EncoderSession> | undefined;
   private readonly fitter: SkeletonFitter;
 
   /**
    * `session` runs latent-erd.onnx; `loadDecoder` gives manifold-decoder.onnx's session (called by `check`,
-   * once). `Tensor` must come from the same onnxruntime module as the sessions.
+   * once); `loadEncoder` gives manifold-encoder.onnx's (called by the first projectManifold). `Tensor` must
+   * come from the same onnxruntime module as the sessions.
    */
   constructor(
     session: InferenceSession,
@@ -119,6 +139,7 @@ export class LatentErdCore {
     private readonly Tensor: TensorConstructor,
     threads = 1,
     private readonly loadDecoder: () => Promise<InferenceSession>,
+    private readonly loadEncoder?: () => Promise<InferenceSession>,
   ) {
     this.erd = model.erd;
     this.manifold = model.manifold;
@@ -154,11 +175,29 @@ export class LatentErdCore {
     return this.decoderLoading;
   }
 
+  private encoderSession(): Promise<EncoderSession> {
+    if (this.encoder) return Promise.resolve(this.encoder);
+    const load = this.loadEncoder;
+    if (!load) return Promise.reject(new Error('the latent ERD core was made without the manifold encoder'));
+    this.encoderLoading ??= load().then(
+      (session) => (this.encoder = new EncoderSession(session, this.manifold, this.Tensor, this.threads)),
+      (err: unknown) => {
+        this.encoderLoading = undefined;
+        throw err;
+      },
+    );
+    return this.encoderLoading;
+  }
+
   async release(): Promise<void> {
     const decoder = this.decoderLoading;
+    const encoder = this.encoderLoading;
     this.decoderLoading = undefined;
     this.decoder = undefined;
+    this.encoderLoading = undefined;
+    this.encoder = undefined;
     await decoder?.then((d) => d.release(), () => undefined);
+    await encoder?.then((e) => e.release(), () => undefined);
     await this.erdSession.release();
   }
 
@@ -351,6 +390,24 @@ export class LatentErdCore {
     const chunk = await this.advance(s, frames, signal);
     chunk.computeMs = performance.now() - started;
     return chunk;
+  }
+
+  /**
+   * The `manifold` clean-up: canonical world positions (frames × joints × 3, at the model's fps) and optional
+   * contacts (frames × 2) projected through the autoencoder in overlapping windows (manifoldProjection.ts).
+   * Loads the encoder on first use; stops at the next network call once `signal` aborts.
+   */
+  async projectManifold(positions: Float32Array, contacts: Uint8Array | undefined, signal?: AbortSignal, progress?: (fraction: number) => void): Promise<ManifoldProjection> {
+    const [encoder, decoder] = await Promise.all([this.encoderSession(), this.decoderSession()]);
+    return projectOnManifold({
+      encode: (rows, frames) => encoder.encode(frames, rows, signal),
+      decode: (latent, steps) => decoder.decode(steps, latent, signal),
+      manifold: this.manifold,
+      positions,
+      ...(contacts === undefined ? {} : { contacts }),
+      fps: this.erd.fps,
+      onWindow: (done, windows) => progress?.(done / windows),
+    });
   }
 
   /** Times `steps` raw ERD step calls at `batch` streams, each feeding its output and state back. */

@@ -6,6 +6,8 @@
 //   - speed and heading: controlTowardHeading(root.heading, target heading, target speed);
 // repeated for the step's 4 frames (the look-ahead repeats it too: the future is not known). The result
 // keeps the generator's return shapes and stats (optimizerRequests.ts), measured the same way.
+// Also `manifoldProject`: canonical motion projected through the autoencoder (the `manifold` clean-up,
+// manifoldProjection.ts).
 import { controlAlongPath, controlTowardHeading, PolylinePath, type Control } from '../motion/control';
 import { plantFeet } from '../motion/footLock';
 import { footStats } from '../motion/footSkating';
@@ -15,6 +17,7 @@ import { angleDifference, checkPathPoints, GroundPath, moveBack, relativeToStart
 import { pathErrors, type Gait } from '../optimizer/pathFollower';
 import { describeValue } from '../motion/describe';
 import type { LatentErdCore, LatentErdStream } from './latentErdCore';
+import type { ManifoldProjection } from './manifoldProjection';
 import type {
   LatentChunk,
   LatentControlChunk,
@@ -35,6 +38,12 @@ export const MAX_LATENT_PATH_SPEED = 4;
 export const ARRIVED_SECONDS = 1;
 /** Frames a live pull may ask for. */
 export const MAX_LIVE_FRAMES = 12;
+
+/** A `manifoldProject` request: canonical world positions (frames × joints × 3) at the model's fps, optional contacts (frames × 2). */
+export interface ManifoldProjectParams {
+  positions: Float32Array;
+  contacts?: Uint8Array;
+}
 
 export function checkPathSpeed(speed: unknown): number {
   if (typeof speed !== 'number' || !(speed > 0 && speed <= MAX_LATENT_PATH_SPEED)) throw new RangeError(`speed must be a number above 0 and at most ${MAX_LATENT_PATH_SPEED} m/s, got ${describeValue(speed)}`);
@@ -79,9 +88,18 @@ export class LatentErdRequests {
         return this.controlPull(request as unknown as LatentControlTarget & { frames: number });
       case 'simulateControl':
         return this.simulate(request as unknown as LatentSimulateControlParams, progress, signal);
+      case 'manifoldProject':
+        return this.manifoldProject(request as unknown as ManifoldProjectParams, progress, signal);
       default:
         return undefined;
     }
+  }
+
+  /** The `manifold` clean-up of canonical positions (frames × joints × 3 at the model's fps) and optional contacts (frames × 2). */
+  manifoldProject(p: ManifoldProjectParams, progress: (fraction: number) => void, signal?: AbortSignal): Promise<ManifoldProjection> {
+    if (!(p.positions instanceof Float32Array)) throw new TypeError(`positions must be a Float32Array of frames × joints × 3 values, got ${describeValue(p.positions)}`);
+    if (p.contacts !== undefined && !(p.contacts instanceof Uint8Array)) throw new TypeError(`contacts must be a Uint8Array of frames × 2 bits, got ${describeValue(p.contacts)}`);
+    return this.core.projectManifold(p.positions, p.contacts, signal, progress);
   }
 
   async followPath(p: LatentFollowPathParams, progress: (fraction: number) => void, signal?: AbortSignal): Promise<LatentFollowPathChunk> {
