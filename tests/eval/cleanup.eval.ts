@@ -1,0 +1,181 @@
+// npm run evaluate:cleanup → docs/models/cleanup.json and cleanup.md: the clean-up methods against the low-pass
+// baseline on held-out CMU clips with synthetic noise, run by the page's own code (web/runtime/cleanup.ts) on
+// onnxruntime-web's Node build (the wasm runtime the browser workers use).
+import { writeFileSync } from 'node:fs';
+import { it } from 'vitest';
+import { parseAMC } from '../../web/motion/asfamc';
+import { detectContacts } from '../../web/motion/contacts';
+import { lowFootSliding } from '../../web/motion/footSkating';
+import { addNoise } from '../../web/motion/noise';
+import { CANONICAL_JOINTS, CANONICAL_PARENTS, mapSkeleton, toCanonical } from '../../web/motion/skeletonMap';
+import type { Motion } from '../../web/motion/types';
+import { parseGeneratorInfo } from '../../web/model/generatorInfo';
+import { parseManifoldInfo } from '../../web/model/latentErdInfo';
+import { cleanUpOnCanonical, lowpassCleanup, manifoldCleaner, mapCleaner, type CleanupMethod, type CleanupResult } from '../../web/runtime/cleanup';
+import { GeneratorCore } from '../../web/runtime/generatorCore';
+import { projectOnManifold } from '../../web/runtime/manifoldProjection';
+import { readCorpus, readRepoFile, REPO_ROOT } from '../unit/corpus';
+import { ort, shippedSession } from '../unit/shippedModel';
+
+/** Held-out walks of the generator's split (generator.json training.valid_files), up to 10 s each. */
+const CLIPS = ['07_10', '16_16', '39_04', '105_06', '35_13'];
+const LEVELS = [0.01, 0.03, 0.05];
+const OUTLIERS = 0.01;
+const MAX_FRAMES = 1200;
+const METHODS: CleanupMethod[] = ['map', 'manifold', 'lowpass'];
+
+const info = parseGeneratorInfo(JSON.parse(readRepoFile('public/models/generator.json')), 'generator.json');
+const manifold = parseManifoldInfo(JSON.parse(readRepoFile('public/models/manifold.json')), 'manifold.json');
+
+function loadClip(name: string): Motion {
+  const m = parseAMC(readCorpus(`cmu/amc/${name}.amc.gz`), readCorpus(`cmu/asf/${name.split('_')[0]}.asf`), { fps: 120 });
+  const frames = Math.min(m.frames, MAX_FRAMES);
+  const positions = m.positions.slice(0, frames * m.joints.length * 3);
+  // Rest the clip on y = 0 (the lowest foot point's 5th percentile), as the other reports' clips are.
+  const view = canonicalView({ ...m, frames, positions });
+  const lows: number[] = [];
+  const feet = ['LeftFoot', 'LeftToeBase', 'LeftToeBase_end', 'RightFoot', 'RightToeBase', 'RightToeBase_end'].map((n) => view.joints.indexOf(n));
+  for (let f = 0; f < frames; f++) lows.push(Math.min(...feet.map((j) => view.positions[(f * 25 + j) * 3 + 1])));
+  lows.sort((a, b) => a - b);
+  const floor = lows[Math.floor(frames * 0.05)];
+  for (let i = 1; i < positions.length; i += 3) positions[i] -= floor;
+  return { ...m, frames, positions };
+}
+
+/** The motion's canonical points at its own size (scale 1), for measures that need the canonical leg names. */
+function canonicalView(m: Motion): Motion {
+  const mapping = { ...mapSkeleton(m, 1), scale: 1 };
+  return { fps: m.fps, frames: m.frames, joints: [...CANONICAL_JOINTS], parents: CANONICAL_PARENTS, positions: toCanonical(m, mapping) };
+}
+
+/** Every `step`-th frame (120 → 30 fps), so speeds and jerk are measured at the rate of the other reports. */
+function decimate(m: Motion, step: number): Motion {
+  const J = m.joints.length;
+  const frames = Math.floor((m.frames - 1) / step) + 1;
+  const positions = new Float32Array(frames * J * 3);
+  for (let f = 0; f < frames; f++) positions.set(m.positions.subarray(f * step * J * 3, (f * step + 1) * J * 3), f * J * 3);
+  const contacts = m.contacts ? new Uint8Array(frames * 2) : undefined;
+  if (contacts) for (let f = 0; f < frames; f++) contacts.set(m.contacts!.subarray(f * step * 2, f * step * 2 + 2), f * 2);
+  return { ...m, fps: m.fps / step, frames, positions, ...(contacts ? { contacts } : {}) };
+}
+
+function positionError(a: Motion, b: Motion): number {
+  let s = 0;
+  for (let i = 0; i < a.positions.length; i += 3) s += Math.hypot(a.positions[i] - b.positions[i], a.positions[i + 1] - b.positions[i + 1], a.positions[i + 2] - b.positions[i + 2]);
+  return s / (a.positions.length / 3);
+}
+
+/** Mean magnitude of the third difference of joint positions × fps³ (m/s³). */
+function jerk(m: Motion): number {
+  const J = m.joints.length;
+  let s = 0, n = 0;
+  for (let f = 3; f < m.frames; f++) {
+    for (let j = 0; j < J; j++) {
+      let q = 0;
+      for (let a = 0; a < 3; a++) {
+        const p = (k: number) => m.positions[((f - k) * J + j) * 3 + a];
+        q += (p(0) - 3 * p(1) + 3 * p(2) - p(3)) ** 2;
+      }
+      s += Math.sqrt(q) * m.fps ** 3;
+      n++;
+    }
+  }
+  return s / n;
+}
+
+/** Mean absolute change of each bone's length from the clean clip's (m). */
+function boneChange(m: Motion, clean: Motion): number {
+  const J = m.joints.length;
+  let s = 0, n = 0;
+  for (let f = 0; f < m.frames; f++) {
+    for (let j = 1; j < J; j++) {
+      const p = m.parents[j];
+      const len = (x: Motion, g: number) => Math.hypot(...[0, 1, 2].map((a) => x.positions[(g * J + j) * 3 + a] - x.positions[(g * J + p) * 3 + a]) as [number, number, number]);
+      s += Math.abs(len(m, f) - len(clean, 0));
+      n++;
+    }
+  }
+  return s / n;
+}
+
+function contactF1(found: Uint8Array, truth: Uint8Array): number {
+  let tp = 0, fp = 0, fn = 0;
+  for (let i = 0; i < truth.length; i++) {
+    if (found[i] && truth[i]) tp++;
+    else if (found[i]) fp++;
+    else if (truth[i]) fn++;
+  }
+  return tp ? (2 * tp) / (2 * tp + fp + fn) : 0;
+}
+
+interface Row { method: string; level: number; error: number; jerk: number; sliding: number; contactF1: number; boneChange: number; realTime: number }
+
+it('evaluates the clean-up methods', async () => {
+  const core = new GeneratorCore(await shippedSession(info.file), info, ort.Tensor);
+  const [encoder, decoder] = await Promise.all([shippedSession(manifold.files.encoder), shippedSession(manifold.files.decoder)]);
+  const project = (positions: Float32Array) =>
+    projectOnManifold({
+      manifold,
+      positions,
+      fps: info.fps,
+      encode: async (rows, frames) => (await encoder.run({ rows: new ort.Tensor('float32', rows, [1, frames, manifold.rows.dim]) })).latent.data as Float32Array,
+      decode: async (latent, steps) => (await decoder.run({ latent: new ort.Tensor('float32', latent, [1, steps, manifold.latent]) })).rows.data as Float32Array,
+    });
+  const run = async (method: CleanupMethod, noisy: Motion): Promise<CleanupResult> => {
+    if (method === 'lowpass') return lowpassCleanup(noisy, { method });
+    const cleaner = method === 'map'
+      ? mapCleaner({ step: (b, x, h, c) => core.step(b, x, h, c), info, mean: core.mean, std: core.std, options: { method } })
+      : manifoldCleaner(project);
+    return cleanUpOnCanonical(info, noisy, method, cleaner);
+  };
+
+  const rows: Row[] = [];
+  const realRows: { clip: string; jerk: number; sliding: number; seconds: number }[] = [];
+  for (const name of CLIPS) {
+    const clean = loadClip(name);
+    const clean30 = decimate(clean, 4);
+    const truth = detectContacts(clean30)!;
+    realRows.push({ clip: name, jerk: jerk(clean30), sliding: lowFootSliding(canonicalView(clean30)), seconds: clean.frames / clean.fps });
+    for (const level of LEVELS) {
+      const { motion: noisy } = addNoise(clean, { jitter: level, outliers: OUTLIERS, seed: 1 });
+      const measure = (method: string, m: Motion, contacts: Uint8Array, ms: number) => {
+        const m30 = decimate(m, 4);
+        rows.push({
+          method, level,
+          error: positionError(m, clean),
+          jerk: jerk(m30),
+          sliding: lowFootSliding(canonicalView(m30)),
+          contactF1: contactF1(contacts, truth),
+          boneChange: boneChange(m, clean),
+          realTime: ms > 0 ? (clean.frames / clean.fps) / (ms / 1000) : Infinity,
+        });
+      };
+      measure('noisy input', noisy, detectContacts(decimate(noisy, 4)) ?? new Uint8Array(truth.length), 0);
+      for (const method of METHODS) {
+        const began = performance.now();
+        const r = await run(method, noisy);
+        const ms = performance.now() - began;
+        measure(method, r.motion, decimate(r.motion, 4).contacts!, ms);
+      }
+      console.log(name, level, 'done');
+    }
+  }
+  const mean = (method: string, level: number, key: keyof Row) => {
+    const v = rows.filter((r) => r.method === method && r.level === level).map((r) => r[key] as number).filter(Number.isFinite);
+    return v.reduce((a, b) => a + b, 0) / v.length;
+  };
+  const summary = LEVELS.flatMap((level) => ['noisy input', ...METHODS].map((method) => ({
+    method, level,
+    error_cm: +(100 * mean(method, level, 'error')).toFixed(2),
+    jerk: +mean(method, level, 'jerk').toFixed(0),
+    sliding: +mean(method, level, 'sliding').toFixed(3),
+    contact_f1: +mean(method, level, 'contactF1').toFixed(3),
+    bone_change_cm: +(100 * mean(method, level, 'boneChange')).toFixed(2),
+    x_real_time: method === 'noisy input' ? null : +mean(method, level, 'realTime').toFixed(1),
+  })));
+  const real = { jerk: +(realRows.reduce((a, r) => a + r.jerk, 0) / realRows.length).toFixed(0), sliding: +(realRows.filter((r) => Number.isFinite(r.sliding)).reduce((a, r, _, all) => a + r.sliding / all.length, 0)).toFixed(3) };
+  const out = { clips: realRows, levels: LEVELS, outliers: OUTLIERS, real, summary, rows };
+  writeFileSync(`${REPO_ROOT}docs/models/cleanup.json`, JSON.stringify(out, null, 1) + '\n');
+  console.log(JSON.stringify(summary));
+  await core.release();
+});

@@ -1,0 +1,82 @@
+// Motion clean-up's shared pipeline (web/runtime/cleanup.ts) on a real held-out CMU clip: the result keeps the
+// imported skeleton (joints, parents, frame count, one length per bone), the options are checked, and a skeleton
+// that cannot be mapped is refused before any model work.
+import { afterAll, beforeAll, describe, expect, it } from 'vitest';
+import { parseAMC } from '../../web/motion/asfamc';
+import { addNoise } from '../../web/motion/noise';
+import { medianBoneLengths, SkeletonMapError } from '../../web/motion/skeletonMap';
+import type { Motion } from '../../web/motion/types';
+import { parseGeneratorInfo } from '../../web/model/generatorInfo';
+import { checkCleanupOptions, cleanUpOnCanonical, lowpassCleanup, mapCleaner } from '../../web/runtime/cleanup';
+import { GeneratorCore } from '../../web/runtime/generatorCore';
+import { readCorpus, readRepoFile } from './corpus';
+import { ort, shippedSession } from './shippedModel';
+
+const info = parseGeneratorInfo(JSON.parse(readRepoFile('public/models/generator.json')), 'generator.json');
+// 35_13 is held out of the generator's training (generator.json training.valid_files).
+const clip = parseAMC(readCorpus('cmu/amc/35_13.amc.gz'), readCorpus('cmu/asf/35.asf'), { fps: 120 });
+const noisy = addNoise(clip, { jitter: 0.02, outliers: 0.01, seed: 3 }).motion;
+
+function boneLength(m: Motion, f: number, j: number): number {
+  const J = m.joints.length, p = m.parents[j];
+  const P = m.positions;
+  return Math.hypot(P[(f * J + j) * 3] - P[(f * J + p) * 3], P[(f * J + j) * 3 + 1] - P[(f * J + p) * 3 + 1], P[(f * J + j) * 3 + 2] - P[(f * J + p) * 3 + 2]);
+}
+
+let core: GeneratorCore;
+beforeAll(async () => {
+  core = new GeneratorCore(await shippedSession(info.file), info, ort.Tensor);
+});
+afterAll(() => core?.release());
+
+describe('clean-up', () => {
+  it('map keeps the imported skeleton: joints, parents, fps, frames, and one length per bone', async () => {
+    let progress = 0;
+    const cleaner = mapCleaner({ step: (b, x, h, c) => core.step(b, x, h, c), info, mean: core.mean, std: core.std, options: { method: 'map' }, onProgress: (p) => (progress = p) });
+    const { motion, stats } = await cleanUpOnCanonical(info, noisy, 'map', cleaner);
+    expect(motion.joints).toEqual(clip.joints);
+    expect(motion.parents).toEqual(clip.parents);
+    expect([motion.fps, motion.frames]).toEqual([clip.fps, clip.frames]);
+    expect(motion.contacts.length).toBe(clip.frames * 2);
+    expect(motion.positions.every(Number.isFinite)).toBe(true);
+    expect(stats.scheme).toBe('CMU ASF');
+    expect(progress).toBeGreaterThan(0.9);
+    const lengths = medianBoneLengths(noisy);
+    for (let f = 0; f < motion.frames; f += 7) {
+      for (let j = 1; j < motion.joints.length; j++) expect(Math.abs(boneLength(motion, f, j) - lengths[j])).toBeLessThan(1e-4);
+    }
+    // The motion moved as the clip did: the root ends near where the clip's does.
+    const J = clip.joints.length, last = (clip.frames - 1) * J * 3;
+    expect(Math.hypot(motion.positions[last] - clip.positions[last], motion.positions[last + 2] - clip.positions[last + 2])).toBeLessThan(0.3);
+  });
+
+  it('refuses a skeleton it cannot map before running any model, naming what is missing', async () => {
+    const knees = new Set(['lfemur', 'rfemur']);
+    const renamed = { ...clip, joints: clip.joints.map((n) => (knees.has(n) ? `${n}_x` : n)) };
+    let called = false;
+    const run = cleanUpOnCanonical(info, renamed, 'map', async () => {
+      called = true;
+      throw new Error('not reached');
+    });
+    await expect(run).rejects.toThrow(SkeletonMapError);
+    await expect(run).rejects.toThrow(/left knee, right knee/);
+    expect(called).toBe(false);
+  });
+
+  it('lowpass keeps joints and frames and smooths the jitter', () => {
+    const { motion, stats } = lowpassCleanup(noisy, { method: 'lowpass' });
+    expect(motion.joints).toEqual(clip.joints);
+    expect(motion.frames).toBe(clip.frames);
+    expect(stats.cutoffHz).toBe(6);
+    const err = (m: Motion) => m.positions.reduce((s, v, i) => s + Math.abs(v - clip.positions[i]), 0);
+    expect(err(motion)).toBeLessThan(0.6 * err(noisy));
+  });
+
+  it('checks options with a reason naming the option', () => {
+    expect(checkCleanupOptions({ method: 'map', sigmaRoot: 0.02 })).toEqual({ method: 'map', sigmaRoot: 0.02 });
+    expect(() => checkCleanupOptions({ method: 'median' })).toThrow(/method must be one of map, manifold, lowpass/);
+    expect(() => checkCleanupOptions({ method: 'map', sigmaAngle: -1 })).toThrow(/sigmaAngle must be a number of radians/);
+    expect(() => checkCleanupOptions({ method: 'map', sigma: 1 })).toThrow(/unknown option "sigma"/);
+    expect(() => checkCleanupOptions('map')).toThrow(/options must be an object/);
+  });
+});

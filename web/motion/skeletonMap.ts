@@ -1,0 +1,349 @@
+// Maps an imported skeleton onto the canonical one (training/mocap/canonical_skeleton.json) by joint names, and
+// carries motion cleaned on the canonical skeleton back onto the imported skeleton.
+//
+// One table holds every naming scheme. A Motion's joint sits where its bone starts (BVH) or ends (ASF: the joint
+// is named by the bone that ends there), so each scheme names, per canonical point, the joint found at that
+// place. A skeleton is matched against each scheme on its own (names clash across schemes: ASF's "lfoot" is the
+// toe base, a 3ds Max Biped's "L Foot" the ankle) and the scheme that places the most points wins.
+//
+// Canonical points that a scheme lacks but that lie between or beyond points it has (the spine and neck
+// segments, toe and hand tips) are placed along them at canonical proportions; the rest are required.
+import type { Motion } from './types';
+
+/** The canonical skeleton's points, in its order (parents: CANONICAL_PARENTS). */
+export const CANONICAL_JOINTS = [
+  'Hips', 'LeftUpLeg', 'LeftLeg', 'LeftFoot', 'LeftToeBase', 'LeftToeBase_end',
+  'RightUpLeg', 'RightLeg', 'RightFoot', 'RightToeBase', 'RightToeBase_end',
+  'Spine', 'Spine1', 'Neck', 'Neck1', 'Head', 'Head_end',
+  'LeftArm', 'LeftForeArm', 'LeftHand', 'LeftHand_end',
+  'RightArm', 'RightForeArm', 'RightHand', 'RightHand_end',
+] as const;
+export type CanonicalJoint = (typeof CANONICAL_JOINTS)[number];
+export const CANONICAL_PARENTS = [-1, 0, 1, 2, 3, 4, 0, 6, 7, 8, 9, 0, 11, 12, 13, 14, 15, 13, 17, 18, 19, 13, 21, 22, 23];
+
+/** What a person calls each required point, for messages. */
+const DESCRIPTIONS: Partial<Record<CanonicalJoint, string>> = {
+  Hips: 'hips', LeftUpLeg: 'left hip', LeftLeg: 'left knee', LeftFoot: 'left ankle', LeftToeBase: 'left toe',
+  RightUpLeg: 'right hip', RightLeg: 'right knee', RightFoot: 'right ankle', RightToeBase: 'right toe',
+  Neck: 'neck base', Head: 'head', LeftArm: 'left shoulder', LeftForeArm: 'left elbow', LeftHand: 'left wrist',
+  RightArm: 'right shoulder', RightForeArm: 'right elbow', RightHand: 'right wrist',
+};
+
+/**
+ * Points placed from others when a scheme lacks them: at `t` along from → to (t > 1 extends beyond `to`).
+ * The fractions are the canonical skeleton's own segment proportions.
+ */
+const DERIVED: Partial<Record<CanonicalJoint, { from: CanonicalJoint; to: CanonicalJoint; t: number }>> = {
+  Spine: { from: 'Hips', to: 'Neck', t: 0.33 },
+  Spine1: { from: 'Hips', to: 'Neck', t: 0.66 },
+  Neck1: { from: 'Neck', to: 'Head', t: 0.5 },
+  Head_end: { from: 'Neck', to: 'Head', t: 1.5 },
+  LeftToeBase_end: { from: 'LeftFoot', to: 'LeftToeBase', t: 1.5 },
+  RightToeBase_end: { from: 'RightFoot', to: 'RightToeBase', t: 1.5 },
+  LeftHand_end: { from: 'LeftForeArm', to: 'LeftHand', t: 1.3 },
+  RightHand_end: { from: 'RightForeArm', to: 'RightHand', t: 1.3 },
+};
+
+/** Per scheme, per canonical point, the (normalised, see normaliseName) joint names found there, best first. */
+type Scheme = { name: string; points: Partial<Record<CanonicalJoint, string[]>> };
+
+/** Both sides of a scheme from its left-side names: `L` in a name becomes the side's word. */
+function sided(left: Partial<Record<string, string[]>>, words: [string, string]): Partial<Record<CanonicalJoint, string[]>> {
+  const out: Partial<Record<CanonicalJoint, string[]>> = {};
+  for (const [point, names] of Object.entries(left)) {
+    out[point as CanonicalJoint] = names!.map((n) => n.replace('L', words[0]));
+    out[point.replace('Left', 'Right') as CanonicalJoint] = names!.map((n) => n.replace('L', words[1]));
+  }
+  return out;
+}
+
+export const NAME_SCHEMES: Scheme[] = [
+  {
+    name: 'CMU ASF',
+    points: {
+      Hips: ['root'], Spine: ['lowerback'], Spine1: ['upperback'], Neck: ['thorax'], Neck1: ['lowerneck'], Head: ['upperneck'], Head_end: ['head'],
+      ...sided({ LeftUpLeg: ['Lhipjoint'], LeftLeg: ['Lfemur'], LeftFoot: ['Ltibia'], LeftToeBase: ['Lfoot'], LeftToeBase_end: ['Ltoes'],
+        LeftArm: ['Lclavicle'], LeftForeArm: ['Lhumerus'], LeftHand: ['Lradius'], LeftHand_end: ['Lwrist'] }, ['l', 'r']),
+    },
+  },
+  {
+    name: 'CMU BVH',
+    points: {
+      Hips: ['hips'], Spine: ['spine'], Spine1: ['spine1'], Neck: ['neck'], Neck1: ['neck1'], Head: ['head'], Head_end: ['headend'],
+      ...sided({ LeftUpLeg: ['Lupleg'], LeftLeg: ['Lleg'], LeftFoot: ['Lfoot'], LeftToeBase: ['Ltoebase'], LeftToeBase_end: ['Ltoebaseend'],
+        LeftArm: ['Larm'], LeftForeArm: ['Lforearm'], LeftHand: ['Lhand'], LeftHand_end: ['Lfingerbase', 'Lhandend'] }, ['left', 'right']),
+    },
+  },
+  {
+    name: 'Mixamo',
+    points: {
+      Hips: ['hips'], Spine: ['spine1'], Spine1: ['spine2'], Neck: ['neck'], Head: ['head'], Head_end: ['headtopend'],
+      ...sided({ LeftUpLeg: ['Lupleg'], LeftLeg: ['Lleg'], LeftFoot: ['Lfoot'], LeftToeBase: ['Ltoebase'], LeftToeBase_end: ['Ltoeend'],
+        LeftArm: ['Larm'], LeftForeArm: ['Lforearm'], LeftHand: ['Lhand'], LeftHand_end: ['Lhandmiddle1'] }, ['left', 'right']),
+    },
+  },
+  {
+    name: '3ds Max Biped',
+    points: {
+      Hips: ['pelvis', ''], Spine: ['spine1', 'spine'], Spine1: ['spine2'], Neck: ['neck'], Head: ['head'], Head_end: ['headnub'],
+      ...sided({ LeftUpLeg: ['Lthigh'], LeftLeg: ['Lcalf'], LeftFoot: ['Lfoot'], LeftToeBase: ['Ltoe0'], LeftToeBase_end: ['Ltoe0nub'],
+        LeftArm: ['Lupperarm'], LeftForeArm: ['Lforearm'], LeftHand: ['Lhand'], LeftHand_end: ['Lfinger2', 'Lfinger1'] }, ['l', 'r']),
+    },
+  },
+  {
+    name: 'Daz',
+    points: {
+      Hips: ['hip', 'pelvis'], Spine: ['abdomenlower', 'abdomen'], Spine1: ['chestlower', 'chest'], Neck: ['necklower', 'neck'], Neck1: ['neckupper'], Head: ['head'],
+      ...sided({ LeftUpLeg: ['Lthighbend', 'Lthigh'], LeftLeg: ['Lshin'], LeftFoot: ['Lfoot'], LeftToeBase: ['Ltoe', 'Lmetatarsals'],
+        LeftArm: ['Lshldrbend', 'Lshldr'], LeftForeArm: ['Lforearmbend', 'Lforearm'], LeftHand: ['Lhand'], LeftHand_end: ['Lmid1'] }, ['l', 'r']),
+    },
+  },
+];
+
+/** A joint name without namespace (`mixamorig:`), Biped prefix (`Bip01 `), case, spaces, `_`, `-` or `.`. */
+export function normaliseName(name: string): string {
+  return name
+    .slice(name.lastIndexOf(':') + 1)
+    .toLowerCase()
+    .replace(/^bip0*1(?=$|[\s_.-])/, '')
+    .replace(/[\s_.-]/g, '');
+}
+
+/** How an imported skeleton's joints become the canonical points. */
+export interface SkeletonMapping {
+  scheme: string;
+  /** Per canonical point: the imported joint placed there, or -1 when the point is derived (DERIVED). */
+  source: number[];
+  /** Imported leg length (hip, knee, ankle) divided into the canonical one: canonical = imported × scale. */
+  scale: number;
+}
+
+/** Raised when a skeleton cannot be mapped; the message names the joints that are missing. */
+export class SkeletonMapError extends Error {
+  constructor(message: string) {
+    super(message);
+    this.name = 'SkeletonMapError';
+  }
+}
+
+function matchScheme(scheme: Scheme, index: Map<string, number>): number[] {
+  return CANONICAL_JOINTS.map((point) => {
+    for (const n of scheme.points[point] ?? []) {
+      const j = index.get(n);
+      if (j !== undefined) return j;
+    }
+    return -1;
+  });
+}
+
+function legLength(motion: Motion, source: number[]): number {
+  const at = (f: number, j: number) => motion.positions.subarray((f * motion.joints.length + j) * 3, (f * motion.joints.length + j) * 3 + 3);
+  const dist = (f: number, a: number, b: number) => Math.hypot(at(f, a)[0] - at(f, b)[0], at(f, a)[1] - at(f, b)[1], at(f, a)[2] - at(f, b)[2]);
+  const idx = (name: CanonicalJoint) => source[CANONICAL_JOINTS.indexOf(name)];
+  let total = 0;
+  for (let f = 0; f < motion.frames; f++) {
+    for (const side of ['Left', 'Right'] as const) {
+      total += dist(f, idx(`${side}UpLeg`), idx(`${side}Leg`)) + dist(f, idx(`${side}Leg`), idx(`${side}Foot`));
+    }
+  }
+  return total / (2 * motion.frames);
+}
+
+/** The canonical mapping of `motion`'s skeleton (`canonicalLegLength`: hip → knee → ankle); throws SkeletonMapError naming what is missing. */
+export function mapSkeleton(motion: Pick<Motion, 'joints' | 'positions' | 'frames'>, canonicalLegLength: number): SkeletonMapping {
+  const index = new Map<string, number>();
+  motion.joints.forEach((name, j) => {
+    const n = normaliseName(name);
+    if (!index.has(n)) index.set(n, j);
+  });
+  let best: { scheme: Scheme; source: number[]; missing: CanonicalJoint[]; placed: number } | undefined;
+  for (const scheme of NAME_SCHEMES) {
+    const source = matchScheme(scheme, index);
+    const missing = CANONICAL_JOINTS.filter((p, k) => source[k] < 0 && !DERIVED[p]);
+    // Spine points are derived from Hips and Neck, so a skeleton needs at least the Neck for them.
+    const placed = source.filter((j) => j >= 0).length;
+    if (!best || missing.length < best.missing.length || (missing.length === best.missing.length && placed > best.placed)) {
+      best = { scheme, source, missing, placed };
+    }
+  }
+  const { scheme, source, missing } = best!;
+  if (missing.length > 0) {
+    const names = missing.map((p) => DESCRIPTIONS[p] ?? p).join(', ');
+    throw new SkeletonMapError(
+      `this skeleton cannot be mapped to the canonical one: no joint for the ${names} (closest naming scheme: ${scheme.name}; known schemes: ${NAME_SCHEMES.map((s) => s.name).join(', ')})`,
+    );
+  }
+  const mapping = { scheme: scheme.name, source, scale: 1 };
+  const length = legLength(motion as Motion, source);
+  if (!(length > 1e-4)) throw new SkeletonMapError('this skeleton cannot be mapped to the canonical one: its legs have no length');
+  mapping.scale = canonicalLegLength / length;
+  return mapping;
+}
+
+/** The canonical points (frames × 25 × 3) of `motion`, scaled by mapping.scale; derived points placed (DERIVED). */
+export function toCanonical(motion: Motion, mapping: SkeletonMapping): Float32Array {
+  const J = motion.joints.length;
+  const K = CANONICAL_JOINTS.length;
+  const out = new Float32Array(motion.frames * K * 3);
+  const s = mapping.scale;
+  for (let f = 0; f < motion.frames; f++) {
+    const o = f * K * 3;
+    mapping.source.forEach((j, k) => {
+      if (j < 0) return;
+      for (let a = 0; a < 3; a++) out[o + k * 3 + a] = motion.positions[(f * J + j) * 3 + a] * s;
+    });
+    // Derived points, in canonical order (a derived point only uses earlier or mapped ones).
+    CANONICAL_JOINTS.forEach((point, k) => {
+      const d = DERIVED[point];
+      if (!d || mapping.source[k] >= 0) return;
+      const a = CANONICAL_JOINTS.indexOf(d.from), b = CANONICAL_JOINTS.indexOf(d.to);
+      for (let c = 0; c < 3; c++) out[o + k * 3 + c] = out[o + a * 3 + c] + d.t * (out[o + b * 3 + c] - out[o + a * 3 + c]);
+    });
+  }
+  return out;
+}
+
+/** Per joint, the median over frames of its bone's length (0 for the root). */
+export function medianBoneLengths(motion: Motion): Float64Array {
+  const J = motion.joints.length;
+  const out = new Float64Array(J);
+  const values = new Float64Array(motion.frames);
+  for (let j = 0; j < J; j++) {
+    const p = motion.parents[j];
+    if (p < 0) continue;
+    for (let f = 0; f < motion.frames; f++) {
+      const a = (f * J + j) * 3, b = (f * J + p) * 3;
+      const P = motion.positions;
+      values[f] = Math.hypot(P[a] - P[b], P[a + 1] - P[b + 1], P[a + 2] - P[b + 2]);
+    }
+    const sorted = Float64Array.from(values).sort();
+    out[j] = sorted[Math.floor(sorted.length / 2)];
+  }
+  return out;
+}
+
+type Q = [number, number, number, number];
+
+function qmul(a: Q, b: Q): Q {
+  return [
+    a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1],
+    a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0],
+    a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3],
+    a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2],
+  ];
+}
+
+function qrot(q: Q, v: [number, number, number]): [number, number, number] {
+  const [x, y, z, w] = q;
+  const tx = 2 * (y * v[2] - z * v[1]), ty = 2 * (z * v[0] - x * v[2]), tz = 2 * (x * v[1] - y * v[0]);
+  return [v[0] + w * tx + (y * tz - z * ty), v[1] + w * ty + (z * tx - x * tz), v[2] + w * tz + (x * ty - y * tx)];
+}
+
+/**
+ * Which canonical segment carries each imported bone (parent → joint), and whether the bone is a whole canonical
+ * segment (both ends mapped, parent to child), whose cleaned direction it then takes exactly.
+ *   - a mapped joint: the canonical segment that ends at its point;
+ *   - an unmapped joint with a mapped joint below it (an extra spine or shoulder joint): the segment ending at the
+ *     first mapped joint below;
+ *   - an unmapped joint with none below (fingers, a head-top, a prop): the segment beyond its nearest mapped
+ *     ancestor (that point's only canonical child), or the ancestor's own segment where it has several (hips, chest).
+ */
+export function boneOwners(parents: readonly number[], mapping: SkeletonMapping): { owner: number[]; whole: boolean[] } {
+  const J = parents.length;
+  const pointOf = new Array<number>(J).fill(-1);
+  mapping.source.forEach((j, k) => {
+    if (j >= 0) pointOf[j] = k;
+  });
+  const children = parents.map(() => [] as number[]);
+  parents.forEach((p, j) => p >= 0 && children[p].push(j));
+  const firstMappedBelow = (j: number): number => {
+    const queue = [...children[j]];
+    while (queue.length) {
+      const c = queue.shift()!;
+      if (pointOf[c] >= 0) return pointOf[c];
+      queue.push(...children[c]);
+    }
+    return -1;
+  };
+  const canonicalChildren = CANONICAL_PARENTS.map((_, k) => CANONICAL_PARENTS.flatMap((p, c) => (p === k ? [c] : [])));
+  const owner = new Array<number>(J).fill(0);
+  const whole = new Array<boolean>(J).fill(false);
+  for (let j = 0; j < J; j++) {
+    if (parents[j] < 0) continue;
+    if (pointOf[j] >= 0) {
+      owner[j] = pointOf[j];
+      whole[j] = pointOf[parents[j]] >= 0 && CANONICAL_PARENTS[pointOf[j]] === pointOf[parents[j]];
+      continue;
+    }
+    const below = firstMappedBelow(j);
+    if (below >= 0) {
+      owner[j] = below;
+      continue;
+    }
+    let a = parents[j];
+    while (a >= 0 && pointOf[a] < 0) a = parents[a];
+    const k = a >= 0 ? pointOf[a] : 0;
+    owner[j] = canonicalChildren[k].length === 1 ? canonicalChildren[k][0] : k;
+  }
+  return { owner, whole };
+}
+
+/**
+ * `motion` (the imported skeleton) moved as the canonical motion changed from `before` to `after`: each bone turns
+ * with the world rotation of its owning canonical segment (boneOwners), and a bone that is a whole canonical segment
+ * takes that segment's cleaned direction exactly. Every bone gets the skeleton's length for it, the median over the
+ * frames (a file's skeleton has one length per bone; noisy positions give a different one each frame, and the
+ * median ignores glitches). The root follows the canonical hips.
+ *
+ * before/after: canonical points (frames × 25 × 3, canonical scale) and the world rotations of their segments
+ * (frames × 25 × 4, x y z w; the rotation at a point turns the segment that ends there).
+ */
+export function fromCanonical(
+  motion: Motion,
+  mapping: SkeletonMapping,
+  before: { points: Float32Array; rotations: Float32Array },
+  after: { points: Float32Array; rotations: Float32Array },
+): Motion {
+  const J = motion.joints.length;
+  const K = CANONICAL_JOINTS.length;
+  const { owner, whole } = boneOwners(motion.parents, mapping);
+  const out = new Float32Array(motion.positions.length);
+  const inv = 1 / mapping.scale;
+  const hips = 0;
+  const p = motion.positions;
+  const lengths = medianBoneLengths(motion);
+  for (let f = 0; f < motion.frames; f++) {
+    const rot = (src: Float32Array, k: number): Q => {
+      const o = (f * K + k) * 4;
+      return [src[o], src[o + 1], src[o + 2], src[o + 3]];
+    };
+    const pt = (src: Float32Array, k: number, a: number) => src[(f * K + k) * 3 + a];
+    for (let j = 0; j < J; j++) {
+      const o = (f * J + j) * 3;
+      const parent = motion.parents[j];
+      if (parent < 0) {
+        // The root moves with the canonical hips (it is the hips in every scheme but a Biped's root node).
+        for (let a = 0; a < 3; a++) out[o + a] = p[o + a] + (pt(after.points, hips, a) - pt(before.points, hips, a)) * inv;
+        continue;
+      }
+      const q = (f * J + parent) * 3;
+      const bone: [number, number, number] = [p[o] - p[q], p[o + 1] - p[q + 1], p[o + 2] - p[q + 2]];
+      let moved: [number, number, number];
+      const k = owner[j];
+      if (whole[j]) {
+        const c = CANONICAL_PARENTS[k];
+        const d = [0, 1, 2].map((a) => pt(after.points, k, a) - pt(after.points, c, a));
+        const n = Math.hypot(d[0], d[1], d[2]);
+        moved = n > 1e-9 ? [d[0] / n, d[1] / n, d[2] / n] : bone;
+      } else {
+        const b = rot(before.rotations, k);
+        const change = qmul(rot(after.rotations, k), [-b[0], -b[1], -b[2], b[3]]);
+        moved = qrot(change, bone);
+      }
+      const n = Math.hypot(moved[0], moved[1], moved[2]);
+      if (n > 1e-12) moved = [(moved[0] / n) * lengths[j], (moved[1] / n) * lengths[j], (moved[2] / n) * lengths[j]];
+      for (let a = 0; a < 3; a++) out[o + a] = out[q + a] + moved[a];
+    }
+  }
+  return { fps: motion.fps, frames: motion.frames, joints: motion.joints.slice(), parents: motion.parents.slice(), positions: out };
+}
