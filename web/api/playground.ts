@@ -17,6 +17,9 @@ import { describeValue } from '../motion/describe';
 import { loadManifest, type ModelInfo } from '../model/manifest';
 import { checkControlSignal } from '../model/latentErdInfo';
 import { checkPathSpeed, LATENT_PATH_SPEED } from '../runtime/latentErdRequests';
+import { checkCleanupOptions, type CleanupMethod, type CleanupStats } from '../runtime/cleanup';
+import { mapSkeleton } from '../motion/skeletonMap';
+import { addNoise as addNoiseTo, checkNoiseOptions, type NoiseOptions } from '../motion/noise';
 
 declare const __APP_VERSION__: string;
 
@@ -138,6 +141,20 @@ export type ControlledMotion = Motion & {
   computeMs: Float32Array;
 };
 
+export interface DenoiseOptions extends CancellableOptions {
+  /** "map" (MAP under the generator, Wang, Chai, Xia §5.4), "manifold" (the motion autoencoder) or "lowpass" (zero-phase Butterworth). */
+  method: CleanupMethod;
+  /** map: σ of the root observation, metres (0.001–1); default measured from the motion's own jitter. */
+  sigmaRoot?: number;
+  /** map: σ of the joint-angle observations, radians (0.001–1.5); default measured per joint from the motion. */
+  sigmaAngle?: number;
+  /** lowpass: cut-off, Hz (0.5–14; default 6). */
+  cutoffHz?: number;
+}
+
+/** A cleaned motion: the input's own skeleton (joints, parents, fps, frames; one length per bone), with contacts. */
+export type DenoisedMotion = Motion & { contacts: Uint8Array; stats: CleanupStats };
+
 export const GENERATE_DEFAULT_TEMPERATURE = 0.5;
 export const GENERATE_MAX_FRAMES = 100_000;
 
@@ -187,6 +204,14 @@ export interface Playground {
    * same code as the Steer mode). Does not show it. `signal` cancels it.
    */
   simulateControl(options: SimulateControlOptions): Promise<ControlledMotion>;
+  /**
+   * Motion clean-up (docs/models/cleanup.md): the motion cleaned on its own skeleton, with contact labels. A
+   * skeleton whose joints cannot be matched to the canonical one rejects with the joints that are missing. Does not
+   * show it. `signal` cancels it.
+   */
+  denoise(motion: Motion, options: DenoiseOptions): Promise<DenoisedMotion>;
+  /** Synthetic capture noise for trying clean-up on a clean clip: jitter σ (m), a share of outlier frames, foot drift (m/s); seeded. */
+  addNoise(motion: Motion, options: NoiseOptions): Motion;
 }
 
 declare global {
@@ -478,6 +503,24 @@ export function createPlayground(app: App): Playground {
         const { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock, sliding, slidingBeforeLock } = m.stats;
         return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, stats: { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock, sliding, slidingBeforeLock } };
       });
+    },
+
+    denoise(motion, options) {
+      return cancellable('denoise', options, async (signal) => {
+        const input = validateMotion(motion);
+        const rest = { ...(options as unknown as Record<string, unknown>) };
+        delete rest.signal;
+        const o = checkCleanupOptions(typeof options === 'object' && options !== null ? rest : options);
+        if (o.method !== 'lowpass') mapSkeleton(input, 1); // an unmappable skeleton fails here, naming its missing joints
+        await ready;
+        const { client } = o.method === 'manifold' ? await app.latentErd.load() : await app.generator.load();
+        const r = await client.denoise({ motion: input, options: o }, { signal });
+        return { ...r.motion, stats: r.stats };
+      });
+    },
+
+    addNoise(motion, options) {
+      return guarded('addNoise', () => addNoiseTo(validateMotion(motion), checkNoiseOptions(options)).motion);
     },
 
     simulateControl(options) {

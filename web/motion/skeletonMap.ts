@@ -289,9 +289,9 @@ export function boneOwners(parents: readonly number[], mapping: SkeletonMapping)
 }
 
 /**
- * `motion` (the imported skeleton) moved as the canonical motion changed from `before` to `after`: each bone turns
- * with the world rotation of its owning canonical segment (boneOwners), and a bone that is a whole canonical segment
- * takes that segment's cleaned direction exactly. Every bone gets the skeleton's length for it, the median over the
+ * `motion` (the imported skeleton) moved as the canonical motion changed from `before` to `after`. A bone that is a
+ * whole canonical segment points from where its parent was placed at the cleaned canonical point (unscaled); any
+ * other bone rides rigidly on its owning canonical segment (boneOwners) at its median offset in that segment's frame. Every bone gets the skeleton's length for it, the median over the
  * frames (a file's skeleton has one length per bone; noisy positions give a different one each frame, and the
  * median ignores glitches). The root follows the canonical hips.
  *
@@ -312,38 +312,86 @@ export function fromCanonical(
   const hips = 0;
   const p = motion.positions;
   const lengths = medianBoneLengths(motion);
+  // A bone that is not a whole canonical segment rides rigidly on its owner: its offset in the owner's frame is the
+  // median over the frames (per component), so jitter of short bones such as fingers is not carried over.
+  const attached: [number, number, number][] = motion.parents.map(() => [0, 0, 0]);
+  {
+    const values = [new Float64Array(motion.frames), new Float64Array(motion.frames), new Float64Array(motion.frames)];
+    for (let j = 0; j < J; j++) {
+      const parent = motion.parents[j];
+      if (parent < 0 || whole[j]) continue;
+      for (let f = 0; f < motion.frames; f++) {
+        const o = (f * J + j) * 3, q = (f * J + parent) * 3, r = (f * K + owner[j]) * 4;
+        const g = before.rotations;
+        const local = qrot([-g[r], -g[r + 1], -g[r + 2], g[r + 3]], [p[o] - p[q], p[o + 1] - p[q + 1], p[o + 2] - p[q + 2]]);
+        for (let a = 0; a < 3; a++) values[a][f] = local[a];
+      }
+      attached[j] = values.map((v) => Float64Array.from(v).sort()[Math.floor(motion.frames / 2)]) as [number, number, number];
+    }
+  }
+  // Per frame: every joint starts at its target (a whole segment's end at the cleaned canonical point, unscaled;
+  // any other joint rigidly on its owner), the bone lengths are then imposed by a few rounds of moving both ends of
+  // each whole bone halfway (so a target chain a few centimetres too short or long spreads the difference instead of
+  // piling it up at the chain's end), and a last pass in parent order places each joint exactly at its bone's length,
+  // aimed at where the rounds put it.
+  const target = new Float64Array(J * 3);
+  const placed = new Float64Array(J * 3);
+  const ROUNDS = 8;
   for (let f = 0; f < motion.frames; f++) {
     const rot = (src: Float32Array, k: number): Q => {
       const o = (f * K + k) * 4;
       return [src[o], src[o + 1], src[o + 2], src[o + 3]];
     };
     const pt = (src: Float32Array, k: number, a: number) => src[(f * K + k) * 3 + a];
+    const attach = (j: number, from: Float64Array, to: Float64Array) => {
+      const moved = qrot(rot(after.rotations, owner[j]), attached[j]);
+      for (let a = 0; a < 3; a++) to[j * 3 + a] = from[motion.parents[j] * 3 + a] + moved[a];
+    };
     for (let j = 0; j < J; j++) {
-      const o = (f * J + j) * 3;
       const parent = motion.parents[j];
       if (parent < 0) {
         // The root moves with the canonical hips (it is the hips in every scheme but a Biped's root node).
-        for (let a = 0; a < 3; a++) out[o + a] = p[o + a] + (pt(after.points, hips, a) - pt(before.points, hips, a)) * inv;
-        continue;
-      }
-      const q = (f * J + parent) * 3;
-      const bone: [number, number, number] = [p[o] - p[q], p[o + 1] - p[q + 1], p[o + 2] - p[q + 2]];
-      let moved: [number, number, number];
-      const k = owner[j];
-      if (whole[j]) {
-        const c = CANONICAL_PARENTS[k];
-        const d = [0, 1, 2].map((a) => pt(after.points, k, a) - pt(after.points, c, a));
-        const n = Math.hypot(d[0], d[1], d[2]);
-        moved = n > 1e-9 ? [d[0] / n, d[1] / n, d[2] / n] : bone;
+        for (let a = 0; a < 3; a++) target[a + j * 3] = p[(f * J + j) * 3 + a] + (pt(after.points, hips, a) - pt(before.points, hips, a)) * inv;
+      } else if (whole[j]) {
+        for (let a = 0; a < 3; a++) target[j * 3 + a] = pt(after.points, owner[j], a) * inv;
       } else {
-        const b = rot(before.rotations, k);
-        const change = qmul(rot(after.rotations, k), [-b[0], -b[1], -b[2], b[3]]);
-        moved = qrot(change, bone);
+        attach(j, target, target);
       }
-      const n = Math.hypot(moved[0], moved[1], moved[2]);
-      if (n > 1e-12) moved = [(moved[0] / n) * lengths[j], (moved[1] / n) * lengths[j], (moved[2] / n) * lengths[j]];
-      for (let a = 0; a < 3; a++) out[o + a] = out[q + a] + moved[a];
     }
+    for (let round = 0; round < ROUNDS; round++) {
+      for (let j = 0; j < J; j++) {
+        const parent = motion.parents[j];
+        if (parent < 0 || !whole[j]) continue;
+        const d = [0, 1, 2].map((a) => target[j * 3 + a] - target[parent * 3 + a]);
+        const n = Math.hypot(d[0], d[1], d[2]);
+        if (n < 1e-9) continue;
+        const c = (n - lengths[j]) / n;
+        const parentMoves = motion.parents[parent] >= 0 ? 0.5 : 0; // the root stays where the hips put it
+        for (let a = 0; a < 3; a++) {
+          target[j * 3 + a] -= (1 - parentMoves) * c * d[a];
+          target[parent * 3 + a] += parentMoves * c * d[a];
+        }
+      }
+    }
+    for (let j = 0; j < J; j++) {
+      const parent = motion.parents[j];
+      if (parent < 0) {
+        for (let a = 0; a < 3; a++) placed[j * 3 + a] = target[j * 3 + a];
+      } else if (whole[j]) {
+        const d = [0, 1, 2].map((a) => target[j * 3 + a] - placed[parent * 3 + a]);
+        const n = Math.hypot(d[0], d[1], d[2]);
+        const q = (f * J + parent) * 3, o = (f * J + j) * 3;
+        const dir = n > 1e-9 ? d.map((v) => v / n) : [p[o] - p[q], p[o + 1] - p[q + 1], p[o + 2] - p[q + 2]].map((v, _, all) => v / (Math.hypot(...all) || 1));
+        for (let a = 0; a < 3; a++) placed[j * 3 + a] = placed[parent * 3 + a] + dir[a] * lengths[j];
+      } else {
+        attach(j, placed, placed);
+        // Rigid offsets keep their own median length; scale to the bone's median length like every bone.
+        const d = [0, 1, 2].map((a) => placed[j * 3 + a] - placed[parent * 3 + a]);
+        const n = Math.hypot(d[0], d[1], d[2]);
+        if (n > 1e-12) for (let a = 0; a < 3; a++) placed[j * 3 + a] = placed[parent * 3 + a] + (d[a] / n) * lengths[j];
+      }
+    }
+    out.set(placed, f * J * 3);
   }
   return { fps: motion.fps, frames: motion.frames, joints: motion.joints.slice(), parents: motion.parents.slice(), positions: out };
 }

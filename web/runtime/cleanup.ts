@@ -211,14 +211,22 @@ export function lowpassCleanup(motion: Motion, options: CleanupOptions): Cleanup
   return { motion: { ...filtered, contacts }, stats: { method: 'lowpass', cutoffHz, computeMs: performance.now() - began } };
 }
 
-/** The floor under canonical points (frames × 25 × 3): the 5th percentile of the lowest toe or ankle point per frame. */
+/**
+ * The floor under canonical points (frames × 25 × 3): the 10th percentile of the lowest foot point per frame,
+ * averaged over 5 frames first so that jitter does not pull it down (a plain percentile of noisy heights sits
+ * centimetres under the true floor).
+ */
 function floorHeight(points: Float32Array): number {
   const K = CANONICAL_JOINTS.length;
   const feet = ['LeftFoot', 'LeftToeBase', 'LeftToeBase_end', 'RightFoot', 'RightToeBase', 'RightToeBase_end'].map((n) => CANONICAL_JOINTS.indexOf(n as never));
-  const lowest: number[] = [];
-  for (let f = 0; f < points.length / (K * 3); f++) lowest.push(Math.min(...feet.map((j) => points[(f * K + j) * 3 + 1])));
-  lowest.sort((a, b) => a - b);
-  return lowest[Math.floor(lowest.length * 0.05)] ?? 0;
+  const frames = points.length / (K * 3);
+  const lowest = Array.from({ length: frames }, (_, f) => Math.min(...feet.map((j) => points[(f * K + j) * 3 + 1])));
+  const averaged = lowest.map((_, f) => {
+    const window = lowest.slice(Math.max(0, f - 2), Math.min(frames, f + 3));
+    return window.reduce((a, b) => a + b, 0) / window.length;
+  });
+  averaged.sort((a, b) => a - b);
+  return averaged[Math.floor(frames * 0.1)] ?? 0;
 }
 
 /** Hip → knee → ankle length of the generator's skeleton. */

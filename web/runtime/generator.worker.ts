@@ -8,6 +8,8 @@ import { ort, serveModel } from './ortWorker';
 import { OptimizerRequests } from './optimizerRequests';
 import type { RefinerParityResult, RefinerStepInputs, StreamParams } from './protocol';
 import { loadRefiner } from './refinerLoader';
+import { mapCleaner } from './cleanup';
+import { serveDenoise, type DenoiseParams } from './cleanupRequests';
 
 // One optimiser per loaded core (a new init replaces the core, and with it the live control stream).
 const optimizers = new WeakMap<GeneratorCore, OptimizerRequests>();
@@ -28,6 +30,13 @@ serveModel({
   extra(request, core, progress, signal) {
     const generator = core as GeneratorCore;
     if (request.type === 'refinerParity') return refinerParity(generator, request as unknown as { inputs: RefinerStepInputs; frames?: number[] });
+    if (request.type === 'denoise') {
+      return serveDenoise(request as unknown as DenoiseParams, {
+        methods: ['map', 'lowpass'],
+        info: () => Promise.resolve(generator.info),
+        cleaner: (options, onProgress) => mapCleaner({ step: (b, x, h, c) => generator.step(b, x, h, c, signal), info: generator.info, mean: generator.mean, std: generator.std, options, onProgress }),
+      }, progress);
+    }
     let optimizer = optimizers.get(generator);
     if (!optimizer) optimizers.set(generator, (optimizer = new OptimizerRequests(generator)));
     return optimizer.handle(request as { type: string } & Record<string, unknown>, progress, signal);

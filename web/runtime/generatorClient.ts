@@ -1,5 +1,7 @@
 // Main-thread handle on the generator worker: promise methods (ModelClient; requests matched to
 // replies by id: WorkerClient).
+import type { CleanupResult } from './cleanup';
+import type { DenoiseParams } from './cleanupRequests';
 import type { StepInputs } from '../model/generatorInfo';
 import type { Motion } from '../motion/types';
 import type {
@@ -123,6 +125,11 @@ export class GeneratorClient extends ModelClient<StreamParams, InitResult, Gener
     const c = await this.request<SimulatedControlChunk>('simulateControl', { ...params }, options);
     const { speed, heading, targetSpeed, targetHeading, computeMs, batchMs, batchFrames } = c;
     return { ...this.toMotion(c), speed, heading, targetSpeed, targetHeading, computeMs, batchMs, batchFrames };
+  }
+
+  /** Motion clean-up with `map` or `lowpass` (cleanup.ts) in the worker; `onProgress` hears the share done; `signal` cancels it. */
+  denoise(params: DenoiseParams, options: ProgressOptions = {}): Promise<CleanupResult> {
+    return this.request<CleanupResult>('denoise', { ...params }, options);
   }
 
   protected toMotion(chunk: GeneratedChunk): GeneratedMotion {

@@ -4,7 +4,10 @@
 // (latent-erd.onnx, loaded by init) and the autoencoder's decoder (manifold-decoder.onnx, named by the
 // manifold.json that latent-erd.json names; loaded while the model is checked); and the autoencoder's encoder
 // (manifold-encoder.onnx), loaded by the first manifoldProject request (latentErdRequests.ts).
+import { loadGeneratorInfo, type GeneratorInfo } from '../model/generatorInfo';
 import { loadLatentErdModel } from '../model/latentErdInfo';
+import { manifoldCleaner } from './cleanup';
+import { serveDenoise, type DenoiseParams } from './cleanupRequests';
 import { LatentErdCore } from './latentErdCore';
 import type { LatentStreamParams } from './latentErdProtocol';
 import { LatentErdRequests } from './latentErdRequests';
@@ -12,10 +15,17 @@ import { loadExtraSession, ort, serveModel } from './ortWorker';
 
 // One set of control requests per loaded core (a new init replaces the core, and with it the live stream).
 const requests = new WeakMap<LatentErdCore, LatentErdRequests>();
+/** latent-erd.json's URL of the latest init: generator.json, whose skeleton the clean-up's IK uses, sits next to it. */
+let infoUrl = '';
+let generatorInfo: Promise<GeneratorInfo> | undefined;
 
 serveModel({
   name: 'latent ERD',
-  loadInfo: loadLatentErdModel,
+  loadInfo: (url) => {
+    infoUrl = url;
+    generatorInfo = undefined;
+    return loadLatentErdModel(url);
+  },
   makeCore: (session, model, threads) =>
     new LatentErdCore(
       session,
@@ -34,6 +44,17 @@ serveModel({
   }),
   extra(request, core, progress, signal) {
     const erd = core as LatentErdCore;
+    if (request.type === 'denoise') {
+      return serveDenoise(request as unknown as DenoiseParams, {
+        methods: ['manifold'],
+        info: () => {
+          generatorInfo ??= loadGeneratorInfo(new URL('generator.json', infoUrl).href);
+          generatorInfo.catch(() => (generatorInfo = undefined)); // a failed fetch is tried again next time
+          return generatorInfo;
+        },
+        cleaner: (_options, onProgress) => manifoldCleaner((positions) => erd.projectManifold(positions, undefined, signal, onProgress)),
+      }, progress);
+    }
     let handler = requests.get(erd);
     if (!handler) requests.set(erd, (handler = new LatentErdRequests(erd)));
     return handler.handle(request as { type: string } & Record<string, unknown>, progress, signal);

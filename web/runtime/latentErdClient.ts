@@ -1,5 +1,7 @@
 // Main-thread handle on the latent ERD's worker: promise methods (ModelClient; requests matched to replies
 // by id: WorkerClient), and the control requests (followPath, live control, simulateControl).
+import type { CleanupResult } from './cleanup';
+import type { DenoiseParams } from './cleanupRequests';
 import type { Motion } from '../motion/types';
 import type {
   LatentChunk,
@@ -67,6 +69,11 @@ export class LatentErdClient extends ModelClient<LatentStreamParams, LatentErdIn
   }
 
   /** Follows a ground path in closed loop (one control per latent step); `onProgress` hears the share of the path done. */
+  /** Motion clean-up with `manifold` (cleanup.ts) in the worker; `onProgress` hears the share done; `signal` cancels it. */
+  denoise(params: DenoiseParams, options: ProgressOptions = {}): Promise<CleanupResult> {
+    return this.request<CleanupResult>('denoise', { ...params }, options);
+  }
+
   async followPath(params: LatentFollowPathParams, options: ProgressOptions = {}): Promise<LatentFollowedPath> {
     const chunk = await this.request<LatentFollowPathChunk>('followPath', { ...params }, options);
     return { ...this.toMotion(chunk), stats: chunk.stats, path: chunk.path };
