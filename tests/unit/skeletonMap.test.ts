@@ -13,6 +13,9 @@ import {
   type CanonicalJoint,
 } from '../../web/motion/skeletonMap';
 import type { Motion } from '../../web/motion/types';
+import { canonicalRotations } from '../../web/model/featureEncode';
+import { parseGeneratorInfo } from '../../web/model/generatorInfo';
+import { readRepoFile } from './corpus';
 
 type V = [number, number, number];
 const FRAMES = 5;
@@ -190,11 +193,9 @@ const expectVec = (a: V, b: V, tol = 1e-5) => {
   for (let i = 0; i < 3; i++) expect(Math.abs(a[i] - b[i])).toBeLessThan(tol);
 };
 
-function identityRotations(): Float32Array {
-  const r = new Float32Array(FRAMES * K * 4);
-  for (let i = 0; i < FRAMES * K; i++) r[i * 4 + 3] = 1;
-  return r;
-}
+const generatorInfo = parseGeneratorInfo(JSON.parse(readRepoFile('public/models/generator.json')), 'generator.json');
+/** The canonical segments' world rotations of canonical points (the clean-up's IK: unmapped bones ride on them). */
+const rotationsOf = (points: Float32Array): Float32Array => canonicalRotations(generatorInfo, points);
 
 /** Rotates v by the unit quaternion q = [x, y, z, w] (written out here, not taken from the module). */
 function rotate(q: number[], v: V): V {
@@ -339,22 +340,27 @@ describe('toCanonical', () => {
 });
 
 describe('fromCanonical', () => {
+  // Bones that are not whole canonical segments (shoulders, extra spine joints, fingers) ride rigidly, at their median
+  // offset, on the segment rotations the clean-up's IK reads from the positions, whose twist about the segment is an
+  // estimate: on these synthetic skeletons they come back within 3 mm (whole segments stay exact, as checked below).
+  const RIDING = 3e-3;
   for (const [label, make] of [['Mixamo', () => mixamo()], ['3ds Max Biped', biped]] as const) {
     it(`gives the ${label} positions back unchanged when the canonical motion does not change`, () => {
       const m = make();
       const mapping = mapSkeleton(m, CANONICAL_LEG);
-      const state = { points: toCanonical(m, mapping), rotations: identityRotations() };
+      const state = { points: toCanonical(m, mapping), rotations: rotationsOf(toCanonical(m, mapping)) };
       const out = fromCanonical(m, mapping, state, { points: state.points.slice(), rotations: state.rotations.slice() });
       expect(out.positions).toHaveLength(m.positions.length);
-      for (let i = 0; i < m.positions.length; i++) expect(Math.abs(out.positions[i] - m.positions[i])).toBeLessThan(1e-5);
+      for (let i = 0; i < m.positions.length; i++) expect(Math.abs(out.positions[i] - m.positions[i])).toBeLessThan(RIDING);
     });
   }
 
-  it('gives every bone of a stretched skeleton its median length over the frames, in its own direction', () => {
+  it('gives every bone of a stretched skeleton its median length over the frames, whole segments near their joints', () => {
     const m = mixamo(1, true);
     const mapping = mapSkeleton(m, CANONICAL_LEG);
-    const state = { points: toCanonical(m, mapping), rotations: identityRotations() };
+    const state = { points: toCanonical(m, mapping), rotations: rotationsOf(toCanonical(m, mapping)) };
     const out = fromCanonical(m, mapping, state, state);
+    const { whole } = boneOwners(m.parents, mapping);
     let stretched = 0;
     for (let j = 0; j < m.joints.length; j++) {
       const p = m.parents[j];
@@ -366,9 +372,9 @@ describe('fromCanonical', () => {
       const median = [...lengths].sort((a, b) => a - b)[(FRAMES - 1) / 2];
       stretched = Math.max(stretched, Math.max(...lengths) - Math.min(...lengths));
       for (let f = 0; f < FRAMES; f++) {
-        const bone = sub(pos(m, f, j), pos(m, f, p));
-        const n = Math.hypot(...bone);
-        expectVec(sub(pos(out, f, j), pos(out, f, p)), bone.map((v) => (v / n) * median) as V);
+        expect(Math.abs(dist(pos(out, f, j), pos(out, f, p)) - median)).toBeLessThan(1e-5);
+        // A whole segment stays near its joint: the frame's stretch against the median is spread along the chain.
+        if (whole[j]) expect(dist(pos(out, f, j), pos(m, f, j))).toBeLessThan(0.03);
       }
     }
     expect(stretched).toBeGreaterThan(0.005);
@@ -378,7 +384,7 @@ describe('fromCanonical', () => {
   const qy = [0, Math.sin(angle / 2), 0, Math.cos(angle / 2)];
   const shift: V = [0.5, 0, 0.2];
   /** `before` turned about the canonical hips by qy and shifted by `shift`, with the rotations turned by qy. */
-  function turned(before: Float32Array) {
+  function turned(before: Float32Array, beforeRotations: Float32Array) {
     const points = new Float32Array(before.length);
     const rotations = new Float32Array(FRAMES * K * 4);
     for (let f = 0; f < FRAMES; f++) {
@@ -387,8 +393,15 @@ describe('fromCanonical', () => {
         const p = point(before, f, k);
         const r = rotate(qy, [p[0] - h[0], p[1] - h[1], p[2] - h[2]]);
         for (let a = 0; a < 3; a++) points[(f * K + k) * 3 + a] = h[a] + r[a] + shift[a];
-        // qy × identity = qy.
-        for (let a = 0; a < 4; a++) rotations[(f * K + k) * 4 + a] = qy[a];
+        // qy × the segment's rotation.
+        const b = Array.from(beforeRotations.subarray((f * K + k) * 4, (f * K + k) * 4 + 4));
+        const q = [
+          qy[3] * b[0] + qy[0] * b[3] + qy[1] * b[2] - qy[2] * b[1],
+          qy[3] * b[1] - qy[0] * b[2] + qy[1] * b[3] + qy[2] * b[0],
+          qy[3] * b[2] + qy[0] * b[1] - qy[1] * b[0] + qy[2] * b[3],
+          qy[3] * b[3] - qy[0] * b[0] - qy[1] * b[1] - qy[2] * b[2],
+        ];
+        for (let a = 0; a < 4; a++) rotations[(f * K + k) * 4 + a] = q[a];
       }
     }
     return { points, rotations };
@@ -398,8 +411,8 @@ describe('fromCanonical', () => {
     it(`keeps the ${label} joints, parents, frames and every bone length, and moves the root by the hips' shift / scale`, () => {
       const m = make();
       const mapping = mapSkeleton(m, CANONICAL_LEG);
-      const before = { points: toCanonical(m, mapping), rotations: identityRotations() };
-      const out = fromCanonical(m, mapping, before, turned(before.points));
+      const before = { points: toCanonical(m, mapping), rotations: rotationsOf(toCanonical(m, mapping)) };
+      const out = fromCanonical(m, mapping, before, turned(before.points, before.rotations));
       expect(out.joints).toEqual(m.joints);
       expect(out.parents).toEqual(m.parents);
       expect(out.frames).toBe(m.frames);
@@ -423,14 +436,14 @@ describe('fromCanonical', () => {
   it('turns a Mixamo skeleton (root = hips) rigidly about its hips and shifts it', () => {
     const m = mixamo();
     const mapping = mapSkeleton(m, CANONICAL_LEG);
-    const before = { points: toCanonical(m, mapping), rotations: identityRotations() };
-    const out = fromCanonical(m, mapping, before, turned(before.points));
+    const before = { points: toCanonical(m, mapping), rotations: rotationsOf(toCanonical(m, mapping)) };
+    const out = fromCanonical(m, mapping, before, turned(before.points, before.rotations));
     for (let f = 0; f < FRAMES; f++) {
       const h = pos(m, f, 0);
       for (let j = 0; j < m.joints.length; j++) {
         const p = pos(m, f, j);
         const r = rotate(qy, [p[0] - h[0], p[1] - h[1], p[2] - h[2]]);
-        expectVec(pos(out, f, j), [0, 1, 2].map((a) => h[a] + r[a] + shift[a] / mapping.scale) as V);
+        expectVec(pos(out, f, j), [0, 1, 2].map((a) => h[a] + r[a] + shift[a] / mapping.scale) as V, RIDING);
       }
     }
   });

@@ -54,9 +54,10 @@ export function integrateRoot(root: RootStart, dtx: number, dtz: number, dry: nu
   root.heading += dry;
 }
 
-export function decodeFeatures(info: GeneratorInfo, features: Float32Array, start: RootStart = { x: 0, z: 0, heading: 0 }): DecodedFeatures {
+/** `offsets` (joints × 3) replaces the skeleton's rest offsets, e.g. to decode onto a captured clip's own proportions. */
+export function decodeFeatures(info: GeneratorInfo, features: Float32Array, start: RootStart = { x: 0, z: 0, heading: 0 }, offsets?: ArrayLike<number>): DecodedFeatures {
   const D = info.onnx.dim;
-  const skeleton = generatorSkeleton(info);
+  const skeleton = offsets ? { ...generatorSkeleton(info), offsets: Float32Array.from(offsets) } : generatorSkeleton(info);
   const J = skeleton.parents.length;
   if (features.length % D !== 0) throw new Error(`decodeFeatures: ${features.length} values is not a whole number of ${D}-value frames`);
   const frames = features.length / D;

@@ -44,7 +44,7 @@ const FIXED_CHILD_SIGMA = 0.1;
  * Inverse kinematics of canonical positions onto the generator's skeleton, one frame at a time. The twist of each
  * segment about itself (which positions do not show) is the one that makes the joint's own local rotation and its
  * children's most likely under a prior: by default each joint's reference (mean) rotation with the features'
- * normalisation spread; the MAP filter passes the generator's own prediction for the frame instead.
+ * normalisation spread (`prior` can give other local rotations).
  */
 export class CanonicalIK {
   private readonly parents: number[];
@@ -152,22 +152,6 @@ export class CanonicalIK {
       row.set(quatToRotvec(quatMultiply(quatConjugate(this.refs[j]), local)), JOINT_FEATURES_START + 3 * k);
     });
   }
-
-  /** Local rotations of a feature row (rotation vectors about the references); the root's is left at its reference. */
-  localRotations(row: ArrayLike<number>): Quat[] {
-    const out = this.refs.slice();
-    this.info.features.joints.forEach((j, k) => {
-      const o = JOINT_FEATURES_START + 3 * k;
-      out[j] = quatMultiply(this.refs[j], rotvecToQuat(row[o], row[o + 1], row[o + 2]));
-    });
-    return out;
-  }
-}
-
-function rotvecToQuat(x: number, y: number, z: number): Quat {
-  const angle = Math.sqrt(x * x + y * y + z * z);
-  const s = angle > 1e-9 ? Math.sin(angle / 2) / angle : 0.5;
-  return [x * s, y * s, z * s, Math.cos(angle / 2)];
 }
 
 /** World segment rotations (frames × J × 4) of canonical positions (frames × J × 3), twists nearest the references. */

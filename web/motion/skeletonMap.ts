@@ -203,8 +203,12 @@ export function toCanonical(motion: Motion, mapping: SkeletonMapping): Float32Ar
   return out;
 }
 
-/** Per joint, the median over frames of its bone's length (0 for the root). */
-export function medianBoneLengths(motion: Motion): Float64Array {
+/**
+ * Per joint, its bone's length over the frames (0 for the root): the median, or with `jitter` (σ per coordinate
+ * of the positions' noise, m) the noise taken out: noise lengthens a bone on average (E|b + n|² = |b|² + 6σ² with
+ * both ends jittered), most of all a short one.
+ */
+export function medianBoneLengths(motion: Motion, jitter = 0): Float64Array {
   const J = motion.joints.length;
   const out = new Float64Array(J);
   const values = new Float64Array(motion.frames);
@@ -214,10 +218,11 @@ export function medianBoneLengths(motion: Motion): Float64Array {
     for (let f = 0; f < motion.frames; f++) {
       const a = (f * J + j) * 3, b = (f * J + p) * 3;
       const P = motion.positions;
-      values[f] = Math.hypot(P[a] - P[b], P[a + 1] - P[b + 1], P[a + 2] - P[b + 2]);
+      values[f] = (P[a] - P[b]) ** 2 + (P[a + 1] - P[b + 1]) ** 2 + (P[a + 2] - P[b + 2]) ** 2;
     }
     const sorted = Float64Array.from(values).sort();
-    out[j] = sorted[Math.floor(sorted.length / 2)];
+    const squared = sorted[Math.floor(sorted.length / 2)];
+    out[j] = Math.sqrt(Math.max(squared - 6 * jitter * jitter, squared / 4));
   }
   return out;
 }
@@ -303,6 +308,7 @@ export function fromCanonical(
   mapping: SkeletonMapping,
   before: { points: Float32Array; rotations: Float32Array },
   after: { points: Float32Array; rotations: Float32Array },
+  jitter = 0,
 ): Motion {
   const J = motion.joints.length;
   const K = CANONICAL_JOINTS.length;
@@ -311,7 +317,7 @@ export function fromCanonical(
   const inv = 1 / mapping.scale;
   const hips = 0;
   const p = motion.positions;
-  const lengths = medianBoneLengths(motion);
+  const lengths = medianBoneLengths(motion, jitter);
   // A bone that is not a whole canonical segment rides rigidly on its owner: its offset in the owner's frame is the
   // median over the frames (per component), so jitter of short bones such as fingers is not carried over.
   const attached: [number, number, number][] = motion.parents.map(() => [0, 0, 0]);

@@ -2,23 +2,24 @@
 //
 //   imported motion (its own skeleton, any fps)
 //     → canonical points by joint names (motion/skeletonMap), at the models' 30 fps (motion/resample)
-//     → a canonical cleaner: `map` (MAP under the generator, optimizer/denoise) or `manifold` (the autoencoder)
-//     → contacts labelled on the cleaned motion and planted feet locked (motion/footLock plantFeet)
+//     → a canonical cleaner: `map` (MAP under the generator, optimizer/smoother) or `manifold` (the autoencoder)
+//     → contacts labelled on the cleaned motion and planted feet pinned (motion/footPin)
 //     → back onto the imported skeleton at its own fps: every bone keeps its length and turns with its canonical
 //       segment; joints the canonical skeleton lacks (fingers, extra spine joints) turn with the segment that
 //       carries them (skeletonMap.fromCanonical).
 // `lowpass`, the baseline, filters the imported joint positions directly and labels contacts by height and speed.
-import { decodeFeatures } from '../model/featureDecode';
-import { CanonicalIK, canonicalRotations, encodeFeatures, headingOf } from '../model/featureEncode';
+import { decodeFeatures, integrateRoot, type RootStart } from '../model/featureDecode';
+import { canonicalRotations, encodeFeatures } from '../model/featureEncode';
 import type { GeneratorInfo } from '../model/generatorInfo';
 import { detectContacts } from '../motion/contacts';
-import { plantFeet } from '../motion/footLock';
-import { lowpassMotion } from '../motion/lowpass';
+import { labelContacts } from '../motion/contactLabels';
+import { pinFeet } from '../motion/footPin';
+import { butterworthLowpass, filtfilt, lowpassMotion } from '../motion/lowpass';
 import { resampledFrames, resampleLinear, resampleNearest, resampleQuaternions } from '../motion/resample';
-import { CANONICAL_JOINTS, fromCanonical, mapSkeleton, toCanonical } from '../motion/skeletonMap';
+import { CANONICAL_JOINTS, fromCanonical, mapSkeleton, medianBoneLengths, toCanonical } from '../motion/skeletonMap';
 import type { Motion } from '../motion/types';
 import { describeValue } from '../motion/describe';
-import { denoiseFeatures, type DenoiseSettings } from '../optimizer/denoise';
+import { smoothFeatures } from '../optimizer/smoother';
 import type { StepFn } from '../optimizer/rollout';
 
 export const CLEANUP_METHODS = ['map', 'manifold', 'lowpass'] as const;
@@ -41,6 +42,8 @@ export interface CleanupStats {
   sigmaRoot?: number;
   sigmaAngle?: number;
   cutoffHz?: number;
+  /** map: the jitter measured on the motion (m), used as the observation σ where none is given. */
+  jitter?: number;
   /** map: share of joint observations discounted as outliers. */
   outlierShare?: number;
   computeMs: number;
@@ -71,6 +74,43 @@ export function checkCleanupOptions(options: unknown): CleanupOptions {
   return out;
 }
 
+/** Cut-off (Hz) of the root track's smoothing: keeps the hips' sway with each step, drops jitter. */
+const ROOT_CUTOFF_HZ = 4;
+
+/**
+ * The observed root's ground track and heading after each frame (integrated from the encoded rows), with glitches
+ * removed (a 5-frame running median) and jitter (a zero-phase low-pass): the root term of eq. 25, solved on its own.
+ */
+export function smoothRootTrack(features: Float32Array, start: RootStart, D: number, fps: number): { rootTrack: RootStart[]; start: RootStart } {
+  const frames = features.length / D;
+  const walker = { ...start };
+  const xs = new Float64Array(frames), zs = new Float64Array(frames), hs = new Float64Array(frames);
+  for (let f = 0; f < frames; f++) {
+    integrateRoot(walker, features[f * D], features[f * D + 1], features[f * D + 2]);
+    [xs[f], zs[f], hs[f]] = [walker.x, walker.z, walker.heading];
+  }
+  const sections = butterworthLowpass(Math.min(ROOT_CUTOFF_HZ, fps * 0.45), fps);
+  const smooth = (v: Float64Array) => (frames > 6 ? filtfilt(runningMedian(v, 2), sections) : v);
+  const [x, z, h] = [smooth(xs), smooth(zs), smooth(hs)];
+  const rootTrack = Array.from({ length: frames }, (_, f) => ({ x: x[f], z: z[f], heading: h[f] }));
+  const next = frames > 1 ? 1 : 0;
+  return { rootTrack, start: { x: 2 * x[0] - x[next], z: 2 * z[0] - z[next], heading: 2 * h[0] - h[next] } };
+}
+
+function runningMedian(v: Float64Array, radius: number): Float64Array {
+  return v.map((_, i) => {
+    const w = Array.from(v.subarray(Math.max(0, i - radius), Math.min(v.length, i + radius + 1))).sort((a, b) => a - b);
+    return w[Math.floor(w.length / 2)];
+  });
+}
+
+/** The motion's jitter (m): per canonical point from its second differences at the motion's own rate, the median. */
+function medianJitter(points: Float32Array): number {
+  const K = CANONICAL_JOINTS.length;
+  const per = Array.from({ length: K }, (_, k) => jitterSigma(points, K * 3, [k * 3, k * 3 + 1, k * 3 + 2])).sort((a, b) => a - b);
+  return per[Math.floor(K / 2)];
+}
+
 /** Robust σ of white noise on a signal from its second differences (median absolute deviation; Var(Δ²n) = 6σ²). */
 function jitterSigma(values: ArrayLike<number>, width: number, columns: number[]): number {
   const frames = values.length / width;
@@ -83,36 +123,17 @@ function jitterSigma(values: ArrayLike<number>, width: number, columns: number[]
   return d[Math.floor(d.length / 2)] / 0.6745 / Math.sqrt(6);
 }
 
-/** The smallest σs the map filter assumes, so clean input is still followed closely but not copied frame by frame. */
-const SIGMA_FLOOR = { root: 0.005, angle: 0.01 };
-
-/**
- * Default observation σs for `map`, measured on the motion itself: the root's from the hips' track, and one per
- * joint from its rotation vector (a short segment's angle is noisier than a long one's for the same jitter).
- */
-export function estimateSigmas(info: GeneratorInfo, features: Float32Array, canonicalPoints: Float32Array): { sigmaRoot: number; sigmaAngle: Float64Array } {
-  const D = info.onnx.dim;
-  const sigmaAngle = new Float64Array(D);
-  for (let d = 4; d + 2 < D; d += 3) {
-    const s = Math.max(SIGMA_FLOOR.angle, jitterSigma(features, D, [d, d + 1, d + 2]));
-    sigmaAngle.fill(s, d, d + 3);
-  }
-  sigmaAngle[2] = sigmaAngle[4]; // the heading change, as the pelvis's tilt
-  const J = info.skeleton.joints.length;
-  return { sigmaAngle, sigmaRoot: Math.max(SIGMA_FLOOR.root, jitterSigma(canonicalPoints, J * 3, [0, 1, 2])) };
-}
-
-function median(values: ArrayLike<number>): number {
-  const v = Array.from(values).sort((a, b) => a - b);
-  return v[Math.floor(v.length / 2)];
-}
+/** The smallest observation σ (m) the map smoother assumes, so clean input is followed closely but not copied frame by frame. */
+const SIGMA_FLOOR = 0.003;
 
 /** What a canonical cleaner gets (at the model's fps) and gives back. */
 export interface CanonicalInput {
-  /** frames × 25 × 3 canonical points (canonical scale) and their world segment rotations (frames × 25 × 4). */
+  /** frames × 25 × 3 canonical points (canonical scale, floor at y = 0) and their world segment rotations (frames × 25 × 4). */
   points: Float32Array;
   rotations: Float32Array;
   fps: number;
+  /** The jitter of the points (m), measured at the motion's own frame rate (jitterSigma, median over the points). */
+  jitter: number;
 }
 export interface CanonicalCleaned {
   positions: Float32Array;
@@ -121,38 +142,37 @@ export interface CanonicalCleaned {
   stats?: Partial<CleanupStats>;
 }
 
-/** The `map` cleaner: MAP filtering under the generator (optimizer/denoise.ts), then decoding. */
+/**
+ * The `map` cleaner: the MAP motion under the generator, by the extended Kalman smoother (optimizer/smoother.ts).
+ * Observation σ per point: the measured jitter by default; `sigmaRoot` sets the hips', `sigmaAngle` the others' as
+ * that angle times the segment's length (a rotation error δ of a segment moves its end by δ · length).
+ */
 export function mapCleaner(args: { step: StepFn; info: GeneratorInfo; mean: ArrayLike<number>; std: ArrayLike<number>; options: CleanupOptions; onProgress?: (fraction: number) => void }) {
   return async (input: CanonicalInput): Promise<CanonicalCleaned> => {
-    const { info } = args;
-    const encoded = encodeFeatures(info, input.points, input.rotations);
-    const estimated = estimateSigmas(info, encoded.features, input.points);
-    const settings: DenoiseSettings = { sigmaRoot: args.options.sigmaRoot ?? estimated.sigmaRoot, sigmaAngle: args.options.sigmaAngle ?? estimated.sigmaAngle };
+    const { info, options } = args;
     const K = CANONICAL_JOINTS.length;
     const frames = input.points.length / (K * 3);
-    const ik = new CanonicalIK(info);
-    const world = new Float32Array(K * 4);
-    const D = info.onnx.dim;
-    const heading = new Float32Array(frames);
-    for (let f = 0; f < frames; f++) heading[f] = headingOf([input.rotations[f * K * 4], input.rotations[f * K * 4 + 1], input.rotations[f * K * 4 + 2], input.rotations[f * K * 4 + 3]]);
-    const reobserve = (f: number, predicted: Float32Array, row: Float32Array) => {
-      ik.solve(input.points, f * K * 3, world, 0, ik.localRotations(predicted));
-      ik.angles(world, 0, heading[f], row);
-    };
-    const r = await denoiseFeatures({
-      step: args.step,
-      info,
-      mean: args.mean,
-      std: args.std,
-      observed: encoded.features,
-      start: encoded.start,
-      settings,
-      reobserve,
+    const encoded = encodeFeatures(info, input.points, input.rotations);
+    const jitter = Math.max(SIGMA_FLOOR, input.jitter);
+    const offsets = segmentOffsets(info, input.points, input.jitter);
+    const sigma = Array.from({ length: K }, (_, k) => {
+      if (k === 0) return options.sigmaRoot ?? jitter;
+      if (options.sigmaAngle === undefined) return jitter;
+      return Math.max(SIGMA_FLOOR, options.sigmaAngle * Math.hypot(offsets[k * 3], offsets[k * 3 + 1], offsets[k * 3 + 2]));
+    });
+    const { rootTrack, start } = smoothRootTrack(encoded.features, encoded.start, info.onnx.dim, input.fps);
+    const r = await smoothFeatures({
+      step: args.step, info, mean: args.mean, std: args.std,
+      points: input.points, sigma, encoded: encoded.features, rootTrack, start, offsets,
       onFrame: (f) => args.onProgress?.(f / frames),
     });
-    const decoded = decodeFeatures(info, r.features, encoded.start);
-    const sigmaAngle = typeof settings.sigmaAngle === 'number' ? settings.sigmaAngle : median(Array.from(settings.sigmaAngle).slice(4, D - 2));
-    return { positions: decoded.positions, bits: decoded.contacts, stats: { sigmaRoot: settings.sigmaRoot, sigmaAngle, outlierShare: r.outlierShare } };
+    // Decoded on the clip's own segment lengths, so the cleaned points keep its proportions.
+    const decoded = decodeFeatures(info, r.features, start, offsets);
+    return {
+      positions: decoded.positions,
+      bits: decoded.contacts,
+      stats: { sigmaRoot: sigma[0], ...(options.sigmaAngle === undefined ? { jitter } : { sigmaAngle: options.sigmaAngle }), outlierShare: r.outlierShare },
+    };
   };
 }
 
@@ -186,15 +206,18 @@ export async function cleanUpOnCanonical(
   // The models stand on y = 0; imported clips need not (CMU AMC floors sit a few centimetres off).
   const floor = floorHeight(points);
   for (let i = 1; i < points.length; i += 3) points[i] -= floor;
-  const cleaned = await clean({ points, rotations: canonicalRotations(info, points), fps });
+  const jitter = medianJitter(beforePoints);
+  const cleaned = await clean({ points, rotations: canonicalRotations(info, points), fps, jitter });
   const { skeleton } = info;
-  const planted = plantFeet(cleaned.positions, cleaned.bits, skeleton.joints, skeleton.offsets, fps);
+  // Contacts labelled on the cleaned motion (the model's bits with the feet's heights and speeds), planted feet pinned.
+  const contacts30 = labelContacts(cleaned.positions, cleaned.bits, skeleton.joints, fps);
+  const planted = { positions: pinFeet(cleaned.positions, contacts30, skeleton.joints), contacts: contacts30 };
   for (let i = 1; i < planted.positions.length; i += 3) planted.positions[i] += floor;
   const afterRotations = canonicalRotations(info, planted.positions);
   // After: back at the imported motion's frame times.
   const afterPoints = resampleLinear(planted.positions, K * 3, fps, motion.fps, motion.frames);
   const after = { points: afterPoints, rotations: resampleQuaternions(afterRotations, K, fps, motion.fps, motion.frames) };
-  const moved = fromCanonical(motion, mapping, { points: beforePoints, rotations: beforeRotations }, after);
+  const moved = fromCanonical(motion, mapping, { points: beforePoints, rotations: beforeRotations }, after, jitter / mapping.scale);
   const contacts = resampleNearest(planted.contacts, 2, fps, motion.fps, motion.frames);
   return {
     motion: { ...moved, contacts },
@@ -227,6 +250,18 @@ function floorHeight(points: Float32Array): number {
   });
   averaged.sort((a, b) => a - b);
   return averaged[Math.floor(frames * 0.1)] ?? 0;
+}
+
+/** The canonical offsets rescaled to the segment lengths of `points` (frames × 25 × 3) with `jitter` (m) taken out (medianBoneLengths). */
+function segmentOffsets(info: GeneratorInfo, points: Float32Array, jitter: number): Float32Array {
+  const { joints, parents, offsets } = info.skeleton;
+  const lengths = medianBoneLengths({ fps: 1, frames: points.length / (joints.length * 3), joints, parents, positions: points }, jitter);
+  const out = Float32Array.from(offsets);
+  for (let j = 1; j < joints.length; j++) {
+    const rest = Math.hypot(offsets[j * 3], offsets[j * 3 + 1], offsets[j * 3 + 2]);
+    if (rest > 0) for (let a = 0; a < 3; a++) out[j * 3 + a] = (offsets[j * 3 + a] / rest) * lengths[j];
+  }
+  return out;
 }
 
 /** Hip → knee → ankle length of the generator's skeleton. */
