@@ -113,7 +113,7 @@ export class CanonicalIK {
         const d = from(parents[j], j);
         g = quatMultiply(swingRotation(quatRotate(g, offsets[j]), d), g);
         const axis = normalize(d);
-        if (length(axis) > 0) g = this.bestTwist(axis, g, (q) => cost(j, parent, q));
+        if (length(axis) > 0) g = this.bestTwist(j, axis, g, (q) => cost(j, parent, q));
       }
       G[j] = quatNormalize(g);
       out.set(G[j], outBase + j * 4);
@@ -121,12 +121,22 @@ export class CanonicalIK {
     out.set(G[0], outBase);
   }
 
-  /** g turned about `axis` by the angle of least cost: a coarse scan, then golden-section search. */
-  private bestTwist(axis: Vec3, g: Quat, cost: (q: Quat) => number): Quat {
+  /** Per joint, the twist the last solved frame chose: frames come in order, so the next one starts near it. */
+  private readonly lastTwist = new Map<number, number>();
+
+  /**
+   * g turned about `axis` by the angle of least cost: a coarse scan of the whole turn (or, after a first frame, of the
+   * last frame's twist and its neighbours: twists change little from frame to frame), then golden-section search.
+   */
+  private bestTwist(joint: number, axis: Vec3, g: Quat, cost: (q: Quat) => number): Quat {
     const twisted = (theta: number) => quatMultiply(quatAboutUnitAxis(axis, theta), g);
     const at = (theta: number) => cost(twisted(theta));
     let best = 0, bestCost = at(0);
-    for (let theta = -Math.PI + TWIST_SCAN; theta < Math.PI; theta += TWIST_SCAN) {
+    const last = this.lastTwist.get(joint);
+    const candidates: number[] = [];
+    if (last === undefined) for (let theta = -Math.PI + TWIST_SCAN; theta < Math.PI; theta += TWIST_SCAN) candidates.push(theta);
+    else candidates.push(last, last - TWIST_SCAN, last + TWIST_SCAN);
+    for (const theta of candidates) {
       const c = at(theta);
       if (c < bestCost) [best, bestCost] = [theta, c];
     }
@@ -140,7 +150,9 @@ export class CanonicalIK {
         lo = a; a = b; ca = cb; b = lo + phi * (hi - lo); cb = at(b);
       }
     }
-    return twisted(ca < cb ? a : b);
+    const theta = ca < cb ? a : b;
+    this.lastTwist.set(joint, theta);
+    return twisted(theta);
   }
 
   /** The joint-angle part of a feature row (tilt, joint rotation vectors) of one frame's world rotations. */

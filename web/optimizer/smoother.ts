@@ -13,7 +13,7 @@
 import type { RootStart } from '../model/featureDecode';
 import { JOINT_FEATURES_START } from '../model/generatorInfo';
 import type { GeneratorInfo } from '../model/generatorInfo';
-import { setStateRow } from '../model/lstmState';
+import { setStateRow, stateRow } from '../model/lstmState';
 import { cholesky, choleskySolve, inverseSPD, matmul, transpose } from './linalg';
 import type { StepFn } from './rollout';
 
@@ -24,6 +24,8 @@ const DYNAMICS_STEP = 1e-2;
 const OBSERVATION_STEP = 1e-3;
 /** Gauss–Newton iterations of each frame's update. */
 const UPDATE_ITERATIONS = 2;
+/** Frames between two evaluations of the generator's Jacobian (each costs one call of batch D − 1). */
+const JACOBIAN_EVERY = 2;
 /** Prior spread (normalised) of the first frame around its observed encoding. */
 const FIRST_FRAME_SIGMA = 0.5;
 
@@ -61,7 +63,7 @@ export async function smoothFeatures(a: SmootherInput): Promise<SmootherResult> 
   const K = info.skeleton.joints.length;
   const m = K * 3;
   const frames = points.length / m;
-  const B = n + 1; // the prediction and one perturbed input per state dimension
+  const wide = n + 1; // the prediction and one perturbed input per state dimension
 
   const normalise = (phys: ArrayLike<number>, out = new Float64Array(D)) => {
     for (let d = 0; d < D; d++) out[d] = (phys[d] - mean[d]) / std[d];
@@ -84,12 +86,9 @@ export async function smoothFeatures(a: SmootherInput): Promise<SmootherResult> 
     if (d2 < nearest) [nearest, seedIndex] = [d2, i];
   });
   const seed = info.seeds[seedIndex];
-  let h: Float32Array = new Float32Array(L * B * H);
-  let c: Float32Array = new Float32Array(L * B * H);
-  for (let b = 0; b < B; b++) {
-    setStateRow(h, L, B, H, b, seed.h);
-    setStateRow(c, L, B, H, b, seed.c);
-  }
+  // The stream's LSTM state (layers × hidden), repeated over a call's batch.
+  let hRow: Float32Array = Float32Array.from(seed.h);
+  let cRow: Float32Array = Float32Array.from(seed.c);
 
   const R = new Float64Array(m);
   for (let k = 0; k < K; k++) for (let i = 0; i < 3; i++) R[k * 3 + i] = Math.max(1e-6, sigma[k] ** 2);
@@ -171,10 +170,19 @@ export async function smoothFeatures(a: SmootherInput): Promise<SmootherResult> 
   contactRows.push(first.slice(n));
   roots.push(root0);
 
-  const input = new Float32Array(B * D);
+  let Fk = new Float64Array(n * n);
   for (let f = 1; f < frames; f++) {
     const prev = xf[f - 1];
     const bits = contactRows[f - 1];
+    // The dynamics' Jacobian every JACOBIAN_EVERY frames (it changes slowly); between, the last one.
+    const withJacobian = (f - 1) % JACOBIAN_EVERY === 0;
+    const B = withJacobian ? wide : 1;
+    const input = new Float32Array(B * D);
+    const h = new Float32Array(L * B * H), c = new Float32Array(L * B * H);
+    for (let b = 0; b < B; b++) {
+      setStateRow(h, L, B, H, b, hRow);
+      setStateRow(c, L, B, H, b, cRow);
+    }
     for (let b = 0; b < B; b++) {
       for (let d = 0; d < n; d++) input[b * D + d] = prev[d] + (b > 0 && b - 1 === d ? DYNAMICS_STEP : 0);
       input[b * D + n] = bits[0];
@@ -195,9 +203,11 @@ export async function smoothFeatures(a: SmootherInput): Promise<SmootherResult> 
       if (score > bestScore) [bestScore, best] = [score, k];
     }
     const mu = Float64Array.from(out.mu.subarray(best * D, best * D + n));
-    const Fk = new Float64Array(n * n);
-    for (let d = 0; d < n; d++) {
-      for (let e = 0; e < n; e++) Fk[e * n + d] = (out.mu[((d + 1) * M + best) * D + e] - out.mu[best * D + e]) / DYNAMICS_STEP;
+    if (withJacobian) {
+      Fk = new Float64Array(n * n);
+      for (let d = 0; d < n; d++) {
+        for (let e = 0; e < n; e++) Fk[e * n + d] = (out.mu[((d + 1) * M + best) * D + e] - out.mu[best * D + e]) / DYNAMICS_STEP;
+      }
     }
     // P⁻ = F P Fᵀ + diag(σ²).
     const P = matmul(matmul(Fk, Pf[f - 1], n, n, n), transpose(Fk, n, n), n, n, n);
@@ -211,17 +221,9 @@ export async function smoothFeatures(a: SmootherInput): Promise<SmootherResult> 
     }
     contactRows.push(contact);
     roots.push(root);
-    // The next call continues from the prediction's row (the unperturbed input).
-    const hNext = new Float32Array(L * B * H), cNext = new Float32Array(L * B * H);
-    for (let l = 0; l < L; l++) {
-      const src = out.h_out.subarray(l * B * H, l * B * H + H), srcC = out.c_out.subarray(l * B * H, l * B * H + H);
-      for (let b = 0; b < B; b++) {
-        hNext.set(src, (l * B + b) * H);
-        cNext.set(srcC, (l * B + b) * H);
-      }
-    }
-    h = hNext;
-    c = cNext;
+    // The next call continues from the unperturbed row's state.
+    hRow = stateRow(out.h_out, L, B, H, 0);
+    cRow = stateRow(out.c_out, L, B, H, 0);
   }
 
   // Backward pass (Rauch–Tung–Striebel): x_t|T = x_t|t + P_t|t Fᵀ_{t+1} P⁻¹_{t+1|t} (x_{t+1|T} − x_{t+1|t}).

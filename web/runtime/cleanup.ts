@@ -198,16 +198,18 @@ export async function cleanUpOnCanonical(
   const mapping = mapSkeleton(motion, legLength(info));
   const K = CANONICAL_JOINTS.length;
   const fps = info.fps;
-  // Before: the imported motion's canonical points and segment rotations, at its own fps and at the model's.
+  // Before: the imported motion's canonical points at its own fps and at the model's, and their segment rotations
+  // (the IK runs at the model's fps; rotations at the motion's own are interpolated).
   const beforePoints = toCanonical(motion, mapping);
-  const beforeRotations = canonicalRotations(info, beforePoints);
   const frames = resampledFrames(motion.frames, motion.fps, fps);
   const points = resampleLinear(beforePoints, K * 3, motion.fps, fps, frames);
   // The models stand on y = 0; imported clips need not (CMU AMC floors sit a few centimetres off).
   const floor = floorHeight(points);
   for (let i = 1; i < points.length; i += 3) points[i] -= floor;
   const jitter = medianJitter(beforePoints);
-  const cleaned = await clean({ points, rotations: canonicalRotations(info, points), fps, jitter });
+  const rotations = canonicalRotations(info, points);
+  const beforeRotations = resampleQuaternions(rotations, K, fps, motion.fps, motion.frames);
+  const cleaned = await clean({ points, rotations, fps, jitter });
   const { skeleton } = info;
   // Contacts labelled on the cleaned motion (the model's bits with the feet's heights and speeds), planted feet pinned.
   const contacts30 = labelContacts(cleaned.positions, cleaned.bits, skeleton.joints, fps);
