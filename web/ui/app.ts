@@ -14,6 +14,7 @@ import { baseName, type FileImportOutcome } from '../runtime/motionFiles';
 import { ImportIndicator } from './files';
 import { $, downloadText, errorMessage } from './dom';
 import { BusyIndicator, ModelHost, pageThreads } from './modelHost';
+import { CleanupPanel } from './cleanupPanel';
 import { DanceMode } from './modes/danceMode';
 import type { ModeHost } from './modes/host';
 import type { LiveChunk, LiveMode } from './modes/liveMode';
@@ -51,6 +52,8 @@ export class App implements ModeHost {
   readonly danceMode: DanceMode;
   readonly pathMode: PathMode;
   readonly steerMode: SteerMode;
+  /** Clip mode's Clean up panel. */
+  readonly cleanup: CleanupPanel;
   private mode: Mode = 'clip';
   /** The clip shown before another mode (Random walk, Dance, Path, Steer), restored when switching back. */
   private clip: { motion: Motion; name: string } | null = null;
@@ -59,7 +62,10 @@ export class App implements ModeHost {
     this.viewer = new Viewer($('stage'));
     this.panel = new Panel(this.viewer);
     this.toasts = new Toasts($('toasts'));
-    this.viewer.onFrame = (s) => this.panel.update(s);
+    this.viewer.onFrame = (s) => {
+      this.panel.update(s);
+      if (this.mode === 'clip') this.cleanup?.frame(s);
+    };
 
     const input = $<HTMLInputElement>('file-input');
     for (const id of ['open-btn', 'empty-open']) $(id).addEventListener('click', () => input.click());
@@ -75,6 +81,7 @@ export class App implements ModeHost {
     this.danceMode = new DanceMode(this);
     this.pathMode = new PathMode(this);
     this.steerMode = new SteerMode(this);
+    this.cleanup = new CleanupPanel(this);
     for (const m of MODES) {
       $(`mode-${m}`).addEventListener('click', () => this.setMode(m));
       const live = this.liveMode(m);
@@ -110,8 +117,9 @@ export class App implements ModeHost {
     const previous = this.mode;
     this.mode = mode;
     for (const m of MODES) $(`mode-${m}`).setAttribute('aria-pressed', String(mode === m));
-    for (const m of MODES) if (m !== 'clip') document.body.classList.toggle(`${m}-mode`, mode === m);
+    for (const m of MODES) document.body.classList.toggle(`${m}-mode`, mode === m);
     this.liveMode(previous)?.stop();
+    if (previous === 'clip') this.cleanup.leave();
     if (previous === 'path') this.pathMode.leave();
     if (mode === 'clip') {
       this.exportBtn.title = 'Download the shown motion as BVH';
@@ -197,6 +205,7 @@ export class App implements ModeHost {
       this.setMode('clip');
     }
     this.showInMode(motion, name);
+    this.cleanup.clipShown(motion, name);
   }
 
   /** Shows a motion like `show` but stays in the current mode (Path mode's results); `name` names exports. */

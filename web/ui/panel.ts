@@ -63,9 +63,9 @@ export class Panel {
   private onKey(e: KeyboardEvent): void {
     if (e.defaultPrevented || e.altKey || e.ctrlKey || e.metaKey) return;
     const t = e.target as HTMLElement | null;
-    if (t && (t.tagName === 'TEXTAREA' || (t.tagName === 'INPUT' && (t as HTMLInputElement).type !== 'range'))) return;
-    // Arrow keys on the focused speed slider adjust the speed, as a slider should.
-    if (t === this.speed && e.key.startsWith('Arrow')) return;
+    if (t && (t.tagName === 'TEXTAREA' || t.tagName === 'SELECT' || (t.tagName === 'INPUT' && (t as HTMLInputElement).type !== 'range'))) return;
+    // Arrow keys on a focused slider (speed, the modes' and the Clean up panel's settings) move it, as a slider's should.
+    if (t instanceof HTMLInputElement && t.type === 'range' && t !== this.timeline && e.key.startsWith('Arrow')) return;
     const v = this.viewer;
     switch (e.key) {
       case ' ':
