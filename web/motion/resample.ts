@@ -51,3 +51,28 @@ export function resampleNearest(values: Uint8Array, width: number, from: number,
   }
   return out;
 }
+
+/**
+ * Values (frames × width) at `from` fps brought down to `count` frames at `to` fps (to < from), each value the median
+ * of the input frames within half an output frame of its time (per value): jitter is averaged over the frames that
+ * would be dropped, and a glitch in one of them is ignored. Returns the values and how many frames a median covers.
+ */
+export function resampleMedian(values: ArrayLike<number>, width: number, from: number, to: number, count: number): { values: Float32Array; window: number } {
+  if (to >= from) return { values: resampleLinear(values, width, from, to, count), window: 1 };
+  const frames = values.length / width;
+  const ratio = from / to;
+  const radius = Math.floor(ratio / 2);
+  const out = new Float32Array(count * width);
+  const window = new Float64Array(2 * radius + 1);
+  for (let f = 0; f < count; f++) {
+    const centre = Math.min(Math.round(f * ratio), frames - 1);
+    const lo = Math.max(0, centre - radius), hi = Math.min(frames - 1, centre + radius);
+    for (let i = 0; i < width; i++) {
+      const w = window.subarray(0, hi - lo + 1);
+      for (let g = lo; g <= hi; g++) w[g - lo] = values[g * width + i];
+      w.sort();
+      out[f * width + i] = w[Math.floor(w.length / 2)];
+    }
+  }
+  return { values: out, window: 2 * radius + 1 };
+}

@@ -15,7 +15,7 @@ import { detectContacts } from '../motion/contacts';
 import { labelContacts } from '../motion/contactLabels';
 import { pinFeet } from '../motion/footPin';
 import { butterworthLowpass, filtfilt, lowpassMotion } from '../motion/lowpass';
-import { resampledFrames, resampleLinear, resampleNearest, resampleQuaternions } from '../motion/resample';
+import { resampleMedian, resampledFrames, resampleLinear, resampleNearest, resampleQuaternions } from '../motion/resample';
 import { CANONICAL_JOINTS, fromCanonical, mapSkeleton, medianBoneLengths, toCanonical } from '../motion/skeletonMap';
 import type { Motion } from '../motion/types';
 import { describeValue } from '../motion/describe';
@@ -132,7 +132,7 @@ export interface CanonicalInput {
   points: Float32Array;
   rotations: Float32Array;
   fps: number;
-  /** The jitter of the points (m), measured at the motion's own frame rate (jitterSigma, median over the points). */
+  /** The jitter of these points (m): measured at the motion's own frame rate (jitterSigma, median over the points), less the averaging down to the model's rate. */
   jitter: number;
 }
 export interface CanonicalCleaned {
@@ -202,14 +202,16 @@ export async function cleanUpOnCanonical(
   // (the IK runs at the model's fps; rotations at the motion's own are interpolated).
   const beforePoints = toCanonical(motion, mapping);
   const frames = resampledFrames(motion.frames, motion.fps, fps);
-  const points = resampleLinear(beforePoints, K * 3, motion.fps, fps, frames);
+  // Down to the model's rate with the dropped frames' median (a 120 fps capture gives 30 fps frames of about half the
+  // jitter, and a one-frame glitch is gone); a median of w values has the jitter of a mean of 2w/π.
+  const { values: points, window } = resampleMedian(beforePoints, K * 3, motion.fps, fps, frames);
   // The models stand on y = 0; imported clips need not (CMU AMC floors sit a few centimetres off).
   const floor = floorHeight(points);
   for (let i = 1; i < points.length; i += 3) points[i] -= floor;
   const jitter = medianJitter(beforePoints);
   const rotations = canonicalRotations(info, points);
   const beforeRotations = resampleQuaternions(rotations, K, fps, motion.fps, motion.frames);
-  const cleaned = await clean({ points, rotations, fps, jitter });
+  const cleaned = await clean({ points, rotations, fps, jitter: jitter / Math.sqrt((2 * window) / Math.PI) });
   const { skeleton } = info;
   // Contacts labelled on the cleaned motion (the model's bits with the feet's heights and speeds), planted feet pinned.
   const contacts30 = labelContacts(cleaned.positions, cleaned.bits, skeleton.joints, fps);
