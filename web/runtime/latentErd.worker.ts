@@ -3,7 +3,8 @@
 // common requests are shared with the other model workers: ortWorker.ts). Two sessions: the ERD step
 // (latent-erd.onnx, loaded by init) and the autoencoder's decoder (manifold-decoder.onnx, named by the
 // manifold.json that latent-erd.json names; loaded while the model is checked); and the autoencoder's encoder
-// (manifold-encoder.onnx), loaded by the first manifoldProject request (latentErdRequests.ts).
+// (manifold-encoder.onnx), loaded by the first manifold projection: the `manifoldProject` request (latentErdRequests.ts)
+// or the `denoise` request of the manifold clean-up (cleanupRequests.ts).
 import { loadGeneratorInfo, type GeneratorInfo } from '../model/generatorInfo';
 import { loadLatentErdModel } from '../model/latentErdInfo';
 import { manifoldCleaner } from './cleanup';
