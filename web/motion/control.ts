@@ -7,6 +7,8 @@
 // (python -m training.fixtures.control_signal) checks the two against each other: every function here
 // does the float64 arithmetic in the same order as its Python twin.
 
+import { Rng } from './random';
+
 /** One frame's signal: [forward m/s, sideways m/s, turn rad/s]. */
 export type Control = [number, number, number];
 /** A walker's ground root: position (m) and heading (rad). */
@@ -172,22 +174,6 @@ export function controlAlongPath(path: PolylinePath, x: number, z: number, headi
   return { control: controlTowardHeading(heading, want, fwd), progress: s };
 }
 
-/** mulberry32's uniform in [0, 1), bit for bit as web/model/sampler.ts Rng and training/control.py Rng (web/motion may not import web/model). */
-class Mulberry32 {
-  private state: number;
-
-  constructor(seed: number) {
-    this.state = seed >>> 0;
-  }
-
-  uniform(): number {
-    this.state = (this.state + 0x6d2b79f5) | 0;
-    let t = Math.imul(this.state ^ (this.state >>> 15), 1 | this.state);
-    t = (t + Math.imul(t ^ (t >>> 7), 61 | t)) ^ t;
-    return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
-  }
-}
-
 /** Python's round(): to the nearest integer, halves to the even one. */
 function roundHalfEven(v: number): number {
   const r = Math.round(v);
@@ -196,7 +182,7 @@ function roundHalfEven(v: number): number {
 
 /** A smooth random [forward, 0, turn] signal (frames × 3) drawn from `seed`. */
 export function randomControl(seed: number, frames: number, fps: number): Float64Array {
-  const rng = new Mulberry32(seed);
+  const rng = new Rng(seed);
   const segment = Math.max(1, roundHalfEven(RANDOM_SEGMENT * fps));
   const ease = 1 - Math.exp(-1 / (RANDOM_EASE * fps));
   let fwd = 1, turn = 0;

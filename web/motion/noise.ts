@@ -2,6 +2,7 @@
 // outlier poses (marker swaps, glitches) and feet that slide while planted (inertial-suit drift). Seeded,
 // so the same options always give the same noise.
 import { findFootJoints } from './contacts';
+import { Rng } from './random';
 import { quoteInput } from './text';
 import type { Motion } from './types';
 
@@ -61,39 +62,6 @@ export function checkNoiseOptions(options: unknown): Required<NoiseOptions> {
   return result;
 }
 
-/**
- * mulberry32 with a Box–Muller normal. control.ts has the same uniform but does not export it, and
- * web/motion may not import web/model's sampler, so it is written again here (noise need not match
- * any other stream bit for bit).
- */
-class Rng {
-  private state: number;
-  private spare: number | undefined;
-
-  constructor(seed: number) {
-    this.state = seed >>> 0;
-  }
-
-  uniform(): number {
-    this.state = (this.state + 0x6d2b79f5) | 0;
-    let t = Math.imul(this.state ^ (this.state >>> 15), 1 | this.state);
-    t = (t + Math.imul(t ^ (t >>> 7), 61 | t)) ^ t;
-    return ((t ^ (t >>> 14)) >>> 0) / 4294967296;
-  }
-
-  /** A standard normal; Box–Muller makes two at a time, so the second is kept for the next call. */
-  normal(): number {
-    if (this.spare !== undefined) {
-      const v = this.spare;
-      this.spare = undefined;
-      return v;
-    }
-    const r = Math.sqrt(-2 * Math.log(1 - this.uniform())); // 1 − u is in (0, 1], so the log is finite
-    const a = 2 * Math.PI * this.uniform();
-    this.spare = r * Math.sin(a);
-    return r * Math.cos(a);
-  }
-}
 
 /** One stream per kind of noise, so that e.g. turning jitter on does not move which frames are outliers. */
 const stream = (seed: number, kind: number) => new Rng((seed ^ Math.imul(kind, 0x9e3779b9)) >>> 0);
