@@ -10,11 +10,15 @@
 // a joint whose innovation is beyond OUTLIER_Z is discounted (Huber), so glitches do not drag the pose. Backward, a
 // Rauch–Tung–Striebel pass lets every frame use the frames after it, so the result is the smoothed MAP of the whole
 // motion, not a filter that lags. Contacts come from the chosen components (the input is unlabelled).
+//
+// Beyond the paper, the prior is the generator's prediction times a constant-velocity guess (a product of the two
+// Gaussians): on held-out capture the generator alone predicts the next frame several centimetres off, and used alone
+// it left the motion as jerky as its observations (docs/models/cleanup.md).
 import type { RootStart } from '../model/featureDecode';
 import { JOINT_FEATURES_START } from '../model/generatorInfo';
 import type { GeneratorInfo } from '../model/generatorInfo';
 import { setStateRow, stateRow } from '../model/lstmState';
-import { cholesky, choleskySolve, inverseSPD, matmul, transpose } from './linalg';
+import { cholesky, choleskySolve, inverseSPD, matmul, sandwich, transpose } from './linalg';
 import type { StepFn } from './rollout';
 
 /** Innovation (in its predicted σ) beyond which a joint's observation is discounted. */
@@ -24,8 +28,10 @@ const DYNAMICS_STEP = 1e-2;
 const OBSERVATION_STEP = 1e-3;
 /** Gauss–Newton iterations of each frame's update. */
 const UPDATE_ITERATIONS = 2;
+/** σ (normalised feature units) of the constant-velocity guess's own error, beside the uncertainty it inherits. */
+const CONSTANT_VELOCITY_SIGMA = 0.05;
 /** Frames between two evaluations of the generator's Jacobian (each costs one call of batch D − 1). */
-const JACOBIAN_EVERY = 2;
+const JACOBIAN_EVERY = 3;
 /** Prior spread (normalised) of the first frame around its observed encoding. */
 const FIRST_FRAME_SIGMA = 0.5;
 
@@ -100,8 +106,7 @@ export async function smoothFeatures(a: SmootherInput): Promise<SmootherResult> 
   let discounted = 0, observations = 0;
 
   /** Gauss–Newton MAP of N(prior, P) × the frame's observation; returns the mean and covariance. */
-  const update = (prior: Float64Array, P: Float64Array, f: number, root: RootStart): { x: Float64Array; cov: Float64Array } => {
-    const Pinv = inverseSPD(P, n);
+  const update = (prior: Float64Array, P: Float64Array, f: number, root: RootStart, Pinv = inverseSPD(P, n)): { x: Float64Array; cov: Float64Array } => {
     let x: Float64Array = Float64Array.from(prior);
     let cov: Float64Array = P;
     const obs = points.subarray(f * m, (f + 1) * m);
@@ -210,10 +215,39 @@ export async function smoothFeatures(a: SmootherInput): Promise<SmootherResult> 
       }
     }
     // P⁻ = F P Fᵀ + diag(σ²).
-    const P = matmul(matmul(Fk, Pf[f - 1], n, n, n), transpose(Fk, n, n), n, n, n);
+    let P: Float64Array = sandwich(Fk, Pf[f - 1], n);
     for (let d = 0; d < n; d++) P[d * n + d] += out.sigma[best * D + d] ** 2;
-    const u = update(mu, P, f, root);
-    xf.push(u.x); Pf.push(u.cov); xp.push(mu); Pp.push(P); F.push(Fk);
+    let prior: Float64Array = mu;
+    let Feff: Float64Array = Fk;
+    if (f >= 2) {
+      // The generator's prediction times a constant-velocity guess N(2 x_{t-1} − x_{t-2}, 4 P_{t-1} + P_{t-2} + c² I):
+      // held-out capture's next frame is 3–6 times closer to the guess than to the generator's mean (cleanup.md).
+      const cv = Float64Array.from(xf[f - 1], (v, d) => 2 * v - xf[f - 2][d]);
+      const Pc = new Float64Array(n * n);
+      for (let i = 0; i < n * n; i++) Pc[i] = 4 * Pf[f - 1][i] + Pf[f - 2][i];
+      for (let d = 0; d < n; d++) Pc[d * n + d] += CONSTANT_VELOCITY_SIGMA ** 2;
+      // The product of N(μ, P) and N(cv, Pc): K = P (P + Pc)⁻¹, mean μ + K (cv − μ), covariance P − K P; its dependence
+      // on x_{t-1} is (I − K) F + 2 K (the x_{t-2} term is left out of the backward pass).
+      const S = new Float64Array(n * n);
+      for (let i = 0; i < n * n; i++) S[i] = P[i] + Pc[i];
+      const K = transpose(choleskySolve(cholesky(S, n), P, n, n), n, n);
+      prior = Float64Array.from(mu, (v, d) => {
+        let s2 = v;
+        for (let e = 0; e < n; e++) s2 += K[d * n + e] * (cv[e] - mu[e]);
+        return s2;
+      });
+      const KP = matmul(K, P, n, n, n);
+      const Pcomb = new Float64Array(n * n);
+      for (let i = 0; i < n; i++) for (let j = 0; j < n; j++) Pcomb[i * n + j] = P[i * n + j] - (KP[i * n + j] + KP[j * n + i]) / 2;
+      const IK = new Float64Array(n * n);
+      for (let i = 0; i < n * n; i++) IK[i] = -K[i];
+      for (let d = 0; d < n; d++) IK[d * n + d] += 1;
+      Feff = matmul(IK, Fk, n, n, n);
+      for (let i = 0; i < n * n; i++) Feff[i] += 2 * K[i];
+      P = Pcomb;
+    }
+    const u = update(prior, P, f, root);
+    xf.push(u.x); Pf.push(u.cov); xp.push(prior); Pp.push(P); F.push(Feff);
     const contact = new Float64Array(2);
     for (let i = 0; i < 2; i++) {
       const on = out.mu[best * D + n + i] * std[n + i] + mean[n + i] > 0.5;
