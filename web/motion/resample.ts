@@ -53,11 +53,12 @@ export function resampleNearest(values: Uint8Array, width: number, from: number,
 }
 
 /**
- * Values (frames × width) at `from` fps brought down to `count` frames at `to` fps (to < from), each value the median
- * of the input frames within half an output frame of its time (per value): jitter is averaged over the frames that
- * would be dropped, and a glitch in one of them is ignored. Returns the values and how many frames a median covers.
+ * Values (frames × width) at `from` fps brought down to `count` frames at `to` fps (to < from), each value a robust
+ * mean of the input frames within half an output frame of its time (per value; see below): jitter is averaged over
+ * the frames that would be dropped, and a glitch in one of them is ignored. Returns the values and how many frames a
+ * window covers.
  */
-export function resampleMedian(values: ArrayLike<number>, width: number, from: number, to: number, count: number): { values: Float32Array; window: number } {
+export function resampleRobust(values: ArrayLike<number>, width: number, from: number, to: number, count: number): { values: Float32Array; window: number } {
   if (to >= from) return { values: resampleLinear(values, width, from, to, count), window: 1 };
   const frames = values.length / width;
   const ratio = from / to;
@@ -71,7 +72,12 @@ export function resampleMedian(values: ArrayLike<number>, width: number, from: n
       const w = window.subarray(0, hi - lo + 1);
       for (let g = lo; g <= hi; g++) w[g - lo] = values[g * width + i];
       w.sort();
-      out[f * width + i] = w[Math.floor(w.length / 2)];
+      // The mean of the window without its lowest and highest value (the median of 3 or fewer): a glitch in one frame
+      // is dropped, and the rest are averaged.
+      let sum = 0;
+      const drop = w.length >= 5 ? 1 : 0;
+      for (let g = drop; g < w.length - drop; g++) sum += w[g];
+      out[f * width + i] = w.length >= 5 ? sum / (w.length - 2) : w[Math.floor(w.length / 2)];
     }
   }
   return { values: out, window: 2 * radius + 1 };
