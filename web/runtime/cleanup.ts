@@ -4,9 +4,9 @@
 //     → canonical points by joint names (motion/skeletonMap), at the models' 30 fps (motion/resample)
 //     → a canonical cleaner: `map` (MAP under the generator, optimizer/smoother) or `manifold` (the autoencoder)
 //     → contacts labelled on the cleaned motion and planted feet pinned (motion/footPin)
-//     → back onto the imported skeleton at its own fps: every bone keeps its length and turns with its canonical
-//       segment; joints the canonical skeleton lacks (fingers, extra spine joints) turn with the segment that
-//       carries them (skeletonMap.fromCanonical).
+//     → back onto the imported skeleton at its own fps, one length per bone: a bone that is a whole canonical
+//       segment aims at its cleaned point; joints the canonical skeleton lacks (fingers, extra spine joints) ride
+//       rigidly on the segment that carries them (skeletonMap.fromCanonical).
 // `lowpass`, the baseline, filters the imported joint positions directly and labels contacts by height and speed.
 import { decodeFeatures, integrateRoot, type RootStart } from '../model/featureDecode';
 import { canonicalRotations, encodeFeatures } from '../model/featureEncode';
@@ -29,7 +29,7 @@ export interface CleanupOptions {
   method: CleanupMethod;
   /** map: σ of the root observation (m); default estimated from the motion's own jitter. */
   sigmaRoot?: number;
-  /** map: σ of the joint-angle observations (rad); default estimated likewise. */
+  /** map: σ of the other joints' observations as an angle (rad; a segment's end moves by it × the segment's length); default the measured jitter. */
   sigmaAngle?: number;
   /** lowpass: the Butterworth filter's cut-off (Hz, default 6). */
   cutoffHz?: number;
