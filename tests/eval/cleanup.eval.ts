@@ -5,9 +5,8 @@ import { writeFileSync } from 'node:fs';
 import { it } from 'vitest';
 import { parseAMC } from '../../web/motion/asfamc';
 import { detectContacts } from '../../web/motion/contacts';
-import { lowFootSliding } from '../../web/motion/footSkating';
 import { addNoise } from '../../web/motion/noise';
-import { CANONICAL_JOINTS, CANONICAL_PARENTS, mapSkeleton, toCanonical } from '../../web/motion/skeletonMap';
+import { boneLengthChange, canonicalView, floorHeight, footSliding, jerk, meanJointError } from '../../web/motion/motionStats';
 import type { Motion } from '../../web/motion/types';
 import { parseGeneratorInfo } from '../../web/model/generatorInfo';
 import { parseManifoldInfo } from '../../web/model/latentErdInfo';
@@ -32,20 +31,9 @@ function loadClip(name: string): Motion {
   const frames = Math.min(m.frames, MAX_FRAMES);
   const positions = m.positions.slice(0, frames * m.joints.length * 3);
   // Rest the clip on y = 0 (the lowest foot point's 5th percentile), as the other reports' clips are.
-  const view = canonicalView({ ...m, frames, positions });
-  const lows: number[] = [];
-  const feet = ['LeftFoot', 'LeftToeBase', 'LeftToeBase_end', 'RightFoot', 'RightToeBase', 'RightToeBase_end'].map((n) => view.joints.indexOf(n));
-  for (let f = 0; f < frames; f++) lows.push(Math.min(...feet.map((j) => view.positions[(f * 25 + j) * 3 + 1])));
-  lows.sort((a, b) => a - b);
-  const floor = lows[Math.floor(frames * 0.05)];
+  const floor = floorHeight(canonicalView({ ...m, frames, positions }));
   for (let i = 1; i < positions.length; i += 3) positions[i] -= floor;
   return { ...m, frames, positions };
-}
-
-/** The motion's canonical points at its own size (scale 1), for measures that need the canonical leg names. */
-function canonicalView(m: Motion): Motion {
-  const mapping = { ...mapSkeleton(m, 1), scale: 1 };
-  return { fps: m.fps, frames: m.frames, joints: [...CANONICAL_JOINTS], parents: CANONICAL_PARENTS, positions: toCanonical(m, mapping) };
 }
 
 /** Every `step`-th frame (120 → 30 fps), so speeds and jerk are measured at the rate of the other reports. */
@@ -57,45 +45,6 @@ function decimate(m: Motion, step: number): Motion {
   const contacts = m.contacts ? new Uint8Array(frames * 2) : undefined;
   if (contacts) for (let f = 0; f < frames; f++) contacts.set(m.contacts!.subarray(f * step * 2, f * step * 2 + 2), f * 2);
   return { ...m, fps: m.fps / step, frames, positions, ...(contacts ? { contacts } : {}) };
-}
-
-function positionError(a: Motion, b: Motion): number {
-  let s = 0;
-  for (let i = 0; i < a.positions.length; i += 3) s += Math.hypot(a.positions[i] - b.positions[i], a.positions[i + 1] - b.positions[i + 1], a.positions[i + 2] - b.positions[i + 2]);
-  return s / (a.positions.length / 3);
-}
-
-/** Mean magnitude of the third difference of joint positions × fps³ (m/s³). */
-function jerk(m: Motion): number {
-  const J = m.joints.length;
-  let s = 0, n = 0;
-  for (let f = 3; f < m.frames; f++) {
-    for (let j = 0; j < J; j++) {
-      let q = 0;
-      for (let a = 0; a < 3; a++) {
-        const p = (k: number) => m.positions[((f - k) * J + j) * 3 + a];
-        q += (p(0) - 3 * p(1) + 3 * p(2) - p(3)) ** 2;
-      }
-      s += Math.sqrt(q) * m.fps ** 3;
-      n++;
-    }
-  }
-  return s / n;
-}
-
-/** Mean absolute change of each bone's length from the clean clip's (m). */
-function boneChange(m: Motion, clean: Motion): number {
-  const J = m.joints.length;
-  let s = 0, n = 0;
-  for (let f = 0; f < m.frames; f++) {
-    for (let j = 1; j < J; j++) {
-      const p = m.parents[j];
-      const len = (x: Motion, g: number) => Math.hypot(...[0, 1, 2].map((a) => x.positions[(g * J + j) * 3 + a] - x.positions[(g * J + p) * 3 + a]) as [number, number, number]);
-      s += Math.abs(len(m, f) - len(clean, 0));
-      n++;
-    }
-  }
-  return s / n;
 }
 
 function contactF1(found: Uint8Array, truth: Uint8Array): number {
@@ -135,18 +84,18 @@ it('evaluates the clean-up methods', async () => {
     const clean = loadClip(name);
     const clean30 = decimate(clean, 4);
     const truth = detectContacts(clean30)!;
-    realRows.push({ clip: name, jerk: jerk(clean30), sliding: lowFootSliding(canonicalView(clean30)), seconds: clean.frames / clean.fps });
+    realRows.push({ clip: name, jerk: jerk(clean30), sliding: footSliding(clean, 0), seconds: clean.frames / clean.fps });
     for (const level of LEVELS) {
       const { motion: noisy } = addNoise(clean, { jitter: level, outliers: OUTLIERS, seed: 1 });
       const measure = (method: string, m: Motion, contacts: Uint8Array, ms: number) => {
         const m30 = decimate(m, 4);
         rows.push({
           method, level,
-          error: positionError(m, clean),
+          error: meanJointError(m, clean),
           jerk: jerk(m30),
-          sliding: lowFootSliding(canonicalView(m30)),
+          sliding: footSliding(m, 0), // the clips rest on y = 0: every method's motion is measured over the same floor
           contactF1: contactF1(contacts, truth),
-          boneChange: boneChange(m, clean),
+          boneChange: boneLengthChange(m, clean),
           realTime: ms > 0 ? (clean.frames / clean.fps) / (ms / 1000) : Infinity,
         });
       };
