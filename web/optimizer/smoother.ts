@@ -102,7 +102,6 @@ export async function smoothFeatures(a: SmootherInput): Promise<SmootherResult> 
   // Forward pass: filtered means and covariances, predictions and their covariances, dynamics Jacobians.
   const xf: Float64Array[] = [], Pf: Float64Array[] = [], xp: Float64Array[] = [], Pp: Float64Array[] = [], F: Float64Array[] = [];
   const contactRows: Float64Array[] = [];
-  const roots: RootStart[] = [];
   let discounted = 0, observations = 0;
 
   /** Gauss–Newton MAP of N(prior, P) × the frame's observation; returns the mean and covariance. */
@@ -173,7 +172,6 @@ export async function smoothFeatures(a: SmootherInput): Promise<SmootherResult> 
   const u0 = update(first.slice(0, n), P0, 0, root0);
   xf.push(u0.x); Pf.push(u0.cov); xp.push(u0.x); Pp.push(P0); F.push(new Float64Array(0));
   contactRows.push(first.slice(n));
-  roots.push(root0);
 
   let Fk = new Float64Array(n * n);
   for (let f = 1; f < frames; f++) {
@@ -254,7 +252,6 @@ export async function smoothFeatures(a: SmootherInput): Promise<SmootherResult> 
       contact[i] = ((on ? 1 : 0) - mean[n + i]) / std[n + i];
     }
     contactRows.push(contact);
-    roots.push(root);
     // The next call continues from the unperturbed row's state.
     hRow = stateRow(out.h_out, L, B, H, 0);
     cRow = stateRow(out.c_out, L, B, H, 0);
