@@ -1,7 +1,7 @@
 // Generator feature rows (physical units) → root trajectory, local rotations and joint positions.
 // A port of training/data/features.py FeatureCodec.decode followed by forward kinematics; keep the two in step.
 import { forwardKinematics } from '../motion/skeleton';
-import { quatMultiply, quatNormalize, type Quat } from '../motion/math';
+import { quatMultiply, quatNormalize, quatRotate, type Quat } from '../motion/math';
 import type { Skeleton } from '../motion/types';
 import { JOINT_FEATURES_START, type GeneratorInfo } from './generatorInfo';
 
@@ -96,5 +96,38 @@ export function decodeFeatures(info: GeneratorInfo, features: Float32Array, star
     contacts,
     rootHeading,
     end: root,
+  };
+}
+
+/**
+ * One physical feature row placed from `root` (the state before it) → world positions (joints × 3) on `offsets`:
+ * decodeFeatures for a single frame, into one reused buffer (the clean-up's smoother poses each frame ~140 times).
+ */
+export function framePoser(info: GeneratorInfo, offsets: ArrayLike<number>): (row: ArrayLike<number>, root: RootStart) => Float32Array {
+  const { parents } = info.skeleton;
+  const J = parents.length;
+  const refs = info.features.references.map((q) => quatNormalize(q as Quat));
+  const featureOf = new Array<number>(J).fill(-1);
+  info.features.joints.forEach((j, k) => (featureOf[j] = JOINT_FEATURES_START + 3 * k));
+  const world: Quat[] = new Array(J);
+  const out = new Float32Array(J * 3);
+  return (row, root) => {
+    const r = { ...root };
+    integrateRoot(r, row[0], row[1], row[2]);
+    world[0] = quatMultiply(yawQuat(r.heading), quatMultiply(refs[0], rotvecToQuat(row[4], row[5], row[6])));
+    out[0] = r.x;
+    out[1] = row[3];
+    out[2] = r.z;
+    for (let j = 1; j < J; j++) {
+      const o = featureOf[j];
+      const local = o < 0 ? refs[j] : quatMultiply(refs[j], rotvecToQuat(row[o], row[o + 1], row[o + 2]));
+      const g = (world[j] = quatMultiply(world[parents[j]], local));
+      const v = quatRotate(g, [offsets[j * 3], offsets[j * 3 + 1], offsets[j * 3 + 2]]);
+      const p = parents[j] * 3;
+      out[j * 3] = out[p] + v[0];
+      out[j * 3 + 1] = out[p + 1] + v[1];
+      out[j * 3 + 2] = out[p + 2] + v[2];
+    }
+    return out;
   };
 }

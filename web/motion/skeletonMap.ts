@@ -8,6 +8,7 @@
 //
 // Canonical points that a scheme lacks but that lie between or beyond points it has (the spine and neck
 // segments, toe and hand tips) are placed along them at canonical proportions; the rest are required.
+import { quatRotate, type Quat } from './math';
 import type { Motion } from './types';
 
 /** The canonical skeleton's points, in its order (parents: CANONICAL_PARENTS). */
@@ -227,23 +228,6 @@ export function medianBoneLengths(motion: Motion, jitter = 0): Float64Array {
   return out;
 }
 
-type Q = [number, number, number, number];
-
-function qmul(a: Q, b: Q): Q {
-  return [
-    a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1],
-    a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0],
-    a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3],
-    a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2],
-  ];
-}
-
-function qrot(q: Q, v: [number, number, number]): [number, number, number] {
-  const [x, y, z, w] = q;
-  const tx = 2 * (y * v[2] - z * v[1]), ty = 2 * (z * v[0] - x * v[2]), tz = 2 * (x * v[1] - y * v[0]);
-  return [v[0] + w * tx + (y * tz - z * ty), v[1] + w * ty + (z * tx - x * tz), v[2] + w * tz + (x * ty - y * tx)];
-}
-
 /**
  * Which canonical segment carries each imported bone (parent → joint), and whether the bone is a whole canonical
  * segment (both ends mapped, parent to child), whose cleaned direction it then takes exactly.
@@ -329,7 +313,7 @@ export function fromCanonical(
       for (let f = 0; f < motion.frames; f++) {
         const o = (f * J + j) * 3, q = (f * J + parent) * 3, r = (f * K + owner[j]) * 4;
         const g = before.rotations;
-        const local = qrot([-g[r], -g[r + 1], -g[r + 2], g[r + 3]], [p[o] - p[q], p[o + 1] - p[q + 1], p[o + 2] - p[q + 2]]);
+        const local = quatRotate([-g[r], -g[r + 1], -g[r + 2], g[r + 3]], [p[o] - p[q], p[o + 1] - p[q + 1], p[o + 2] - p[q + 2]]);
         for (let a = 0; a < 3; a++) values[a][f] = local[a];
       }
       attached[j] = values.map((v) => Float64Array.from(v).sort()[Math.floor(motion.frames / 2)]) as [number, number, number];
@@ -344,13 +328,13 @@ export function fromCanonical(
   const placed = new Float64Array(J * 3);
   const ROUNDS = 8;
   for (let f = 0; f < motion.frames; f++) {
-    const rot = (src: Float32Array, k: number): Q => {
+    const rot = (src: Float32Array, k: number): Quat => {
       const o = (f * K + k) * 4;
       return [src[o], src[o + 1], src[o + 2], src[o + 3]];
     };
     const pt = (src: Float32Array, k: number, a: number) => src[(f * K + k) * 3 + a];
     const attach = (j: number, from: Float64Array, to: Float64Array) => {
-      const moved = qrot(rot(after.rotations, owner[j]), attached[j]);
+      const moved = quatRotate(rot(after.rotations, owner[j]), attached[j]);
       for (let a = 0; a < 3; a++) to[j * 3 + a] = from[motion.parents[j] * 3 + a] + moved[a];
     };
     for (let j = 0; j < J; j++) {

@@ -14,8 +14,7 @@
 // Beyond the paper, the prior is the generator's prediction times a constant-velocity guess (a product of the two
 // Gaussians): on held-out capture the generator alone predicts the next frame several centimetres off, and used alone
 // it left the motion as jerky as its observations (docs/models/cleanup.md).
-import type { RootStart } from '../model/featureDecode';
-import { JOINT_FEATURES_START } from '../model/generatorInfo';
+import { framePoser, type RootStart } from '../model/featureDecode';
 import type { GeneratorInfo } from '../model/generatorInfo';
 import { setStateRow, stateRow } from '../model/lstmState';
 import { cholesky, choleskySolve, inverseSPD, matmul, sandwich, transpose } from './linalg';
@@ -283,54 +282,3 @@ export async function smoothFeatures(a: SmootherInput): Promise<SmootherResult> 
   return { features, seedIndex, outlierShare: observations ? discounted / observations : 0 };
 }
 
-type Q = [number, number, number, number];
-const qmul = (a: Q, b: Q): Q => [
-  a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1],
-  a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0],
-  a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3],
-  a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2],
-];
-const expRotvec = (x: number, y: number, z: number): Q => {
-  const angle = Math.sqrt(x * x + y * y + z * z);
-  const s = angle > 1e-9 ? Math.sin(angle / 2) / angle : 0.5;
-  return [x * s, y * s, z * s, Math.cos(angle / 2)];
-};
-
-/**
- * One physical feature row placed from `root` (the state before it) → world positions (joints × 3): decodeFeatures
- * for a single frame, without its allocations (the smoother poses each frame about 140 times).
- */
-export function framePoser(info: GeneratorInfo, offsets: ArrayLike<number>) {
-  const { parents } = info.skeleton;
-  const J = parents.length;
-  const refs = info.features.references.map((q) => {
-    const n = Math.hypot(q[0], q[1], q[2], q[3]);
-    return [q[0] / n, q[1] / n, q[2] / n, q[3] / n] as Q;
-  });
-  const featureOf = new Array<number>(J).fill(-1);
-  info.features.joints.forEach((j, k) => (featureOf[j] = JOINT_FEATURES_START + 3 * k));
-  const world: Q[] = new Array(J);
-  const out = new Float32Array(J * 3);
-  return (row: ArrayLike<number>, root: RootStart): Float32Array => {
-    const c = Math.cos(root.heading), s = Math.sin(root.heading);
-    const x = root.x + c * row[0] + s * row[1], z = root.z - s * row[0] + c * row[1], heading = root.heading + row[2];
-    const yaw: Q = [0, Math.sin(heading / 2), 0, Math.cos(heading / 2)];
-    world[0] = qmul(yaw, qmul(refs[0], expRotvec(row[4], row[5], row[6])));
-    out[0] = x;
-    out[1] = row[3];
-    out[2] = z;
-    for (let j = 1; j < J; j++) {
-      const o = featureOf[j];
-      const local = o < 0 ? refs[j] : qmul(refs[j], expRotvec(row[o], row[o + 1], row[o + 2]));
-      const g = (world[j] = qmul(world[parents[j]], local));
-      // g · offset (rotate the vector by the unit quaternion)
-      const vx = offsets[j * 3], vy = offsets[j * 3 + 1], vz = offsets[j * 3 + 2];
-      const tx = 2 * (g[1] * vz - g[2] * vy), ty = 2 * (g[2] * vx - g[0] * vz), tz = 2 * (g[0] * vy - g[1] * vx);
-      const p = parents[j] * 3;
-      out[j * 3] = out[p] + vx + g[3] * tx + (g[1] * tz - g[2] * ty);
-      out[j * 3 + 1] = out[p + 1] + vy + g[3] * ty + (g[2] * tx - g[0] * tz);
-      out[j * 3 + 2] = out[p + 2] + vz + g[3] * tz + (g[0] * ty - g[1] * tx);
-    }
-    return out;
-  };
-}
