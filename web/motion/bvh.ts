@@ -17,10 +17,12 @@
 //
 // Export (exportBVH): centimetres, y up, "Frame Time" = 1/fps; every joint has channels
 // "Zrotation Yrotation Xrotation" (the root has "Xposition Yposition Zposition" first), written in
-// degrees with 6 decimals. The rest pose (OFFSETs) uses each bone's mean length and its direction in
-// the clip's tallest frame. Rotations are solved from joint positions as minimal swings relative to
-// the parent; joints with several children get zero-offset helper joints named `<joint>_to_<child>`
-// and leaf joints a zero-offset End Site, both of which the importer drops again. Joint names are
+// degrees with 6 decimals. The rest pose (OFFSETs) uses each bone's mean length and, by default
+// (restPose 'clip'), its direction in the clip's tallest frame; restPose 'tpose' writes a T-pose facing +z
+// instead (restPose.ts), the motion's positions unchanged. Rotations are solved from joint positions as
+// minimal swings relative to the parent (jointRotations.ts); joints with several children get zero-offset
+// helper joints named `<joint>_to_<child>` and leaf joints a zero-offset End Site, both of which the
+// importer drops again. Joint names are
 // written as bvhJointNames says: a name parseBVH can return as it is, any other made readable back
 // (braces, whitespace, control characters replaced; unique). There is no mapping in the file: BVH has no
 // comment syntax, and other readers must be able to open it. So parseBVH(exportBVH(m)) gives back
@@ -29,10 +31,9 @@
 // every importer returns them, and the figure is over about 1.07 m tall (else pass unitScale: 0.01 to
 // parseBVH). The frame rate must be at least 1 fps.
 import { MotionFormatError, type Motion } from './types';
-import {
-  DEG, quatAboutAxis, quatConjugate, quatIdentity, quatMultiply, quatRotate, quatToEulerZYX,
-  rotationFromTwoVectors, swingRotation, cross, length, normalize, type Axis, type Quat, type Vec3,
-} from './math';
+import { DEG, quatAboutAxis, quatConjugate, quatIdentity, quatMultiply, quatRotate, quatToEulerZYX, type Axis, type Quat, type Vec3 } from './math';
+import { jointAt, parentNodeGlobal, rigClip, rotationPairs, solveGlobalRotations, type RigClip } from './jointRotations';
+import { REST_POSES, restOffsets, type RestPose } from './restPose';
 import { MAX_FRAMES, MAX_VALUES, checkText, parseBounded, parseNumber, parseWork, quoteInput, splitLines, tokens } from './text';
 import { MAX_JOINTS, positionOutOfBounds, validateMotion } from './validate';
 
@@ -500,8 +501,6 @@ function poseNodes(nodes: BvhNode[], posed: PosedNode[], values: Float64Array, g
 // Export
 
 const CM_PER_M = 100;
-/** Rest offset (metres) given to bones of zero length so the importer does not drop their joint. */
-const TINY_BONE = 1e-5;
 
 function fmt(v: number): string {
   const s = v.toFixed(6);
@@ -535,26 +534,24 @@ export function bvhJointNames(joints: readonly string[]): string[] {
 
 type ExportNode = { kind: 'joint'; joint: number } | { kind: 'helper'; joint: number; child: number };
 
-/** A validated Motion as the exporter reads it, with each joint's children in index order. */
-interface ExportClip {
-  frames: number;
-  joints: string[];
-  parents: number[];
-  positions: Float32Array;
-  children: number[][];
+export interface BVHExportOptions {
+  /** The rest pose written as the HIERARCHY's OFFSETs (restPose.ts); 'clip' (the default) or 'tpose'. */
+  restPose?: RestPose;
 }
 
-/** Positions-only Motion → BVH text (centimetres, y up, ZYX Euler channels in degrees). */
-export function exportBVH(motion: Motion): string {
+/**
+ * Positions-only Motion → BVH text (centimetres, y up, ZYX Euler channels in degrees). `restPose: 'tpose'`
+ * throws an Error when the skeleton's legs and arms cannot be named (restPose.ts).
+ */
+export function exportBVH(motion: Motion, options: BVHExportOptions = {}): string {
   const m = validateMotion(motion);
+  const restPose = options.restPose ?? 'clip';
+  if (!REST_POSES.includes(restPose)) throw new Error(`BVH export: restPose must be ${REST_POSES.map((p) => `'${p}'`).join(' or ')}, got ${quoteInput(String(restPose))}`);
   if (!(1 / m.fps <= MAX_FRAME_TIME)) {
     throw new Error(`BVH export needs at least ${1 / MAX_FRAME_TIME} fps (a "Frame Time" of at most ${MAX_FRAME_TIME} s, as the importer reads), got ${m.fps}`);
   }
-  const children: number[][] = m.joints.map(() => []);
-  for (let j = 1; j < m.joints.length; j++) children[m.parents[j]].push(j);
-  const clip: ExportClip = { frames: m.frames, joints: m.joints, parents: m.parents, positions: m.positions, children };
-
-  const rest = restBones(clip);
+  const clip = rigClip(m);
+  const rest = restOffsets(clip, restPose);
   const framePair = rotationPairs(clip, rest);
   const out: string[] = ['HIERARCHY'];
   const order = writeHierarchy(clip, bvhJointNames(clip.joints), rest, out);
@@ -569,83 +566,6 @@ export function exportBVH(motion: Motion): string {
   return out.join('\n') + '\n';
 }
 
-function jointAt(clip: ExportClip, f: number, j: number): Vec3 {
-  const P = clip.positions;
-  const b = (f * clip.joints.length + j) * 3;
-  return [P[b], P[b + 1], P[b + 2]];
-}
-
-/** Joint j's position minus its parent's in frame f. */
-function boneVector(clip: ExportClip, f: number, j: number): Vec3 {
-  const a = jointAt(clip, f, clip.parents[j]);
-  const b = jointAt(clip, f, j);
-  return [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-}
-
-/** The frame with the largest y extent (the first of equals). */
-function tallestFrame(clip: ExportClip): number {
-  const P = clip.positions;
-  const J = clip.joints.length;
-  let restFrame = 0;
-  let tallest = -Infinity;
-  for (let f = 0; f < clip.frames; f++) {
-    let lo = Infinity;
-    let hi = -Infinity;
-    for (let j = 0; j < J; j++) {
-      const y = P[(f * J + j) * 3 + 1];
-      lo = Math.min(lo, y);
-      hi = Math.max(hi, y);
-    }
-    if (hi - lo > tallest + 1e-9) {
-      tallest = hi - lo;
-      restFrame = f;
-    }
-  }
-  return restFrame;
-}
-
-/**
- * Rest bone of each joint (metres; zero for the root): direction from the tallest frame (keeps unit
- * detection on re-import reliable even if the clip starts crouched), length averaged over all frames.
- */
-function restBones(clip: ExportClip): Vec3[] {
-  const F = clip.frames;
-  const restFrame = tallestFrame(clip);
-  const rest: Vec3[] = clip.joints.map(() => [0, 0, 0]);
-  for (let j = 1; j < clip.joints.length; j++) {
-    let mean = 0;
-    for (let f = 0; f < F; f++) mean += length(boneVector(clip, f, j));
-    mean /= F;
-    let dir = normalize(boneVector(clip, restFrame, j));
-    for (let f = 0; length(dir) === 0 && f < F; f++) dir = normalize(boneVector(clip, f, j));
-    if (length(dir) === 0) dir = [0, 1, 0];
-    const len = mean > TINY_BONE ? mean : TINY_BONE;
-    rest[j] = [dir[0] * len, dir[1] * len, dir[2] * len];
-  }
-  return rest;
-}
-
-/**
- * For joints with several children, the pair of children whose rest bones are least parallel
- * defines the joint's own rotation; undefined where no pair is far enough from parallel.
- */
-function rotationPairs(clip: ExportClip, rest: Vec3[]): Array<[number, number] | undefined> {
-  return clip.children.map((kids) => {
-    let best: [number, number] | undefined;
-    let bestSin = 1e-3;
-    for (let a = 0; a < kids.length; a++) {
-      for (let b = a + 1; b < kids.length; b++) {
-        const s = length(cross(normalize(rest[kids[a]]), normalize(rest[kids[b]])));
-        if (s > bestSin) {
-          bestSin = s;
-          best = [kids[a], kids[b]];
-        }
-      }
-    }
-    return best;
-  });
-}
-
 /** A piece of the hierarchy still to write: a joint's block (its subtree included), a helper joint's block, or a line. */
 type HierarchyStep = { joint: number; offset: Vec3; indent: string } | { helperOf: number; child: number; indent: string } | string;
 
@@ -653,7 +573,7 @@ type HierarchyStep = { joint: number; offset: Vec3; indent: string } | { helperO
  * Appends the HIERARCHY lines to `out`, depth first, children in index order; returns the BVH nodes in
  * channel order. Walks with a stack of steps, not recursion, so a deep skeleton cannot overflow the call stack.
  */
-function writeHierarchy(clip: ExportClip, names: string[], rest: Vec3[], out: string[]): ExportNode[] {
+function writeHierarchy(clip: RigClip, names: string[], rest: Vec3[], out: string[]): ExportNode[] {
   const { parents, children } = clip;
   const order: ExportNode[] = [];
   const steps: HierarchyStep[] = [{ joint: 0, offset: [0, 0, 0], indent: '' }];
@@ -692,42 +612,8 @@ function writeHierarchy(clip: ExportClip, names: string[], rest: Vec3[], out: st
   return order;
 }
 
-/** Global rotation of the BVH node directly above joint j: identity, j's helper joint, or j's parent. */
-function parentNodeGlobal(clip: ExportClip, j: number, jointGlobal: Quat[], helperGlobal: Quat[]): Quat {
-  const p = clip.parents[j];
-  return p < 0 ? quatIdentity() : clip.children[p].length > 1 ? helperGlobal[j] : jointGlobal[p];
-}
-
-/**
- * Frame f's global rotations, parents first. A joint's rotation aims its child bone(s); it starts from
- * the rotation of the BVH node above it, so local rotations stay small and twist-free.
- */
-function solveGlobalRotations(
-  clip: ExportClip, rest: Vec3[], framePair: Array<[number, number] | undefined>, f: number, jointGlobal: Quat[], helperGlobal: Quat[],
-): void {
-  for (let j = 0; j < clip.joints.length; j++) {
-    const base = parentNodeGlobal(clip, j, jointGlobal, helperGlobal);
-    const kids = clip.children[j];
-    const current = kids.map((c) => boneVector(clip, f, c));
-    let g = base;
-    if (kids.length === 1) {
-      g = quatMultiply(swingRotation(quatRotate(base, rest[kids[0]]), current[0]), base);
-    } else if (kids.length > 1) {
-      const pair = framePair[j];
-      if (pair) {
-        const [a, b] = pair;
-        g = rotationFromTwoVectors(rest[a], rest[b], boneVector(clip, f, a), boneVector(clip, f, b)) ?? base;
-      }
-      kids.forEach((c, k) => {
-        helperGlobal[c] = quatMultiply(swingRotation(quatRotate(g, rest[c]), current[k]), g);
-      });
-    }
-    jointGlobal[j] = g;
-  }
-}
-
 /** Frame f's motion line: root position (cm), then each node's local rotation as Z Y X degrees. */
-function frameLine(clip: ExportClip, f: number, order: ExportNode[], jointGlobal: Quat[], helperGlobal: Quat[]): string {
+function frameLine(clip: RigClip, f: number, order: ExportNode[], jointGlobal: Quat[], helperGlobal: Quat[]): string {
   const line: string[] = [];
   const euler = (q: Quat) => {
     const [z, y, x] = quatToEulerZYX(q);

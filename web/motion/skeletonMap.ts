@@ -23,7 +23,7 @@ export type CanonicalJoint = (typeof CANONICAL_JOINTS)[number];
 export const CANONICAL_PARENTS = [-1, 0, 1, 2, 3, 4, 0, 6, 7, 8, 9, 0, 11, 12, 13, 14, 15, 13, 17, 18, 19, 13, 21, 22, 23];
 
 /** What a person calls each required point, for messages. */
-const DESCRIPTIONS: Partial<Record<CanonicalJoint, string>> = {
+export const DESCRIPTIONS: Partial<Record<CanonicalJoint, string>> = {
   Hips: 'hips', LeftUpLeg: 'left hip', LeftLeg: 'left knee', LeftFoot: 'left ankle', LeftToeBase: 'left toe',
   RightUpLeg: 'right hip', RightLeg: 'right knee', RightFoot: 'right ankle', RightToeBase: 'right toe',
   Neck: 'neck base', Head: 'head', LeftArm: 'left shoulder', LeftForeArm: 'left elbow', LeftHand: 'left wrist',
@@ -137,6 +137,16 @@ function matchScheme(scheme: Scheme, index: Map<string, number>): number[] {
   });
 }
 
+/** Per naming scheme (NAME_SCHEMES order), the joint it places at each canonical point (CANONICAL_JOINTS order; -1: none). */
+export function matchSchemes(joints: readonly string[]): Array<{ scheme: string; source: number[] }> {
+  const index = new Map<string, number>();
+  joints.forEach((name, j) => {
+    const n = normaliseName(name);
+    if (!index.has(n)) index.set(n, j);
+  });
+  return NAME_SCHEMES.map((scheme) => ({ scheme: scheme.name, source: matchScheme(scheme, index) }));
+}
+
 function legLength(motion: Motion, source: number[]): number {
   const at = (f: number, j: number) => motion.positions.subarray((f * motion.joints.length + j) * 3, (f * motion.joints.length + j) * 3 + 3);
   const dist = (f: number, a: number, b: number) => Math.hypot(at(f, a)[0] - at(f, b)[0], at(f, a)[1] - at(f, b)[1], at(f, a)[2] - at(f, b)[2]);
@@ -152,14 +162,8 @@ function legLength(motion: Motion, source: number[]): number {
 
 /** The canonical mapping of `motion`'s skeleton (`canonicalLegLength`: hip → knee → ankle); throws SkeletonMapError naming what is missing. */
 export function mapSkeleton(motion: Pick<Motion, 'joints' | 'positions' | 'frames'>, canonicalLegLength: number): SkeletonMapping {
-  const index = new Map<string, number>();
-  motion.joints.forEach((name, j) => {
-    const n = normaliseName(name);
-    if (!index.has(n)) index.set(n, j);
-  });
-  let best: { scheme: Scheme; source: number[]; missing: CanonicalJoint[]; placed: number } | undefined;
-  for (const scheme of NAME_SCHEMES) {
-    const source = matchScheme(scheme, index);
+  let best: { scheme: string; source: number[]; missing: CanonicalJoint[]; placed: number } | undefined;
+  for (const { scheme, source } of matchSchemes(motion.joints)) {
     const missing = CANONICAL_JOINTS.filter((p, k) => source[k] < 0 && !DERIVED[p]);
     // Spine points are derived from Hips and Neck, so a skeleton needs at least the Neck for them.
     const placed = source.filter((j) => j >= 0).length;
@@ -171,10 +175,10 @@ export function mapSkeleton(motion: Pick<Motion, 'joints' | 'positions' | 'frame
   if (missing.length > 0) {
     const names = missing.map((p) => DESCRIPTIONS[p] ?? p).join(', ');
     throw new SkeletonMapError(
-      `this skeleton cannot be mapped to the canonical one: no joint for the ${names} (closest naming scheme: ${scheme.name}; known schemes: ${NAME_SCHEMES.map((s) => s.name).join(', ')})`,
+      `this skeleton cannot be mapped to the canonical one: no joint for the ${names} (closest naming scheme: ${scheme}; known schemes: ${NAME_SCHEMES.map((s) => s.name).join(', ')})`,
     );
   }
-  const mapping = { scheme: scheme.name, source, scale: 1 };
+  const mapping = { scheme, source, scale: 1 };
   const length = legLength(motion as Motion, source);
   if (!(length > 1e-4)) throw new SkeletonMapError('this skeleton cannot be mapped to the canonical one: its legs have no length');
   mapping.scale = canonicalLegLength / length;
