@@ -1,6 +1,6 @@
-import { readFileSync } from 'node:fs';
+import { readdirSync, readFileSync } from 'node:fs';
 import { fileURLToPath } from 'node:url';
-import { defineConfig } from 'vite';
+import { defineConfig, type Plugin } from 'vite';
 
 const here = fileURLToPath(new URL('.', import.meta.url));
 const pkg = JSON.parse(readFileSync(new URL('./package.json', import.meta.url), 'utf8')) as { version: string };
@@ -12,7 +12,21 @@ const isolationHeaders = {
   'Cross-Origin-Embedder-Policy': 'require-corp',
 };
 
+/** examples/*.html go into the build as they are: they load ../motion-playground.js like any other site would. */
+function examples(): Plugin {
+  return {
+    name: 'motion-playground-examples',
+    apply: 'build',
+    generateBundle() {
+      for (const name of readdirSync(`${here}examples`).filter((f) => f.endsWith('.html'))) {
+        this.emitFile({ type: 'asset', fileName: `examples/${name}`, source: readFileSync(`${here}examples/${name}`, 'utf8') });
+      }
+    },
+  };
+}
+
 export default defineConfig({
+  plugins: [examples()],
   root: `${here}web`,
   publicDir: `${here}public`,
   base: './',
@@ -39,6 +53,15 @@ export default defineConfig({
     emptyOutDir: true,
     target: 'es2022',
     sourcemap: true,
-    chunkSizeWarningLimit: 1024, // three.js alone is ~600 kB minified
+    chunkSizeWarningLimit: 2048, // three.js alone is ~600 kB minified
+    rollupOptions: {
+      // The page, and the <motion-playground> element as one ES module at the top of the folder (the page
+      // imports it too), with its workers, wasm and models beside it under relative URLs.
+      input: { index: `${here}web/index.html`, 'motion-playground': `${here}web/motion-playground.ts` },
+      preserveEntrySignatures: 'exports-only',
+      output: {
+        entryFileNames: (chunk) => (chunk.name === 'motion-playground' ? 'motion-playground.js' : 'assets/[name]-[hash].js'),
+      },
+    },
   },
 });

@@ -1,12 +1,8 @@
-// Entry point: builds the page (viewer, panel, drop zone) and installs the automation API.
-import './style.css';
-import { createPlayground } from './api/playground';
-import { App } from './ui/app';
+// The page: one full-window <motion-playground> (index.html) that keeps its view in the URL; its API
+// is also window.playground.
+import './motion-playground';
 
-const app = new App();
-const playground = createPlayground(app);
-window.playground = playground;
-
-const version = document.getElementById('version');
-if (version) version.textContent = `v${playground.version}`;
-document.body.classList.toggle('isolated', globalThis.crossOriginIsolated === true);
+const element = document.querySelector('motion-playground');
+if (!element) throw new Error('index.html has no <motion-playground>');
+window.playground = element.playground;
+document.documentElement.classList.toggle('isolated', globalThis.crossOriginIsolated === true);

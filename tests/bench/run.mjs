@@ -206,14 +206,14 @@ async function generatorBenchmark(ctx, threads, batch, steps) {
  */
 async function liveModeBenchmark(ctx, button, statusId, model) {
   const { context, page, problems } = await openPlayground(ctx.browser, ctx.url, VIEWPORT);
-  const streamFrame = () => page.evaluate((id) => Number(document.getElementById(id).dataset.frame), statusId);
+  const streamFrame = () => page.evaluate((id) => Number($ui(id).dataset.frame), statusId);
   try {
     await page.click(button);
     if (model) {
       await page.selectOption('#steer-model', model); // restarts the stream with that model
-      await page.waitForFunction((m) => document.getElementById('steer-status').dataset.model === m, model, { timeout: 60_000 });
+      await page.waitForFunction((m) => $ui('steer-status').dataset.model === m, model, { timeout: 60_000 });
     }
-    await page.waitForFunction((id) => Number(document.getElementById(id).dataset.frame) > 0, statusId, { timeout: 60_000 });
+    await page.waitForFunction((id) => Number($ui(id).dataset.frame) > 0, statusId, { timeout: 60_000 });
     await page.waitForTimeout(WARMUP_SECONDS * 1000);
     const f0 = await streamFrame();
     const frames = await measureFrames(page, SECONDS);
@@ -494,7 +494,7 @@ async function steerKeysBenchmark(ctx) {
     page.evaluate(
       () =>
         new Promise((resolve) => {
-          const el = document.getElementById('steer-readout');
+          const el = $ui('steer-readout');
           const observer = new MutationObserver(() => {
             observer.disconnect();
             resolve({ heading: Number(el.dataset.targetHeading), speed: Number(el.dataset.targetSpeed) });
@@ -517,7 +517,7 @@ async function steerKeysBenchmark(ctx) {
   };
   try {
     await page.click('#mode-steer');
-    await page.waitForFunction(() => Number(document.getElementById('steer-status').dataset.frame) > 15, null, { timeout: 120_000 });
+    await page.waitForFunction(() => Number($ui('steer-status').dataset.frame) > 15, null, { timeout: 120_000 });
     const a = await readout();
     const turnSeconds = await hold('ArrowLeft', 1000);
     const b = await readout();
@@ -563,7 +563,7 @@ async function largeImportBenchmark(ctx, megabytes) {
         const observer = new PerformanceObserver((list) => tasks.push(...list.getEntries().map((e) => ({ start: e.startTime, ms: e.duration }))));
         observer.observe({ type: 'longtask' });
         let shownAt = null;
-        const title = document.getElementById('clip-name');
+        const title = $ui('clip-name');
         const titleObserver = new MutationObserver(() => {
           if (title.textContent === name) shownAt ??= performance.now();
         });
@@ -574,7 +574,7 @@ async function largeImportBenchmark(ctx, megabytes) {
         const started = performance.now();
         const gaps = [];
         let last = started, after = 0;
-        const target = document.querySelector('.viewer-canvas');
+        const target = $uiOne('.viewer-canvas');
         for (const type of ['dragenter', 'dragover', 'drop']) target.dispatchEvent(new DragEvent(type, { dataTransfer: dt, bubbles: true, cancelable: true }));
         for (;;) {
           const now = await nextFrame();

@@ -45,7 +45,7 @@ const ZIGZAG = Array.from({ length: 121 }, (_, i) => {
   return [leg % 2 ? 0.85 - 0.7 * t : 0.15 + 0.7 * t, 0.3 + 0.07 * leg + 0.07 * t];
 });
 
-const pathState = (page) => page.evaluate(() => ({ state: document.getElementById('path-status').dataset.state, text: document.getElementById('path-status').textContent }));
+const pathState = (page) => page.evaluate(() => ({ state: $ui('path-status').dataset.state, text: $ui('path-status').textContent }));
 
 /** Waits until the generator worker has answered request `type` number `nth` (0-based) and returns the reply. */
 function replyTo(page, type, nth, what) {
@@ -206,7 +206,7 @@ describe('cancelling requests', { timeout: 600_000 }, () => {
     assert.equal(started.ok, true);
     const order = await page.evaluate((ids) => ids.map((id) => window.workerLog.replies.findIndex((r) => r.worker === 'generator' && r.id === id)), [first, simulation, second]);
     assert.ok(order[0] < order[1] && order[1] < order[2], `the replaced start was answered from the queue, before the simulation it waited behind ended (${order})`);
-    await waitUntil(page, () => Number(document.getElementById('walk-status').dataset.frame) > 0, null, { timeout: 120_000, message: 'the walk plays' });
+    await waitUntil(page, () => Number($ui('walk-status').dataset.frame) > 0, null, { timeout: 120_000, message: 'the walk plays' });
     await page.click('#mode-clip');
   });
 });

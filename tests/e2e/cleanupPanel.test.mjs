@@ -33,16 +33,16 @@ describe('Clip mode: the Clean up panel', () => {
       { amc: AMC, asf: ASF, rename },
     );
     if ((await page.locator('#cleanup-toggle').getAttribute('aria-expanded')) !== 'true') await page.locator('#cleanup-toggle').click();
-    await waitUntil(page, () => document.getElementById('cleanup-status').dataset.state === 'clip', null, { message: 'the panel shows the new clip' });
+    await waitUntil(page, () => $ui('cleanup-status').dataset.state === 'clip', null, { message: 'the panel shows the new clip' });
   }
 
   /** Records every state #cleanup-status goes through, with whether Cancel and the progress bar were shown then. */
   function recordStates() {
     return suite.page.evaluate(() => {
-      const status = document.getElementById('cleanup-status');
+      const status = $ui('cleanup-status');
       window.cleanupStates = [];
       window.cleanupObserver?.disconnect();
-      const seen = () => window.cleanupStates.push({ state: status.dataset.state, cancel: !document.getElementById('cleanup-cancel').hidden, progress: !document.getElementById('cleanup-progress').hidden });
+      const seen = () => window.cleanupStates.push({ state: status.dataset.state, cancel: !$ui('cleanup-cancel').hidden, progress: !$ui('cleanup-progress').hidden });
       window.cleanupObserver = new MutationObserver(seen);
       window.cleanupObserver.observe(status, { attributes: true, attributeFilter: ['data-state'] });
     });
@@ -51,29 +51,29 @@ describe('Clip mode: the Clean up panel', () => {
   const panel = () =>
     suite.page.evaluate(() => {
       const num = (id) => {
-        const t = document.getElementById(id).textContent;
+        const t = $ui(id).textContent;
         return t === '—' ? null : Number(t);
       };
       const row = (r) => ({ jerk: num(`cleanup-${r}-jerk`), sliding: num(`cleanup-${r}-sliding`), bones: num(`cleanup-${r}-bones`), error: num(`cleanup-${r}-error`) });
-      const s = document.getElementById('cleanup-status');
-      const plot = document.getElementById('cleanup-plot').dataset;
-      const labels = [...document.querySelectorAll('.figure-label')].filter((l) => !l.hidden).map((l) => l.textContent);
+      const s = $ui('cleanup-status');
+      const plot = $ui('cleanup-plot').dataset;
+      const labels = [...$uiAll('.figure-label')].filter((l) => !l.hidden).map((l) => l.textContent);
       return {
         state: s.dataset.state, method: s.dataset.method ?? null, runs: Number(s.dataset.runs), text: s.textContent,
-        ready: document.getElementById('cleanup-readout').dataset.ready,
+        ready: $ui('cleanup-readout').dataset.ready,
         input: row('input'), cleaned: row('cleaned'),
         plot: { joint: plot.joint, input: Number(plot.inputPoints), cleaned: Number(plot.cleanedPoints), original: Number(plot.originalPoints) },
-        joint: document.getElementById('cleanup-joint').selectedOptions[0]?.textContent ?? null,
+        joint: $ui('cleanup-joint').selectedOptions[0]?.textContent ?? null,
         labels,
-        exportDisabled: document.getElementById('cleanup-export').disabled,
-        restoreDisabled: document.getElementById('cleanup-restore').disabled,
+        exportDisabled: $ui('cleanup-export').disabled,
+        restoreDisabled: $ui('cleanup-restore').disabled,
       };
     });
 
   /** Add noise with the tool (default settings: 3 cm jitter, 1 % outlier frames); resolves once the noisy clip is shown. */
   async function addNoise() {
     await suite.page.locator('#cleanup-add-noise').click();
-    await waitUntil(suite.page, () => document.getElementById('cleanup-status').dataset.state === 'noisy', null, { message: 'Add noise shows the noisy clip' });
+    await waitUntil(suite.page, () => $ui('cleanup-status').dataset.state === 'noisy', null, { message: 'Add noise shows the noisy clip' });
   }
 
   /** Clean up with `method`, waiting until the cleaned motion is shown. */
@@ -84,7 +84,7 @@ describe('Clip mode: the Clean up panel', () => {
     await recordStates();
     await page.locator('#cleanup-go').click();
     await waitUntil(page, (n) => {
-      const d = document.getElementById('cleanup-status').dataset;
+      const d = $ui('cleanup-status').dataset;
       return (d.state === 'cleaned' && Number(d.runs) > n) || window.playground.lastError();
     }, runs, { timeout: CLEAN_TIMEOUT, message: `Clean up with ${method} finishes` });
     assert.equal(await page.evaluate(() => window.playground.lastError()), null, 'no error');
@@ -104,7 +104,7 @@ describe('Clip mode: the Clean up panel', () => {
       const m = window.playground.current(), c = window.cleanClip;
       let largest = 0;
       for (let i = 0; i < c.positions.length; i++) largest = Math.max(largest, Math.abs(m.positions[i] - c.positions[i]));
-      return { same: m === c, frames: m.frames, cleanFrames: c.frames, joints: m.joints.join(), cleanJoints: c.joints.join(), largest, title: document.getElementById('clip-name').textContent };
+      return { same: m === c, frames: m.frames, cleanFrames: c.frames, joints: m.joints.join(), cleanJoints: c.joints.join(), largest, title: $ui('clip-name').textContent };
     });
     assert.equal(noisy.same, false, 'the noisy copy is shown');
     assert.equal(noisy.frames, noisy.cleanFrames);
@@ -117,9 +117,9 @@ describe('Clip mode: the Clean up panel', () => {
     assert.ok(after.input.error > 2 && after.input.error < 8, `joint error to the clean clip ${after.input.error} cm`);
     assert.ok(after.plot.original > 300, 'the clean original is plotted too');
     await page.locator('#cleanup-restore').click();
-    await waitUntil(page, () => document.getElementById('cleanup-status').dataset.state === 'clip', null, { message: 'Restore shows the clip again' });
+    await waitUntil(page, () => $ui('cleanup-status').dataset.state === 'clip', null, { message: 'Restore shows the clip again' });
     assert.equal(await page.evaluate(() => window.playground.current() === window.cleanClip), true, 'the original clip itself is shown again');
-    assert.equal(await page.evaluate(() => document.getElementById('clip-name').textContent), '35_13.amc');
+    assert.equal(await page.evaluate(() => $ui('clip-name').textContent), '35_13.amc');
   });
 
   test('the controls are reached with Tab and work from the keyboard (a slider\'s arrows move it, not the playhead)', async () => {
@@ -130,21 +130,21 @@ describe('Clip mode: the Clean up panel', () => {
       window.playground.seek(100);
     });
     await page.locator('#cleanup-toggle').focus();
-    const focused = () => page.evaluate(() => document.activeElement?.id);
+    const focused = () => page.evaluate(() => $uiActive()?.id);
     await page.keyboard.press('Tab');
     assert.equal(await focused(), 'cleanup-method');
     await page.keyboard.press('Tab');
     assert.equal(await focused(), 'cleanup-jitter');
     await page.keyboard.press('ArrowRight');
-    assert.equal(await page.evaluate(() => document.getElementById('cleanup-jitter-out').textContent), '3.5 cm');
+    assert.equal(await page.evaluate(() => $ui('cleanup-jitter-out').textContent), '3.5 cm');
     assert.equal((await page.evaluate(() => window.playground.state())).frame, 100, 'the playhead did not move');
     for (let i = 0; i < 3; i++) await page.keyboard.press('Tab');
     assert.equal(await focused(), 'cleanup-add-noise');
     await page.keyboard.press('Enter');
-    await waitUntil(page, () => document.getElementById('cleanup-status').dataset.state === 'noisy', null, { message: 'Enter on Add noise adds noise' });
+    await waitUntil(page, () => $ui('cleanup-status').dataset.state === 'noisy', null, { message: 'Enter on Add noise adds noise' });
     assert.match((await panel()).text, /jitter 3\.5 cm/);
     await page.evaluate(() => {
-      const s = document.getElementById('cleanup-jitter');
+      const s = $ui('cleanup-jitter');
       s.value = '3';
       s.dispatchEvent(new Event('input'));
     });
@@ -189,7 +189,7 @@ describe('Clip mode: the Clean up panel', () => {
         mkdirSync(path.dirname(out), { recursive: true });
         writeFileSync(out, await page.screenshot({ type: 'png' }));
         const layout = await page.evaluate(() => {
-          const card = document.getElementById('cleanup-card'), bar = document.getElementById('controls').getBoundingClientRect();
+          const card = $ui('cleanup-card'), bar = $ui('controls').getBoundingClientRect();
           const r = card.getBoundingClientRect();
           return { bottom: r.bottom, right: r.right, barTop: bar.top, barRight: bar.right, left: r.left, scroll: card.scrollHeight - card.clientHeight, width: innerWidth, height: innerHeight };
         });
@@ -207,10 +207,10 @@ describe('Clip mode: the Clean up panel', () => {
     await page.evaluate(() => (window.noisyInput = window.playground.current()));
     await page.selectOption('#cleanup-method', 'map');
     await page.locator('#cleanup-go').click();
-    await waitUntil(page, () => document.getElementById('cleanup-status').dataset.state === 'cleaning', null, { message: 'the clean-up starts' });
+    await waitUntil(page, () => $ui('cleanup-status').dataset.state === 'cleaning', null, { message: 'the clean-up starts' });
     await page.locator('#cleanup-cancel').click();
-    await waitUntil(page, () => document.getElementById('cleanup-status').dataset.state === 'noisy', null, { message: 'Cancel ends the clean-up' });
-    const after = await page.evaluate(() => ({ same: window.playground.current() === window.noisyInput, error: window.playground.lastError(), labels: document.querySelectorAll('.figure-label').length }));
+    await waitUntil(page, () => $ui('cleanup-status').dataset.state === 'noisy', null, { message: 'Cancel ends the clean-up' });
+    const after = await page.evaluate(() => ({ same: window.playground.current() === window.noisyInput, error: window.playground.lastError(), labels: $uiAll('.figure-label').length }));
     assert.deepEqual(after, { same: true, error: null, labels: 0 });
   });
 
@@ -247,11 +247,11 @@ describe('Clip mode: the Clean up panel', () => {
     assert.ok(await page.locator('.toast.error', { hasText: 'cannot be mapped' }).isVisible(), 'as the page\'s message');
     const after = await page.evaluate(() => ({
       same: window.playground.current() === window.cleanClip,
-      state: document.getElementById('cleanup-status').dataset.state,
-      labels: document.querySelectorAll('.figure-label').length,
-      sliding: document.getElementById('cleanup-input-sliding').textContent,
+      state: $ui('cleanup-status').dataset.state,
+      labels: $uiAll('.figure-label').length,
+      sliding: $ui('cleanup-input-sliding').textContent,
     }));
     assert.deepEqual(after, { same: true, state: 'clip', labels: 0, sliding: '—' });
-    await page.evaluate(() => document.querySelectorAll('.toast').forEach((t) => t.remove()));
+    await page.evaluate(() => $uiAll('.toast').forEach((t) => t.remove()));
   });
 });

@@ -72,8 +72,8 @@ function digest(page, options) {
   }, options);
 }
 
-const status = (page) => page.evaluate(() => Number(document.getElementById('dance-status').dataset.frame));
-const plotSeconds = (page) => page.evaluate(() => Number(document.getElementById('dance-plot').dataset.seconds));
+const status = (page) => page.evaluate(() => Number($ui('dance-status').dataset.frame));
+const plotSeconds = (page) => page.evaluate(() => Number($ui('dance-plot').dataset.seconds));
 
 /** In-page: the message generate rejects with, or "resolved". */
 const rejection = (page, options) => page.evaluate((o) => window.playground.generate(o).then(() => 'resolved', (e) => e.message), options);
@@ -214,13 +214,13 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
     });
     assert.equal(clipFrames, 45);
     await suite.page.click('#mode-dance');
-    await waitUntil(suite.page, () => Number(document.getElementById('dance-status').dataset.frame) > 10, null, { timeout: 60_000, message: 'the dance starts' });
+    await waitUntil(suite.page, () => Number($ui('dance-status').dataset.frame) > 10, null, { timeout: 60_000, message: 'the dance starts' });
     const ui = await suite.page.evaluate(() => ({
-      dance: document.body.classList.contains('dance-mode'),
-      pressed: document.getElementById('mode-dance').getAttribute('aria-pressed'),
-      styles: [...document.getElementById('dance-style').options].map((o) => o.value),
-      seeds: [...document.getElementById('dance-seed').options].map((o) => o.textContent),
-      plotVisible: getComputedStyle(document.getElementById('dance-plot-card')).display !== 'none',
+      dance: $uiFrame().classList.contains('dance-mode'),
+      pressed: $ui('mode-dance').getAttribute('aria-pressed'),
+      styles: [...$ui('dance-style').options].map((o) => o.value),
+      seeds: [...$ui('dance-seed').options].map((o) => o.textContent),
+      plotVisible: getComputedStyle($ui('dance-plot-card')).display !== 'none',
     }));
     assert.ok(ui.dance);
     assert.equal(ui.pressed, 'true');
@@ -230,13 +230,13 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
 
     // Frames advance and the plot gains a point per second of them.
     const f1 = await status(suite.page);
-    await waitUntil(suite.page, () => Number(document.getElementById('dance-plot').dataset.seconds) >= 3, null, { timeout: 30_000, message: 'the plot shows 3 seconds' });
+    await waitUntil(suite.page, () => Number($ui('dance-plot').dataset.seconds) >= 3, null, { timeout: 30_000, message: 'the plot shows 3 seconds' });
     const f2 = await status(suite.page);
     assert.ok(f2 > f1 + INFO.fps, `the dance advances (frame ${f1} → ${f2})`);
     const live = await suite.page.evaluate(() => {
       const m = window.playground.current();
-      const plot = document.getElementById('dance-plot').dataset;
-      return { joints: m.joints.length, frames: m.frames, fps: m.fps, playing: window.playground.state().playing, last: Number(plot.last), loading: document.getElementById('model-status').hidden };
+      const plot = $ui('dance-plot').dataset;
+      return { joints: m.joints.length, frames: m.frames, fps: m.fps, playing: window.playground.state().playing, last: Number(plot.last), loading: $ui('model-status').hidden };
     });
     assert.equal(live.joints, 57);
     assert.equal(live.fps, INFO.fps);
@@ -245,7 +245,7 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
     assert.equal(live.loading, true, 'the loading indicator is hidden once the model is loaded');
 
     // Export BVH saves the dance: 57 joints at the skeleton's bone lengths.
-    const [download] = await Promise.all([suite.page.waitForEvent('download'), suite.page.locator('#export-btn').click()]);
+    const [download] = await Promise.all([suite.page.waitForEvent('download'), suite.page.locator('#export-menu-btn').click().then(() => suite.page.locator('#export-btn').click())]);
     assert.equal(download.suggestedFilename(), 'dance.bvh');
     const text = readFileSync(await download.path(), 'utf8');
     const reimported = await suite.page.evaluate(
@@ -273,32 +273,32 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
     await suite.page.selectOption('#dance-style', style);
     await waitUntil(
       suite.page,
-      (s) => document.getElementById('clip-meta').textContent.includes(s) && Number(document.getElementById('dance-status').dataset.frame) < 200,
+      (s) => $ui('clip-meta').textContent.includes(s) && Number($ui('dance-status').dataset.frame) < 200,
       style,
       { timeout: 30_000, message: `the dance restarts as ${style}` },
     );
     const switched = await suite.page.evaluate(() => ({
-      seeds: [...document.getElementById('dance-seed').options].map((o) => o.textContent),
-      meta: document.getElementById('clip-meta').textContent,
+      seeds: [...$ui('dance-seed').options].map((o) => o.textContent),
+      meta: $ui('clip-meta').textContent,
     }));
     assert.deepEqual(switched.seeds, INFO.seeds.filter((s) => s.style === style).map((s) => s.name));
     assert.match(switched.meta, new RegExp(`acLSTM · ${style}`));
     assert.ok((await plotSeconds(suite.page)) <= 3, 'the plot restarted');
-    await waitUntil(suite.page, () => Number(document.getElementById('dance-plot').dataset.seconds) >= 1, null, { timeout: 30_000, message: 'the new plot gains a second' });
+    await waitUntil(suite.page, () => Number($ui('dance-plot').dataset.seconds) >= 1, null, { timeout: 30_000, message: 'the new plot gains a second' });
 
     // The vanilla baseline runs in the same mode.
     await suite.page.selectOption('#dance-model', 'aclstm-vanilla');
-    await waitUntil(suite.page, () => document.getElementById('clip-meta').textContent.includes('vanilla'), null, { timeout: 60_000, message: 'the baseline is shown' });
+    await waitUntil(suite.page, () => $ui('clip-meta').textContent.includes('vanilla'), null, { timeout: 60_000, message: 'the baseline is shown' });
     // The switch shows at once; the baseline's stream starts once its model has loaded (no fixed deadline).
     const g1 = await status(suite.page);
-    await waitUntil(suite.page, (from) => Number(document.getElementById('dance-status').dataset.frame) > from + 30, g1, {
+    await waitUntil(suite.page, (from) => Number($ui('dance-status').dataset.frame) > from + 30, g1, {
       timeout: 60_000,
       message: `the baseline's dance advances 30 frames from frame ${g1}`,
     });
     assert.match(await suite.page.locator('#clip-meta').textContent(), /vanilla/, 'the baseline dances too');
 
     await suite.page.click('#mode-clip');
-    const back = await suite.page.evaluate(() => ({ frames: window.playground.current()?.frames, dance: document.body.classList.contains('dance-mode') }));
+    const back = await suite.page.evaluate(() => ({ frames: window.playground.current()?.frames, dance: $uiFrame().classList.contains('dance-mode') }));
     assert.equal(back.dance, false);
     assert.equal(back.frames, clipFrames, 'the clip shown before is back');
   });
@@ -307,15 +307,15 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
     const fresh = await openPlayground(suite.browser, suite.url);
     try {
       await fresh.page.click('#mode-dance');
-      await waitUntil(fresh.page, () => Number(document.getElementById('dance-plot').dataset.seconds) >= 2, null, { timeout: 60_000, message: 'the plot shows 2 seconds' });
+      await waitUntil(fresh.page, () => Number($ui('dance-plot').dataset.seconds) >= 2, null, { timeout: 60_000, message: 'the plot shows 2 seconds' });
       const a = await status(fresh.page);
       // Frames keep coming (their rate against the wall clock is `npm run bench`'s dance-mode) and the
       // plot gains the seconds they complete.
-      await waitUntil(fresh.page, ([a, fps]) => Number(document.getElementById('dance-status').dataset.frame) > a + 2 * fps, [a, INFO.fps], {
+      await waitUntil(fresh.page, ([a, fps]) => Number($ui('dance-status').dataset.frame) > a + 2 * fps, [a, INFO.fps], {
         timeout: 60_000,
         message: `the dance advances 2 s of frames from frame ${a}`,
       });
-      await waitUntil(fresh.page, () => Number(document.getElementById('dance-plot').dataset.seconds) >= 3, null, { timeout: 30_000, message: 'the plot shows 3 seconds' });
+      await waitUntil(fresh.page, () => Number($ui('dance-plot').dataset.seconds) >= 3, null, { timeout: 30_000, message: 'the plot shows 3 seconds' });
       assert.deepEqual(fresh.problems, []);
     } finally {
       await fresh.context.close();

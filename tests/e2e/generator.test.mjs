@@ -170,15 +170,15 @@ describe('generator in the page', { timeout: 240_000 }, () => {
       return { frames: window.playground.current().frames };
     });
     await page.click('#mode-walk');
-    await waitUntil(page, () => Number(document.getElementById('walk-status').dataset.frame) > 5, null, { timeout: 60_000, message: 'the walk starts' });
-    const f1 = await page.evaluate(() => Number(document.getElementById('walk-status').dataset.frame));
-    await waitUntil(page, (f) => Number(document.getElementById('walk-status').dataset.frame) > f + 30, f1, { timeout: 60_000, message: `the walk advances 30 frames from frame ${f1}` });
+    await waitUntil(page, () => Number($ui('walk-status').dataset.frame) > 5, null, { timeout: 60_000, message: 'the walk starts' });
+    const f1 = await page.evaluate(() => Number($ui('walk-status').dataset.frame));
+    await waitUntil(page, (f) => Number($ui('walk-status').dataset.frame) > f + 30, f1, { timeout: 60_000, message: `the walk advances 30 frames from frame ${f1}` });
     const s = await page.evaluate(() => ({
-      frame: Number(document.getElementById('walk-status').dataset.frame),
+      frame: Number($ui('walk-status').dataset.frame),
       state: window.playground.state(),
       current: window.playground.current() && { frames: window.playground.current().frames, joints: window.playground.current().joints.length },
-      walk: document.body.classList.contains('walk-mode'),
-      loading: document.getElementById('model-status').hidden,
+      walk: $uiFrame().classList.contains('walk-mode'),
+      loading: $ui('model-status').hidden,
     }));
     assert.ok(s.walk);
     assert.ok(s.frame > f1 + 30, `the walk advances (frame ${f1} → ${s.frame})`);
@@ -188,14 +188,14 @@ describe('generator in the page', { timeout: 240_000 }, () => {
 
     // A new temperature restarts the walk from the start.
     await page.evaluate(() => {
-      const t = document.getElementById('walk-temperature');
+      const t = $ui('walk-temperature');
       t.value = '0.2';
       t.dispatchEvent(new Event('change'));
     });
-    await waitUntil(page, () => /τ 0\.20/.test(document.getElementById('walk-status').textContent), null, { timeout: 20_000, message: 'the walk restarts at τ 0.20' });
+    await waitUntil(page, () => /τ 0\.20/.test($ui('walk-status').textContent), null, { timeout: 20_000, message: 'the walk restarts at τ 0.20' });
 
     await page.click('#mode-clip');
-    const back = await page.evaluate(() => ({ frames: window.playground.current()?.frames, walk: document.body.classList.contains('walk-mode') }));
+    const back = await page.evaluate(() => ({ frames: window.playground.current()?.frames, walk: $uiFrame().classList.contains('walk-mode') }));
     assert.equal(back.walk, false);
     assert.equal(back.frames, before.frames, 'the clip shown before is back');
   });
@@ -204,13 +204,13 @@ describe('generator in the page', { timeout: 240_000 }, () => {
     const fresh = await openPlayground(browser, url);
     try {
       await fresh.page.click('#mode-walk');
-      await waitUntil(fresh.page, () => Number(document.getElementById('walk-status').dataset.frame) > 0, null, { timeout: 60_000, message: 'the walk starts' });
-      const a = await fresh.page.evaluate(() => Number(document.getElementById('walk-status').dataset.frame));
+      await waitUntil(fresh.page, () => Number($ui('walk-status').dataset.frame) > 0, null, { timeout: 60_000, message: 'the walk starts' });
+      const a = await fresh.page.evaluate(() => Number($ui('walk-status').dataset.frame));
       // Frames keep coming: a few seconds of the stream (its rate against the wall clock is `npm run bench`'s random-walk).
-      await waitUntil(fresh.page, (a) => Number(document.getElementById('walk-status').dataset.frame) > a + 90, a, { timeout: 60_000, message: `the walk advances 90 frames from frame ${a}` });
+      await waitUntil(fresh.page, (a) => Number($ui('walk-status').dataset.frame) > a + 90, a, { timeout: 60_000, message: `the walk advances 90 frames from frame ${a}` });
       // Past 20 s (600 frames at 30 fps) the window keeps the last 600 frames behind the playhead and the
       // few generated ahead (under 120), so it can run for hours. (Dance and Steer share this LiveMode window.)
-      await waitUntil(fresh.page, () => Number(document.getElementById('walk-status').dataset.frame) > 700, null, { timeout: 120_000, message: 'the walk passes frame 700' });
+      await waitUntil(fresh.page, () => Number($ui('walk-status').dataset.frame) > 700, null, { timeout: 120_000, message: 'the walk passes frame 700' });
       const s = await fresh.page.evaluate(() => ({ frames: window.playground.current().frames, playing: window.playground.state().playing }));
       assert.ok(s.frames >= 600 && s.frames <= 600 + 120, `only the last 20 s and what is ready ahead are kept (${s.frames} frames)`);
       assert.equal(s.playing, true);

@@ -84,10 +84,30 @@ export async function openPlayground(browser, url, { width = 1280, height = 800 
   });
   page.on('pageerror', (err) => problems.push(`pageerror: ${err.message}`));
   page.on('requestfailed', (req) => problems.push(`request failed: ${req.url()} ${req.failure()?.errorText ?? ''}`));
-  await page.goto(url, { waitUntil: 'load' });
+  await page.addInitScript(installUiLookups);
+  // A first visit opens on Random walk; the tests start from the empty Clip view unless the URL says otherwise.
+  const address = new URL(url);
+  if (!address.searchParams.has('mode')) address.searchParams.set('mode', 'clip');
+  await page.goto(address.href, { waitUntil: 'load' });
   await page.waitForFunction(() => window.playground !== undefined, null, { timeout: 20_000 });
   await page.evaluate(() => window.playground.ready);
   return { context, page, problems };
+}
+
+/**
+ * Runs in the page before its scripts: lookups into the page's <motion-playground> shadow root for the
+ * tests' page.evaluate calls ($ui(id), $uiAll(selector), $uiOne(selector), $uiFrame() for the mode classes,
+ * $uiActive() for the focused element inside it).
+ */
+export function installUiLookups() {
+  const root = () => document.querySelector('motion-playground')?.shadowRoot ?? null;
+  Object.assign(window, {
+    $ui: (id) => root()?.getElementById(id) ?? null,
+    $uiAll: (selector) => root()?.querySelectorAll(selector) ?? [],
+    $uiOne: (selector) => root()?.querySelector(selector) ?? null,
+    $uiFrame: () => root()?.querySelector('.app') ?? null,
+    $uiActive: () => root()?.activeElement ?? null,
+  });
 }
 
 /** Waits for `n` animation frames in the page (lets the viewer render what was just set). */

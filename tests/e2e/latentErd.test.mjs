@@ -52,8 +52,8 @@ const STATS = /error mean (\d+\.\d) cm · max (\d+\.\d) cm · (\d+) % of the pat
 
 const steerStatus = (page) =>
   page.evaluate(() => {
-    const s = document.getElementById('steer-status');
-    return { model: s.dataset.model, frame: Number(s.dataset.frame), text: s.textContent, meta: document.getElementById('clip-meta').textContent };
+    const s = $ui('steer-status');
+    return { model: s.dataset.model, frame: Number(s.dataset.frame), text: s.textContent, meta: $ui('clip-meta').textContent };
   });
 
 /** Waits until Steer mode streams from `model` and has shown more than `frames` frames of it. */
@@ -61,10 +61,10 @@ function steerStreams(page, model, frames = 8) {
   return waitUntil(
     page,
     ({ model, frames }) => {
-      const s = document.getElementById('steer-status');
+      const s = $ui('steer-status');
       // The status names the stream's model once it describes a frame of it ("… latent ERD · 2.1 ms per 4 frames", "… 24 particles").
       const marker = model === 'latent-erd' ? / · latent ERD · / : / particles$/;
-      return s.dataset.model === model && marker.test(s.textContent) && Number(s.dataset.frame) > frames && document.getElementById('clip-meta').textContent.includes(model === 'latent-erd' ? 'latent ERD' : 'generator');
+      return s.dataset.model === model && marker.test(s.textContent) && Number(s.dataset.frame) > frames && $ui('clip-meta').textContent.includes(model === 'latent-erd' ? 'latent ERD' : 'generator');
     },
     { model, frames },
     { timeout: 90_000, message: `Steer mode streams from the ${model}` },
@@ -72,7 +72,7 @@ function steerStreams(page, model, frames = 8) {
 }
 
 /** The values of both model selects. */
-const choices = (page) => page.evaluate(() => [document.getElementById('steer-model').value, document.getElementById('path-model').value]);
+const choices = (page) => page.evaluate(() => [$ui('steer-model').value, $ui('path-model').value]);
 
 describe('the model choice of Steer and Path modes', { timeout: 400_000 }, () => {
   const suite = usePlayground();
@@ -80,18 +80,18 @@ describe('the model choice of Steer and Path modes', { timeout: 400_000 }, () =>
   test('Steer mode: the latent ERD is chosen from the keyboard, steered live, kept across mode switches; back to the generator', async () => {
     const page = suite.page;
     await page.click('#mode-steer');
-    const labels = await page.evaluate(() => [...document.getElementById('steer-model').options].map((o) => [o.value, o.textContent]));
+    const labels = await page.evaluate(() => [...$ui('steer-model').options].map((o) => [o.value, o.textContent]));
     assert.deepEqual(labels, [['generator', 'Generator + MAP optimiser'], ['latent-erd', 'Latent ERD']]);
     assert.deepEqual(await choices(page), ['generator', 'generator'], 'the generator by default');
     await steerStreams(page, 'generator');
     assert.match((await steerStatus(page)).text, /particles/, 'the MAP controller runs');
 
     // Keyboard: the select is in the tab order, and typing an option's first letter picks it.
-    assert.equal(await page.evaluate(() => document.getElementById('steer-model').tabIndex), 0);
+    assert.equal(await page.evaluate(() => $ui('steer-model').tabIndex), 0);
     await page.focus('#steer-model');
     await page.keyboard.press('l');
     assert.deepEqual(await choices(page), ['latent-erd', 'latent-erd'], 'one choice for both modes');
-    await page.evaluate(() => document.activeElement.blur());
+    await page.evaluate(() => $uiActive()?.blur());
     await steerStreams(page, 'latent-erd');
     const erd = await steerStatus(page);
     assert.match(erd.text, /latent ERD · \d+\.\d ms per 4 frames/);
@@ -106,12 +106,12 @@ describe('the model choice of Steer and Path modes', { timeout: 400_000 }, () =>
     const before = await steerStatus(page);
     await page.keyboard.down('ArrowLeft');
     try {
-      await waitUntil(page, () => Number(document.getElementById('steer-readout').dataset.targetHeading) > 0.6, null, { timeout: 20_000, message: '← turns the target heading' });
+      await waitUntil(page, () => Number($ui('steer-readout').dataset.targetHeading) > 0.6, null, { timeout: 20_000, message: '← turns the target heading' });
     } finally {
       await page.keyboard.up('ArrowLeft');
     }
-    await waitUntil(page, (f) => Number(document.getElementById('steer-status').dataset.frame) > f + 30, before.frame, { timeout: 60_000, message: 'the latent ERD stream goes on' });
-    const readout = await page.evaluate(() => ({ ...document.getElementById('steer-readout').dataset }));
+    await waitUntil(page, (f) => Number($ui('steer-status').dataset.frame) > f + 30, before.frame, { timeout: 60_000, message: 'the latent ERD stream goes on' });
+    const readout = await page.evaluate(() => ({ ...$ui('steer-readout').dataset }));
     assert.ok(Number.isFinite(Number(readout.speed)) && readout.speed !== '', `an achieved speed is shown (${readout.speed})`);
 
     // Away and back: still the latent ERD.
@@ -134,16 +134,16 @@ describe('the model choice of Steer and Path modes', { timeout: 400_000 }, () =>
     assert.deepEqual(await choices(page), ['latent-erd', 'latent-erd']);
     assert.equal(await page.locator('#path-fit').isDisabled(), true, 'no fit tolerance for the latent ERD');
     await drawStroke(page, Array.from({ length: 31 }, (_, i) => [0.3 + (0.4 * i) / 30, 0.45]));
-    assert.equal(await page.evaluate(() => document.getElementById('path-status').dataset.state), 'drawn');
-    await page.evaluate(() => (document.getElementById('path-progress').value = 0));
+    assert.equal(await page.evaluate(() => $ui('path-status').dataset.state), 'drawn');
+    await page.evaluate(() => ($ui('path-progress').value = 0));
     await page.click('#path-go');
-    await waitUntil(page, () => document.getElementById('path-status').dataset.state === 'done', null, { timeout: 120_000, message: 'the latent ERD walks the path' });
+    await waitUntil(page, () => $ui('path-status').dataset.state === 'done', null, { timeout: 120_000, message: 'the latent ERD walks the path' });
     const done = await page.evaluate(() => {
-      const s = document.getElementById('path-status');
+      const s = $ui('path-status');
       const m = window.playground.current();
       return {
-        walkedBy: s.dataset.walkedBy, text: s.textContent, meta: document.getElementById('clip-meta').textContent,
-        progress: document.getElementById('path-progress').value, progressHidden: document.getElementById('path-progress').hidden,
+        walkedBy: s.dataset.walkedBy, text: s.textContent, meta: $ui('clip-meta').textContent,
+        progress: $ui('path-progress').value, progressHidden: $ui('path-progress').hidden,
         frames: m.frames, joints: m.joints.length, finite: m.positions.every(Number.isFinite), playing: window.playground.state().playing,
       };
     });
@@ -162,12 +162,12 @@ describe('the model choice of Steer and Path modes', { timeout: 400_000 }, () =>
     await page.click('#mode-clip');
     await page.click('#mode-path');
     assert.deepEqual(await choices(page), ['latent-erd', 'latent-erd']);
-    assert.equal(await page.evaluate(() => document.getElementById('path-status').dataset.walkedBy), 'latent-erd');
+    assert.equal(await page.evaluate(() => $ui('path-status').dataset.walkedBy), 'latent-erd');
     await page.selectOption('#path-model', 'generator');
     assert.equal(await page.locator('#path-fit').isDisabled(), false);
     await page.click('#path-go');
-    await waitUntil(page, () => document.getElementById('path-status').dataset.walkedBy === 'generator' && document.getElementById('path-status').dataset.state === 'done', null, { timeout: 180_000, message: 'the generator walks the path' });
-    const generator = await page.evaluate(() => ({ text: document.getElementById('path-status').textContent, meta: document.getElementById('clip-meta').textContent }));
+    await waitUntil(page, () => $ui('path-status').dataset.walkedBy === 'generator' && $ui('path-status').dataset.state === 'done', null, { timeout: 180_000, message: 'the generator walks the path' });
+    const generator = await page.evaluate(() => ({ text: $ui('path-status').textContent, meta: $ui('clip-meta').textContent }));
     assert.doesNotMatch(generator.text, /latent ERD/);
     assert.ok(STATS.test(generator.text));
     assert.match(generator.meta, /generator · walk/);

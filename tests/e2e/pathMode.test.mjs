@@ -16,7 +16,7 @@ function line(x0, x1, y, n = 30) {
 
 const pathState = (page) =>
   page.evaluate(() => {
-    const s = document.getElementById('path-status');
+    const s = $ui('path-status');
     return { state: s.dataset.state, text: s.textContent };
   });
 
@@ -41,12 +41,12 @@ const shown = (page) =>
 
 const readout = (page) =>
   page.evaluate(() => {
-    const d = document.getElementById('steer-readout').dataset;
+    const d = $ui('steer-readout').dataset;
     return {
       targetSpeed: Number(d.targetSpeed), targetHeading: Number(d.targetHeading), speed: d.speed === '' ? NaN : Number(d.speed), heading: d.heading === '' ? NaN : Number(d.heading),
-      frame: Number(document.getElementById('steer-status').dataset.frame),
-      slider: Number(document.getElementById('steer-speed').value),
-      sliderText: document.getElementById('steer-speed-out').textContent,
+      frame: Number($ui('steer-status').dataset.frame),
+      slider: Number($ui('steer-speed').value),
+      sliderText: $ui('steer-speed-out').textContent,
     };
   });
 
@@ -63,7 +63,7 @@ async function freshReadout(page) {
           observer.disconnect();
           resolve();
         });
-        observer.observe(document.getElementById('steer-readout'), { attributes: true });
+        observer.observe($ui('steer-readout'), { attributes: true });
       }),
   );
   return readout(page);
@@ -112,7 +112,7 @@ async function walkAStroke(page, points) {
   const drawn = await pathState(page);
   assert.equal(drawn.state, 'drawn', `the stroke is a path (${drawn.text})`);
   await page.click('#path-go');
-  await waitUntil(page, () => document.getElementById('path-status').dataset.state !== 'optimising', null, { timeout: 180_000, message: 'the optimiser finishes' });
+  await waitUntil(page, () => $ui('path-status').dataset.state !== 'optimising', null, { timeout: 180_000, message: 'the optimiser finishes' });
   const done = await pathState(page);
   assert.equal(done.state, 'done', `the walk arrived (${done.text}; last error ${await page.evaluate(() => window.playground.lastError())})`);
   return Number(/path (\d+\.\d) m/.exec(drawn.text)?.[1]);
@@ -126,12 +126,12 @@ describe('Path and Steer modes', { timeout: 400_000 }, () => {
     await showClipToComeBackTo(page);
     await enterEmptyPathMode(page);
     const ui = await page.evaluate(() => ({
-      path: document.body.classList.contains('path-mode'),
-      pressed: document.getElementById('mode-path').getAttribute('aria-pressed'),
-      controls: getComputedStyle(document.getElementById('path-controls')).display,
+      path: $uiFrame().classList.contains('path-mode'),
+      pressed: $ui('mode-path').getAttribute('aria-pressed'),
+      controls: getComputedStyle($ui('path-controls')).display,
       current: window.playground.current(),
-      go: document.getElementById('path-go').disabled,
-      progress: document.getElementById('path-progress').hidden,
+      go: $ui('path-go').disabled,
+      progress: $ui('path-progress').hidden,
     }));
     assert.deepEqual(ui, { path: true, pressed: 'true', controls: 'flex', current: null, go: true, progress: true });
     assert.equal((await pathState(page)).state, 'empty');
@@ -146,12 +146,12 @@ describe('Path and Steer modes', { timeout: 400_000 }, () => {
 
     await page.click('#path-go');
     const busy = await page.evaluate(() => ({
-      state: document.getElementById('path-status').dataset.state,
-      progress: document.getElementById('path-progress').hidden,
-      go: document.getElementById('path-go').disabled,
+      state: $ui('path-status').dataset.state,
+      progress: $ui('path-progress').hidden,
+      go: $ui('path-go').disabled,
     }));
     assert.deepEqual(busy, { state: 'optimising', progress: false, go: true }, 'the progress bar shows while optimising');
-    await waitUntil(page, () => document.getElementById('path-status').dataset.state !== 'optimising', null, { timeout: 180_000, message: 'the optimiser finishes' });
+    await waitUntil(page, () => $ui('path-status').dataset.state !== 'optimising', null, { timeout: 180_000, message: 'the optimiser finishes' });
     const done = await pathState(page);
     assert.equal(done.state, 'done', `the walk arrived (${done.text}; last error ${await page.evaluate(() => window.playground.lastError())})`);
     const stats = STATS.exec(done.text);
@@ -173,10 +173,10 @@ describe('Path and Steer modes', { timeout: 400_000 }, () => {
     assert.equal(m.playing, true, 'the walk plays');
     assert.ok(Math.abs(m.span - length) < 0.25 * length, `a straight stroke is walked end to end (${m.span.toFixed(2)} m of ${length} m)`);
     assert.ok(Math.abs((m.frames - 1) / 30 - motionS) < 0.1, 'the stats describe the shown motion');
-    assert.equal(await page.evaluate(() => document.body.classList.contains('path-mode')), true, 'still in Path mode');
+    assert.equal(await page.evaluate(() => $uiFrame().classList.contains('path-mode')), true, 'still in Path mode');
     assert.equal(await page.locator('#path-progress').isHidden(), true);
 
-    const [download] = await Promise.all([page.waitForEvent('download'), page.locator('#export-btn').click()]);
+    const [download] = await Promise.all([page.waitForEvent('download'), page.locator('#export-menu-btn').click().then(() => page.locator('#export-btn').click())]);
     assert.equal(download.suggestedFilename(), 'path-walk.bvh');
     const back = await page.evaluate((text) => window.playground.importMotion(text, 'bvh').then((r) => r.frames), readFileSync(await download.path(), 'utf8'));
     assert.equal(back, m.frames, 'the export holds the walk');
@@ -219,7 +219,7 @@ describe('Path and Steer modes', { timeout: 400_000 }, () => {
     await page.click('#mode-clip');
     const clip = await shown(page);
     assert.equal(clip.frames, 60, 'the clip shown before Path mode is back');
-    assert.equal(await page.evaluate(() => document.body.classList.contains('path-mode')), false);
+    assert.equal(await page.evaluate(() => $uiFrame().classList.contains('path-mode')), false);
 
     await page.click('#mode-path');
     const again = await shown(page);
@@ -239,7 +239,7 @@ describe('Path and Steer modes', { timeout: 400_000 }, () => {
     const page = suite.page;
     await showClipToComeBackTo(page);
     await page.click('#mode-steer');
-    await waitUntil(page, () => Number(document.getElementById('steer-status').dataset.frame) > 15, null, { timeout: 120_000, message: 'the steered stream starts' });
+    await waitUntil(page, () => Number($ui('steer-status').dataset.frame) > 15, null, { timeout: 120_000, message: 'the steered stream starts' });
     const start = await readout(page);
     assert.equal(start.targetSpeed, 1.2, 'default target speed');
     assert.equal(start.targetHeading, 0, 'the stream starts facing +z');
@@ -250,24 +250,24 @@ describe('Path and Steer modes', { timeout: 400_000 }, () => {
 
     // ← turns the target heading left (toward +x: a growing heading) while held, without stepping playback;
     // it stops when let go. (The rate, 90° a second, is `npm run bench`'s steer-keys.)
-    const turned = await holdUntil(page, 'ArrowLeft', () => Number(document.getElementById('steer-readout').dataset.targetHeading) > 0.8, null, '← turns the target heading left past 0.8 rad');
+    const turned = await holdUntil(page, 'ArrowLeft', () => Number($ui('steer-readout').dataset.targetHeading) > 0.8, null, '← turns the target heading left past 0.8 rad');
     assert.ok(turned.targetHeading > 0.8 && turned.targetHeading < Math.PI, `heading after ← (${turned.targetHeading.toFixed(2)} rad)`);
     assert.equal(await page.evaluate(() => window.playground.state().playing), true, '← steers instead of stepping frames');
     const f = turned.frame;
-    await waitUntil(page, (f) => Number(document.getElementById('steer-status').dataset.frame) > f + 6, f, { timeout: 60_000, message: 'the stream goes on' });
+    await waitUntil(page, (f) => Number($ui('steer-status').dataset.frame) > f + 6, f, { timeout: 60_000, message: 'the stream goes on' });
     assert.equal((await freshReadout(page)).targetHeading, turned.targetHeading, 'a released key stops turning');
     // The character turns to it.
     await waitUntil(
       page,
-      (h) => Math.abs(Math.atan2(Math.sin(Number(document.getElementById('steer-readout').dataset.heading) - h), Math.cos(Number(document.getElementById('steer-readout').dataset.heading) - h))) < 0.4,
+      (h) => Math.abs(Math.atan2(Math.sin(Number($ui('steer-readout').dataset.heading) - h), Math.cos(Number($ui('steer-readout').dataset.heading) - h))) < 0.4,
       turned.targetHeading,
       { timeout: 60_000, message: 'the character turns to face the target heading' },
     );
 
     // D turns right; ↑ speeds up (the slider follows).
-    const right = await holdUntil(page, 'd', (h) => Number(document.getElementById('steer-readout').dataset.targetHeading) < h - 0.3, turned.targetHeading, 'D turns the target heading right by 0.3 rad');
+    const right = await holdUntil(page, 'd', (h) => Number($ui('steer-readout').dataset.targetHeading) < h - 0.3, turned.targetHeading, 'D turns the target heading right by 0.3 rad');
     assert.ok(right.targetHeading < turned.targetHeading - 0.3, `D turns right (${turned.targetHeading.toFixed(2)} → ${right.targetHeading.toFixed(2)})`);
-    const faster = await holdUntil(page, 'ArrowUp', () => Number(document.getElementById('steer-readout').dataset.targetSpeed) > 1.5, null, '↑ raises the target speed past 1.5 m/s');
+    const faster = await holdUntil(page, 'ArrowUp', () => Number($ui('steer-readout').dataset.targetSpeed) > 1.5, null, '↑ raises the target speed past 1.5 m/s');
     assert.ok(faster.targetSpeed > 1.5, `↑ raises the target speed (${faster.targetSpeed})`);
     assert.ok(Math.abs(faster.slider - faster.targetSpeed) <= 0.026, `the slider follows (${faster.slider})`);
     assert.ok(Math.abs(Number.parseFloat(faster.sliderText) - faster.targetSpeed) <= 0.051, `so does its output (${faster.sliderText})`);
@@ -304,7 +304,7 @@ describe('Path and Steer modes', { timeout: 400_000 }, () => {
 
     // The stream kept going all along, with sound frames.
     const f0 = (await readout(page)).frame;
-    await waitUntil(page, (f) => Number(document.getElementById('steer-status').dataset.frame) > f + 20, f0, { timeout: 60_000, message: 'the stream goes on' });
+    await waitUntil(page, (f) => Number($ui('steer-status').dataset.frame) > f + 20, f0, { timeout: 60_000, message: 'the stream goes on' });
     const live = await shown(page);
     assert.equal(live.joints, 25);
     assert.ok(live.finite, 'finite positions');

@@ -235,7 +235,7 @@ describe('motion playground page', { timeout: 150_000 }, () => {
 
   test('the Export BVH button downloads the shown motion', async () => {
     await showClip();
-    const [download] = await Promise.all([page.waitForEvent('download'), page.locator('#export-btn').click()]);
+    const [download] = await Promise.all([page.waitForEvent('download'), page.locator('#export-menu-btn').click().then(() => page.locator('#export-btn').click())]);
     assert.equal(download.suggestedFilename(), '16_11.bvh');
     const file = await download.path();
     const bvh = readFileSync(file, 'utf8');
@@ -384,7 +384,7 @@ describe('motion playground page', { timeout: 150_000 }, () => {
           const data = f.base64 ? Uint8Array.from(atob(f.base64), (c) => c.charCodeAt(0)) : f.text;
           dt.items.add(new File([data], f.name));
         }
-        const target = document.querySelector('.viewer-canvas');
+        const target = $uiOne('.viewer-canvas');
         for (const type of ['dragenter', 'dragover', 'drop']) {
           target.dispatchEvent(new DragEvent(type, { dataTransfer: dt, bubbles: true, cancelable: true }));
         }
@@ -420,7 +420,7 @@ describe('motion playground page', { timeout: 150_000 }, () => {
       await drop([{ name: '07_04.bvh', text: text.bvh }]);
       await waitFrames(450);
       await drop([{ name: '16.asf', text: text.asf }]);
-      await page.waitForFunction(() => [...document.querySelectorAll('.toast.info')].some((t) => /Skeleton 16\.asf/.test(t.textContent)));
+      await page.waitForFunction(() => [...$uiAll('.toast.info')].some((t) => /Skeleton 16\.asf/.test(t.textContent)));
       assert.equal((await currentSummary()).frames, 450, 'an ASF alone does not change the scene');
       const amc12 = corpusText('cmu/amc/16_12.amc.gz');
       await drop([{ name: '16_12.amc', text: amc12 }]);
@@ -444,7 +444,7 @@ describe('motion playground page', { timeout: 150_000 }, () => {
           window.posted.push({ type: message?.type, files: Array.isArray(message?.files) ? message.files.map((f) => f.name) : undefined });
           return window.nativePostMessage.call(this, message, transfer);
         };
-        const status = document.getElementById('import-status');
+        const status = $ui('import-status');
         window.importSeen = [];
         window.importWatch = new MutationObserver(() => window.importSeen.push(status.hidden ? 'hidden' : status.dataset.stage));
         window.importWatch.observe(status, { attributes: true, attributeFilter: ['hidden', 'data-stage'] });

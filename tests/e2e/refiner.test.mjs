@@ -173,28 +173,28 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
   test('Random walk: refine toggle, side-by-side view and the skating readout', async () => {
     const status = () =>
       suite.page.evaluate(() => {
-        const s = document.getElementById('walk-status');
-        const card = document.getElementById('walk-skating');
-        const labels = [...document.querySelectorAll('.figure-label')].filter((l) => !l.hidden).map((l) => ({ text: l.textContent, box: l.getBoundingClientRect().toJSON() }));
+        const s = $ui('walk-status');
+        const card = $ui('walk-skating');
+        const labels = [...$uiAll('.figure-label')].filter((l) => !l.hidden).map((l) => ({ text: l.textContent, box: l.getBoundingClientRect().toJSON() }));
         return {
           frame: Number(s.dataset.frame),
           text: s.textContent,
           skating: { ...card.dataset },
           card: getComputedStyle(card).display,
-          rawLine: !document.getElementById('walk-skating-raw').closest('.skate-line').hidden,
-          refinedLine: !document.getElementById('walk-skating-refined').closest('.skate-line').hidden,
-          rawText: document.getElementById('walk-skating-raw').textContent,
-          refinedText: document.getElementById('walk-skating-refined').textContent,
+          rawLine: !$ui('walk-skating-raw').closest('.skate-line').hidden,
+          refinedLine: !$ui('walk-skating-refined').closest('.skate-line').hidden,
+          rawText: $ui('walk-skating-raw').textContent,
+          refinedText: $ui('walk-skating-refined').textContent,
           labels,
-          meta: document.getElementById('clip-meta').textContent,
-          sideBySide: document.getElementById('walk-side-by-side').checked,
-          refine: document.getElementById('walk-refine').checked,
+          meta: $ui('clip-meta').textContent,
+          sideBySide: $ui('walk-side-by-side').checked,
+          refine: $ui('walk-refine').checked,
         };
       });
     const waitFrame = (n, text = '') =>
       waitUntil(
         suite.page,
-        ([n, text]) => Number(document.getElementById('walk-status').dataset.frame) > n && document.getElementById('walk-status').textContent.includes(text),
+        ([n, text]) => Number($ui('walk-status').dataset.frame) > n && $ui('walk-status').textContent.includes(text),
         [n, text],
         { timeout: 90_000, message: `the walk passes frame ${n}${text ? ` (${text})` : ''}` },
       );
@@ -214,7 +214,7 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
 
     // Refine: the stream restarts refined; one figure, the refined readout.
     await suite.page.check('#walk-refine');
-    await waitUntil(suite.page, () => /refined/.test(document.getElementById('walk-status').textContent), null, { timeout: 60_000, message: 'the walk restarts refined' });
+    await waitUntil(suite.page, () => /refined/.test($ui('walk-status').textContent), null, { timeout: 60_000, message: 'the walk restarts refined' });
     await waitFrame(90, 'refined');
     s = await status();
     assert.equal(s.skating.shown, 'refined');
@@ -233,21 +233,21 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
     // The lowest stream frame shown from here on is watched: a restart would start again from 0.
     const before = s.frame;
     await suite.page.evaluate(() => {
-      const el = document.getElementById('walk-status');
+      const el = $ui('walk-status');
       window.lowestWalkFrame = Number(el.dataset.frame);
       new MutationObserver(() => (window.lowestWalkFrame = Math.min(window.lowestWalkFrame, Number(el.dataset.frame)))).observe(el, { attributes: true, attributeFilter: ['data-frame'] });
     });
     await suite.page.check('#walk-side-by-side');
     await waitUntil(
       suite.page,
-      () => /side by side/.test(document.getElementById('walk-status').textContent) && document.querySelectorAll('.figure-label:not([hidden])').length === 2,
+      () => /side by side/.test($ui('walk-status').textContent) && $uiAll('.figure-label:not([hidden])').length === 2,
       null,
       { timeout: 20_000, message: 'both figures are labelled' },
     );
     // A second of the walk side by side, with both numbers in the readout.
     await waitUntil(
       suite.page,
-      (f) => Number(document.getElementById('walk-status').dataset.frame) > f + 30 && document.getElementById('walk-skating').dataset.shown === 'both',
+      (f) => Number($ui('walk-status').dataset.frame) > f + 30 && $ui('walk-skating').dataset.shown === 'both',
       before,
       { timeout: 60_000, message: `the walk goes on side by side from frame ${before}` },
     );
@@ -269,20 +269,20 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
 
     // Side by side off: one figure again, same stream.
     await suite.page.uncheck('#walk-side-by-side');
-    await waitUntil(suite.page, () => document.querySelectorAll('.figure-label').length === 0, null, { timeout: 10_000, message: 'the labels go' });
+    await waitUntil(suite.page, () => $uiAll('.figure-label').length === 0, null, { timeout: 10_000, message: 'the labels go' });
     s = await status();
     assert.equal(s.refine, true);
     assert.equal(s.skating.shown, 'refined');
 
     // Refine off (turns side by side off too): back to the raw generator.
     await suite.page.check('#walk-side-by-side');
-    await waitUntil(suite.page, () => document.querySelectorAll('.figure-label').length === 2, null, { timeout: 10_000, message: 'both figures are labelled again' });
+    await waitUntil(suite.page, () => $uiAll('.figure-label').length === 2, null, { timeout: 10_000, message: 'both figures are labelled again' });
     await suite.page.uncheck('#walk-refine');
-    assert.equal(await suite.page.evaluate(() => document.querySelectorAll('.figure-label').length), 0, 'the raw figure goes at once');
+    assert.equal(await suite.page.evaluate(() => $uiAll('.figure-label').length), 0, 'the raw figure goes at once');
     await waitUntil(
       suite.page,
       () => {
-        const s = document.getElementById('walk-status');
+        const s = $ui('walk-status');
         return /τ/.test(s.textContent) && !/refined/.test(s.textContent) && Number(s.dataset.frame) > 30;
       },
       null,
@@ -294,6 +294,6 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
     assert.equal(s.skating.shown, 'raw');
 
     await suite.page.click('#mode-clip');
-    assert.equal(await suite.page.evaluate(() => getComputedStyle(document.getElementById('walk-skating')).display), 'none');
+    assert.equal(await suite.page.evaluate(() => getComputedStyle($ui('walk-skating')).display), 'none');
   });
 });

@@ -26,18 +26,18 @@ const worst = (a, b) => {
 
 const pathStatus = (page) =>
   page.evaluate(() => {
-    const s = document.getElementById('path-status');
+    const s = $ui('path-status');
     const m = window.playground.current();
     return {
       state: s.dataset.state, walkedBy: s.dataset.walkedBy, comparedWith: s.dataset.comparedWith, text: s.textContent,
       lines: [...s.querySelectorAll('.path-stats')].map((l) => [l.dataset.model, l.textContent]),
-      meta: document.getElementById('clip-meta').textContent, seed: document.getElementById('path-seed').value,
+      meta: $ui('clip-meta').textContent, seed: $ui('path-seed').value,
       positions: m ? Array.from(m.positions.subarray(0, 600)) : [], frames: m?.frames ?? 0,
-      labels: [...document.querySelectorAll('.figure-label')].map((l) => l.textContent),
+      labels: [...$uiAll('.figure-label')].map((l) => l.textContent),
     };
   });
 
-const choices = (page) => page.evaluate(() => [document.getElementById('steer-model').value, document.getElementById('path-model').value]);
+const choices = (page) => page.evaluate(() => [$ui('steer-model').value, $ui('path-model').value]);
 
 describe('the VAE-LSTM in Path mode', { timeout: 400_000 }, () => {
   const suite = usePlayground();
@@ -45,7 +45,7 @@ describe('the VAE-LSTM in Path mode', { timeout: 400_000 }, () => {
   test('chosen, it walks a path as soon as it is drawn; Vary draws another walk; Steer keeps a model it can steer', async () => {
     const page = suite.page;
     await page.click('#mode-path');
-    const options = await page.evaluate(() => [...document.getElementById('path-model').options].map((o) => o.value));
+    const options = await page.evaluate(() => [...$ui('path-model').options].map((o) => o.value));
     assert.deepEqual(options, ['generator', 'latent-erd', 'vae-lstm']);
     assert.equal(await page.locator('#path-vary').isHidden(), true, 'Vary is the VAE-LSTM\'s');
     await page.selectOption('#path-model', 'vae-lstm');
@@ -56,7 +56,7 @@ describe('the VAE-LSTM in Path mode', { timeout: 400_000 }, () => {
 
     await drawStroke(page, Array.from({ length: 31 }, (_, i) => [0.3 + (0.4 * i) / 30, 0.45 + 0.1 * Math.sin(i / 6)]));
     // No Go: the walk appears once the path is drawn.
-    await waitUntil(page, () => document.getElementById('path-status').dataset.state === 'done', null, { timeout: 120_000, message: 'the VAE-LSTM walks the drawn path' });
+    await waitUntil(page, () => $ui('path-status').dataset.state === 'done', null, { timeout: 120_000, message: 'the VAE-LSTM walks the drawn path' });
     const first = await pathStatus(page);
     assert.equal(first.walkedBy, 'vae-lstm');
     assert.equal(first.lines.length, 1);
@@ -69,8 +69,8 @@ describe('the VAE-LSTM in Path mode', { timeout: 400_000 }, () => {
     // Vary: the next seed, another walk of the same path.
     await page.click('#path-vary');
     await waitUntil(page, (seed) => {
-      const s = document.getElementById('path-status');
-      return s.dataset.state === 'done' && document.getElementById('path-seed').value !== seed;
+      const s = $ui('path-status');
+      return s.dataset.state === 'done' && $ui('path-seed').value !== seed;
     }, first.seed, { timeout: 120_000, message: 'Vary walks the path again' });
     const varied = await pathStatus(page);
     assert.equal(Number(varied.seed), Number(first.seed) + 1);
@@ -79,7 +79,7 @@ describe('the VAE-LSTM in Path mode', { timeout: 400_000 }, () => {
 
     // Steer runs the generator meanwhile.
     await page.click('#mode-steer');
-    await waitUntil(page, () => document.getElementById('steer-status').dataset.model === 'generator', null, { timeout: 60_000, message: 'Steer streams from the generator' });
+    await waitUntil(page, () => $ui('steer-status').dataset.model === 'generator', null, { timeout: 60_000, message: 'Steer streams from the generator' });
     await page.click('#mode-path');
     assert.deepEqual(await choices(page), ['generator', 'vae-lstm'], 'the choice stays');
     await page.click('#mode-clip');
@@ -92,7 +92,7 @@ describe('the VAE-LSTM in Path mode', { timeout: 400_000 }, () => {
     await page.selectOption('#path-compare', 'latent-erd');
     await page.click('#path-go');
     await waitUntil(page, () => {
-      const s = document.getElementById('path-status');
+      const s = $ui('path-status');
       return s.dataset.state === 'done' && s.dataset.comparedWith === 'latent-erd';
     }, null, { timeout: 180_000, message: 'both models walk the path' });
     const r = await pathStatus(page);
@@ -106,7 +106,7 @@ describe('the VAE-LSTM in Path mode', { timeout: 400_000 }, () => {
     await page.selectOption('#path-compare', '');
     await page.click('#path-go');
     await waitUntil(page, () => {
-      const s = document.getElementById('path-status');
+      const s = $ui('path-status');
       return s.dataset.state === 'done' && !s.dataset.comparedWith;
     }, null, { timeout: 120_000, message: 'one walk' });
     assert.deepEqual((await pathStatus(page)).labels, []);

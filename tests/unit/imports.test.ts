@@ -140,7 +140,8 @@ describe('web/ import graph', () => {
   const graph = importGraph();
 
   it('reads the imports (static, type-only, side-effect and worker references)', () => {
-    expect(graph.get('main.ts')).toEqual(expect.arrayContaining(['api/playground.ts', 'ui/app.ts']));
+    expect(graph.get('main.ts')).toEqual(['motion-playground.ts']); // `import './motion-playground'`
+    expect(graph.get('motion-playground.ts')).toEqual(expect.arrayContaining(['api/element.ts', 'runtime/assetBase.ts']));
     expect(graph.get('ui/app.ts')).toContain('ui/modes/host.ts'); // `import type`
     expect(graph.get('viewer/viewer.ts')).toContain('viewer/palette.ts'); // `import './palette'`
     expect(graph.get('runtime/danceClient.ts')).toContain('runtime/dance.worker.ts'); // new URL(…, import.meta.url)

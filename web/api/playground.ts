@@ -2,7 +2,9 @@
 // in step. Every method that takes user data checks it, and on bad input throws / rejects with an Error
 // whose message says what is wrong, shows the same message on the page, and leaves the scene as it was.
 
-import { exportBVH as exportBVHText } from '../motion/bvh';
+import { exportBVH as exportBVHText, type BVHExportOptions } from '../motion/bvh';
+import type { RestPose } from '../motion/restPose';
+import { exportGLB as exportGLBBytes, type GLBExportOptions } from '../motion/gltf';
 import { validateMotion } from '../motion/io';
 import type { Motion } from '../motion/types';
 import type { PlaybackState } from '../viewer/playback';
@@ -15,6 +17,7 @@ import { checkPathPoints, GroundPath } from '../optimizer/path';
 import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed, optional } from '../optimizer/options';
 import { describeValue } from '../motion/describe';
 import { loadManifest, type ModelInfo } from '../model/manifest';
+import { assetUrl } from '../runtime/assetBase';
 import { checkControlSignal } from '../model/latentErdInfo';
 import { checkPathSpeed, LATENT_PATH_SPEED } from '../runtime/latentErdRequests';
 import { checkCleanupOptions, type CleanupMethod, type CleanupStats } from '../runtime/cleanup';
@@ -167,8 +170,16 @@ export interface Playground {
   models(): ModelInfo[];
   /** Parses a BVH, or an AMC with its ASF skeleton text. Does not show it. `signal` cancels it. */
   importMotion(text: string, format: ImportFormat, asfText?: string, options?: CancellableOptions): Promise<Motion>;
-  /** BVH text of a motion (centimetres, y up, ZYX Euler channels, Frame Time = 1/fps). */
-  exportBVH(motion: Motion): string;
+  /**
+   * BVH text of a motion (centimetres, y up, ZYX Euler channels, Frame Time = 1/fps). `options.restPose`:
+   * 'clip' (default, the clip's tallest frame) or 'tpose' (a T-pose facing +z, for retargeting tools).
+   */
+  exportBVH(motion: Motion, options?: BVHExportOptions): string;
+  /**
+   * Binary glTF (GLB) of a motion: a skinned figure bound to a skeleton and one animation (root translation,
+   * joint rotations). `options.restPose`: 'tpose' (default) or 'clip'; `options.name` names it.
+   */
+  exportGLB(motion: Motion, options?: GLBExportOptions): Uint8Array<ArrayBuffer>;
   /** Shows a motion in the viewer from its first frame, playing. `name` labels it on the page. */
   show(motion: Motion, name?: string): void;
   play(): void;
@@ -281,6 +292,13 @@ function checkKeys(options: unknown, known: string[], shape: string): Record<str
     if (!known.includes(k)) throw new TypeError(`unknown option ${describeValue(k)} (known: ${known.join(', ')})`);
   }
   return options as Record<string, unknown>;
+}
+
+/** Export options (undefined: the defaults); the values themselves are checked by the exporters. */
+function checkExportOptions(options: unknown, withName: boolean): { restPose?: RestPose; name?: string } {
+  if (options === undefined) return {};
+  const keys = withName ? ['restPose', 'name'] : ['restPose'];
+  return checkKeys(options, keys, `{ restPose?: 'tpose' | 'clip'${withName ? ', name?' : ''} }`) as { restPose?: RestPose; name?: string };
 }
 
 /** Throws unless `options` are view options: layer switches true or false, framing "character" or "all". */
@@ -399,7 +417,7 @@ export function createPlayground(app: App): Playground {
   let models: ModelInfo[] = [];
   const { guarded, guardedAsync, cancellable } = errorGuards(app);
 
-  const ready = loadManifest(`${import.meta.env.BASE_URL}models/index.json`).then(
+  const ready = loadManifest(assetUrl('models/index.json')).then(
     (m) => {
       models = m;
     },
@@ -424,8 +442,11 @@ export function createPlayground(app: App): Playground {
       });
     },
 
-    exportBVH(motion) {
-      return guarded('exportBVH', () => exportBVHText(validateMotion(motion)));
+    exportBVH(motion, options) {
+      return guarded('exportBVH', () => exportBVHText(validateMotion(motion), checkExportOptions(options, false)));
+    },
+    exportGLB(motion, options) {
+      return guarded('exportGLB', () => exportGLBBytes(validateMotion(motion), checkExportOptions(options, true)));
     },
 
     show(motion, name = 'motion') {

@@ -6,6 +6,7 @@
 import type { Motion } from '../motion/types';
 import { CANCELLED_ERROR_NAME, CancelledError } from './cancellation';
 import { WORKER_ERROR_ID, type BenchmarkResult, type CancelMessage, type WorkerMessage } from './protocol';
+import { assetUrl } from './assetBase';
 
 /** Options of any request: `signal` cancels it (cancellation.ts). */
 export interface RequestOptions {
@@ -197,7 +198,7 @@ export abstract class ModelClient<P extends object, Init extends ModelSkeleton, 
   }
 }
 
-/** A model file URL resolved against the page (the worker resolves relative URLs against its own script). */
+/** A model file URL resolved against the asset base (assetBase.ts; the worker would resolve relative URLs against its own script). */
 export function pageUrl(url: string): string {
-  return new URL(url, document.baseURI).href;
+  return assetUrl(url);
 }

@@ -1,9 +1,13 @@
 // Page controller: owns the viewer, the panel and the messages; imports dropped/picked files and
-// exports the shown motion. The automation API (web/api/playground.ts) drives the same methods.
+// exports the shown motion. One per <motion-playground> element (web/api/element.ts), built inside its
+// shadow root; the automation API (web/api/playground.ts) drives the same methods.
 
 import { detectContacts } from '../motion/contacts';
 import { exportBVH } from '../motion/bvh';
+import { exportGLB } from '../motion/gltf';
+import type { RestPose } from '../motion/restPose';
 import type { Motion } from '../motion/types';
+import type { PlaybackState } from '../viewer/playback';
 import { Viewer } from '../viewer/viewer';
 import { DanceClient, type DanceInitResult } from '../runtime/danceClient';
 import { GeneratorClient, type InitResult } from '../runtime/generatorClient';
@@ -12,7 +16,9 @@ import { ImportClient } from '../runtime/importClient';
 import { VaeLstmClient, type VaeLstmInitResult } from '../runtime/vaeLstmClient';
 import { baseName, type FileImportOutcome } from '../runtime/motionFiles';
 import { ImportIndicator } from './files';
-import { $, downloadText, errorMessage } from './dom';
+import { $, downloadBlob, errorMessage, type DomScope } from './dom';
+import { Capture } from './capture';
+import { ExportMenu } from './exportMenu';
 import { BusyIndicator, ModelHost, pageThreads } from './modelHost';
 import { CleanupPanel } from './cleanupPanel';
 import { DanceMode } from './modes/danceMode';
@@ -25,14 +31,22 @@ import { SteerMode } from './modes/steerMode';
 import { Panel } from './panel';
 import { Toasts } from './toast';
 
-export type Mode = 'clip' | 'walk' | 'dance' | 'path' | 'steer';
-const MODES: Mode[] = ['clip', 'walk', 'dance', 'path', 'steer'];
+import { MODES, type Mode } from './viewState';
+export type { Mode };
+
+/** What the page tells its element (which turns them into DOM events). */
+export interface AppEvents {
+  /** A new motion is shown: a clip, a path walk, or a new live stream. */
+  motion(name: string): void;
+  /** An error message was shown. */
+  error(reason: string): void;
+}
 
 export class App implements ModeHost {
   readonly viewer: Viewer;
   readonly panel: Panel;
   readonly toasts: Toasts;
-  private readonly busy = new BusyIndicator(document.getElementById('model-status'));
+  private readonly busy = new BusyIndicator($('model-status'));
   /** The generator model, loaded on first use (playground.generate, Random walk). */
   readonly generator = new ModelHost<GeneratorClient, InitResult>(() => new GeneratorClient({ threads: pageThreads() }), this.busy);
   /** The latent ERD and its autoencoder's decoder (one worker), loaded on first use (playground.generate, followPath, simulateControl; Steer and Path modes). */
@@ -46,6 +60,16 @@ export class App implements ModeHost {
   private name = '';
   private lastErrorMessage: string | null = null;
   private readonly exportBtn = $<HTMLButtonElement>('export-btn');
+  private readonly exportGlbBtn = $<HTMLButtonElement>('export-glb-btn');
+  private readonly restPoseSelect = $<HTMLSelectElement>('rest-pose');
+  /** Snapshot and Record. */
+  readonly capture: Capture;
+  /** The header's Export menu (exports, snapshot, record). */
+  readonly exportMenu: ExportMenu;
+  private readonly clipName = $('clip-name');
+  private readonly clipMeta = $('clip-meta');
+  private readonly modeButtons = new Map(MODES.map((m) => [m, $(`mode-${m}`)]));
+  private readonly dropOverlay = $('drop-overlay');
   /** The model Steer and Path modes run (one choice for both, kept across mode switches). */
   readonly controlModel = new ModelChoice([$<HTMLSelectElement>('steer-model'), $<HTMLSelectElement>('path-model')]);
   readonly walk: RandomWalk;
@@ -54,17 +78,24 @@ export class App implements ModeHost {
   readonly steerMode: SteerMode;
   /** Clip mode's Clean up panel. */
   readonly cleanup: CleanupPanel;
+  /** Called every rendered frame with the playback state (the element's play and pause events). */
+  readonly frameListeners: ((s: PlaybackState) => void)[] = [];
   private mode: Mode = 'clip';
   /** The clip shown before another mode (Random walk, Dance, Path, Steer), restored when switching back. */
   private clip: { motion: Motion; name: string } | null = null;
 
-  constructor() {
+  /** Build it inside `buildIn(scope, …)` (dom.ts): its parts look up their elements in `scope` as they are made. */
+  constructor(
+    private readonly scope: DomScope,
+    private readonly events: AppEvents,
+  ) {
     this.viewer = new Viewer($('stage'));
     this.panel = new Panel(this.viewer);
     this.toasts = new Toasts($('toasts'));
     this.viewer.onFrame = (s) => {
       this.panel.update(s);
       if (this.mode === 'clip') this.cleanup?.frame(s);
+      for (const listener of this.frameListeners) listener(s);
     };
 
     const input = $<HTMLInputElement>('file-input');
@@ -74,7 +105,10 @@ export class App implements ModeHost {
       input.value = '';
       if (files.length) void this.handleFiles(files);
     });
-    this.exportBtn.addEventListener('click', () => this.exportCurrent());
+    this.exportBtn.addEventListener('click', () => this.exportCurrent('bvh'));
+    this.exportGlbBtn.addEventListener('click', () => this.exportCurrent('glb'));
+    this.capture = new Capture(this);
+    this.exportMenu = new ExportMenu();
     this.installDropZone();
 
     this.walk = new RandomWalk(this);
@@ -83,7 +117,7 @@ export class App implements ModeHost {
     this.steerMode = new SteerMode(this);
     this.cleanup = new CleanupPanel(this);
     for (const m of MODES) {
-      $(`mode-${m}`).addEventListener('click', () => this.setMode(m));
+      this.modeButtons.get(m)!.addEventListener('click', () => this.setMode(m));
       const live = this.liveMode(m);
       if (live) live.onFailed = () => this.setMode('clip');
     }
@@ -116,8 +150,8 @@ export class App implements ModeHost {
     if (mode === this.mode) return;
     const previous = this.mode;
     this.mode = mode;
-    for (const m of MODES) $(`mode-${m}`).setAttribute('aria-pressed', String(mode === m));
-    for (const m of MODES) document.body.classList.toggle(`${m}-mode`, mode === m);
+    for (const m of MODES) this.modeButtons.get(m)!.setAttribute('aria-pressed', String(mode === m));
+    for (const m of MODES) this.scope.frame.classList.toggle(`${m}-mode`, mode === m);
     this.liveMode(previous)?.stop();
     if (previous === 'clip') this.cleanup.leave();
     if (previous === 'path') this.pathMode.leave();
@@ -153,16 +187,17 @@ export class App implements ModeHost {
 
   /** The title line in a live mode. */
   setLiveLabel(name: string, meta: string): void {
-    $('clip-name').textContent = name;
-    $('clip-meta').textContent = ` ${meta}`;
+    this.clipName.textContent = name;
+    this.clipMeta.textContent = ` ${meta}`;
   }
 
   /** A live mode: shows the current window of streamed frames (`dropped` < 0: a new stream); `name` names exports. */
   showLive(motion: Motion, dropped: number, name: string): void {
     this.viewer.setLive(motion, motion.contacts, dropped);
     this.name = name;
-    this.exportBtn.disabled = false;
-    document.body.classList.add('has-motion');
+    this.exportBtn.disabled = this.exportGlbBtn.disabled = false;
+    this.scope.frame.classList.add('has-motion');
+    if (dropped < 0) this.events.motion(name);
   }
 
   syncLayers(): void {
@@ -173,10 +208,10 @@ export class App implements ModeHost {
   clearMotion(): void {
     this.viewer.clear();
     this.name = '';
-    this.exportBtn.disabled = true;
-    document.body.classList.remove('has-motion');
-    $('clip-name').textContent = 'No motion';
-    $('clip-meta').textContent = '';
+    this.exportBtn.disabled = this.exportGlbBtn.disabled = true;
+    this.scope.frame.classList.remove('has-motion');
+    this.clipName.textContent = 'No motion';
+    this.clipMeta.textContent = '';
   }
 
   get current(): Motion | null {
@@ -191,6 +226,7 @@ export class App implements ModeHost {
   reportError(message: string): void {
     this.lastErrorMessage = message;
     this.toasts.show(message, 'error');
+    this.events.error(message);
   }
 
   note(message: string): void {
@@ -220,20 +256,43 @@ export class App implements ModeHost {
     }
     this.viewer.setMotion(motion, contacts);
     this.name = name;
-    this.exportBtn.disabled = false;
-    document.body.classList.add('has-motion');
+    this.exportBtn.disabled = this.exportGlbBtn.disabled = false;
+    this.scope.frame.classList.add('has-motion');
     const secs = (motion.frames - 1) / motion.fps;
-    $('clip-name').textContent = name;
-    $('clip-meta').textContent =
+    this.clipName.textContent = name;
+    this.clipMeta.textContent =
       `${motion.joints.length} joints · ${motion.frames} frames · ${+motion.fps.toFixed(2)} fps · ${secs.toFixed(1)} s` +
       (this.viewer.footprintCount ? ` · ${this.viewer.footprintCount} steps` : '');
+    this.events.motion(name);
   }
 
-  exportCurrent(): void {
+  /** The base of download names: the shown motion's name without its extension ("motion" when it has none). */
+  exportName(): string {
+    return baseName(this.name) || 'motion';
+  }
+
+  /**
+   * Downloads the shown motion as BVH or GLB with the footer's rest pose. A T-pose the skeleton cannot be
+   * given (legs or arms that cannot be named) falls back to the clip's own rest pose, with a note saying so.
+   */
+  exportCurrent(format: 'bvh' | 'glb'): void {
     const m = this.current;
     if (!m) return;
+    const write = (restPose: RestPose) =>
+      format === 'bvh'
+        ? new Blob([exportBVH(m, { restPose })], { type: 'text/plain' })
+        : new Blob([exportGLB(m, { restPose, name: this.exportName() })], { type: 'model/gltf-binary' });
+    const chosen = this.restPoseSelect.value as RestPose;
     try {
-      downloadText(`${baseName(this.name) || 'motion'}.bvh`, exportBVH(m), 'text/plain');
+      let blob: Blob;
+      try {
+        blob = write(chosen);
+      } catch (e) {
+        if (chosen !== 'tpose' || !/T-pose/.test(errorMessage(e))) throw e;
+        blob = write('clip');
+        this.note(`${errorMessage(e)}; exported with the clip's own rest pose instead`);
+      }
+      downloadBlob(`${this.exportName()}.${format}`, blob);
     } catch (e) {
       this.reportError(`Export failed: ${errorMessage(e)}`);
     }
@@ -261,26 +320,28 @@ export class App implements ModeHost {
   }
 
   private installDropZone(): void {
-    const overlay = $('drop-overlay');
+    // On the element's own area: several elements on a page each take the files dropped on them.
+    const overlay = this.dropOverlay;
+    const zone = this.scope.frame;
     let depth = 0;
     const hasFiles = (e: DragEvent) => !!e.dataTransfer && [...e.dataTransfer.types].includes('Files');
-    window.addEventListener('dragenter', (e) => {
+    zone.addEventListener('dragenter', (e) => {
       if (!hasFiles(e)) return;
       e.preventDefault();
       depth++;
       overlay.classList.add('visible');
     });
-    window.addEventListener('dragover', (e) => {
+    zone.addEventListener('dragover', (e) => {
       if (!hasFiles(e)) return;
       e.preventDefault();
       e.dataTransfer!.dropEffect = 'copy';
     });
-    window.addEventListener('dragleave', (e) => {
+    zone.addEventListener('dragleave', (e) => {
       if (!hasFiles(e)) return;
       depth = Math.max(0, depth - 1);
       if (depth === 0) overlay.classList.remove('visible');
     });
-    window.addEventListener('drop', (e) => {
+    zone.addEventListener('drop', (e) => {
       if (!e.dataTransfer) return;
       e.preventDefault();
       depth = 0;

@@ -23,7 +23,7 @@ import type { LatentErdClient } from '../runtime/latentErdClient';
 import { baseName } from '../runtime/motionFiles';
 import type { PlaybackState } from '../viewer/playback';
 import { AnglePlot } from './anglePlot';
-import { $, downloadText, errorMessage, setSliderFill } from './dom';
+import { $, $all, downloadText, errorMessage, setSliderFill } from './dom';
 import type { ModeHost } from './modes/host';
 
 /** What each method does, in one line under the select. */
@@ -91,7 +91,12 @@ export class CleanupPanel {
   private readonly readout = $('cleanup-readout');
   private readonly jointSelect = $<HTMLSelectElement>('cleanup-joint');
   private readonly exportBtn = $<HTMLButtonElement>('cleanup-export');
-  private readonly originalLegend = document.querySelector<HTMLElement>('#cleanup-body .legend-original')!;
+  private readonly jitterOut = $('cleanup-jitter-out');
+  private readonly outliersOut = $('cleanup-outliers-out');
+  private readonly driftOut = $('cleanup-drift-out');
+  /** The readout's cells by id (cleanup-input-jerk …). */
+  private readonly cells = new Map($all('#cleanup-readout td').map((td) => [td.id, td]));
+  private readonly originalLegend = $all('#cleanup-body .legend-original')[0];
   private readonly plot = new AnglePlot($<HTMLCanvasElement>('cleanup-plot'), $('cleanup-playhead'));
 
   private session: Session | null = null;
@@ -208,9 +213,9 @@ export class CleanupPanel {
 
   private showNoise(): void {
     const o = this.noiseOptions();
-    $('cleanup-jitter-out').textContent = `${+(o.jitter * 100).toFixed(1)} cm`;
-    $('cleanup-outliers-out').textContent = `${+(o.outliers * 100).toFixed(1)} %`;
-    $('cleanup-drift-out').textContent = `${o.drift.toFixed(2)} m/s`;
+    this.jitterOut.textContent = `${+(o.jitter * 100).toFixed(1)} cm`;
+    this.outliersOut.textContent = `${+(o.outliers * 100).toFixed(1)} %`;
+    this.driftOut.textContent = `${o.drift.toFixed(2)} m/s`;
     for (const el of [this.jitter, this.outliers, this.drift]) {
       setSliderFill(el, (Number(el.value) - Number(el.min)) / (Number(el.max) - Number(el.min)));
     }
@@ -389,7 +394,7 @@ export class CleanupPanel {
   private showNumbers(): void {
     const s = this.session;
     const cell = (id: string, v: number | undefined, digits: number, scale = 1) => {
-      const el = $(id);
+      const el = this.cells.get(id)!;
       el.textContent = v === undefined ? '—' : fmt(v * scale, digits);
     };
     let input: CleanupNumbers | undefined, cleaned: CleanupNumbers | undefined;

@@ -1,11 +1,48 @@
-// Small helpers the page's ui files share: looking up index.html's elements, making elements, slider
+// Small helpers the page's ui files share: looking up the template's elements, making elements, slider
 // fills, reading seed fields, the text of a caught error for the page's messages, and offering a text as a download.
 
-/** The element with this id in index.html (a missing one is a bug in the page, so it throws). */
+/**
+ * Where the page's UI classes find their elements: the <motion-playground> element's shadow root, and
+ * whether a key or file drop is this element's (several elements on one page each take their own).
+ * Set while App builds its parts (buildIn); the classes look up every element they need then.
+ */
+export interface DomScope {
+  root: ShadowRoot;
+  /** The wrapper whose classes say the mode and state (style.css's `.app.walk-mode` …). */
+  frame: HTMLElement;
+  /** Whether a keyboard event is for this element: from inside it, or on the bare page when it owns the page. */
+  ownsEvent(e: Event): boolean;
+}
+
+let building: DomScope | null = null;
+
+/** Runs `build` with `scope` as the place `$` looks (App's constructor). */
+export function buildIn<T>(scope: DomScope, build: () => T): T {
+  const outer = building;
+  building = scope;
+  try {
+    return build();
+  } finally {
+    building = outer;
+  }
+}
+
+/** The scope being built (a UI class keeps it when it needs to check events later). */
+export function currentScope(): DomScope {
+  if (!building) throw new Error('the page UI looks up its elements while it is built (inside buildIn)');
+  return building;
+}
+
+/** The element with this id in the playground's template (a missing one is a bug in the page, so it throws). */
 export function $<T extends HTMLElement = HTMLElement>(id: string): T {
-  const el = document.getElementById(id);
-  if (!el) throw new Error(`missing #${id} in index.html`);
+  const el = currentScope().root.getElementById(id);
+  if (!el) throw new Error(`missing #${id} in the playground's template (web/ui/playground.html)`);
   return el as T;
+}
+
+/** Every element matching `selector` in the scope being built. */
+export function $all<T extends HTMLElement = HTMLElement>(selector: string): T[] {
+  return [...currentScope().root.querySelectorAll<T>(selector)];
 }
 
 /** A new element with a class and, optionally, its text. */
@@ -36,7 +73,12 @@ export function errorMessage(e: unknown): string {
 
 /** Offers a text as a file download. */
 export function downloadText(fileName: string, text: string, mime = 'text/plain'): void {
-  const url = URL.createObjectURL(new Blob([text], { type: mime }));
+  downloadBlob(fileName, new Blob([text], { type: mime }));
+}
+
+/** Offers a blob (an image, a video, a binary export) as a file download. */
+export function downloadBlob(fileName: string, blob: Blob): void {
+  const url = URL.createObjectURL(blob);
   const a = document.createElement('a');
   a.href = url;
   a.download = fileName;

@@ -2,7 +2,7 @@
 
 import type { Viewer, ViewerLayers } from '../viewer/viewer';
 import type { PlaybackState } from '../viewer/playback';
-import { $, setSliderFill } from './dom';
+import { $, $all, currentScope, setSliderFill, type DomScope } from './dom';
 
 export class Panel {
   private readonly playBtn = $<HTMLButtonElement>('play-btn');
@@ -12,6 +12,8 @@ export class Panel {
   private readonly speed = $<HTMLInputElement>('speed');
   private readonly speedOut = $('speed-out');
   private readonly fpsOut = $('fps-out');
+  private readonly layerButtons = $all<HTMLButtonElement>('[data-layer]');
+  private readonly scope: DomScope = currentScope();
   private scrubbing = false;
   private wasPlaying = false;
   private shown = { frame: -1, frames: -1, playing: false, speed: -1, fps: -1 };
@@ -37,7 +39,7 @@ export class Panel {
     this.timeline.addEventListener('input', () => viewer.seek(Number(this.timeline.value)));
     this.speed.addEventListener('input', () => viewer.setSpeed(Number(this.speed.value)));
 
-    document.querySelectorAll<HTMLButtonElement>('[data-layer]').forEach((btn) => {
+    this.layerButtons.forEach((btn) => {
       const layer = btn.dataset.layer as keyof ViewerLayers;
       btn.addEventListener('click', () => {
         viewer.setLayers({ [layer]: !viewer.layers()[layer] });
@@ -55,14 +57,14 @@ export class Panel {
 
   syncLayers(): void {
     const l = this.viewer.layers();
-    document.querySelectorAll<HTMLButtonElement>('[data-layer]').forEach((btn) => {
+    this.layerButtons.forEach((btn) => {
       btn.setAttribute('aria-pressed', String(l[btn.dataset.layer as keyof ViewerLayers]));
     });
   }
 
   private onKey(e: KeyboardEvent): void {
-    if (e.defaultPrevented || e.altKey || e.ctrlKey || e.metaKey) return;
-    const t = e.target as HTMLElement | null;
+    if (e.defaultPrevented || e.altKey || e.ctrlKey || e.metaKey || !this.scope.ownsEvent(e)) return;
+    const t = (e.composedPath()[0] ?? e.target) as HTMLElement | null; // inside the shadow root, not the host
     if (t && (t.tagName === 'TEXTAREA' || t.tagName === 'SELECT' || (t.tagName === 'INPUT' && (t as HTMLInputElement).type !== 'range'))) return;
     // Arrow keys on a focused slider (speed, the modes' and the Clean up panel's settings) move it, as a slider's should.
     if (t instanceof HTMLInputElement && t.type === 'range' && t !== this.timeline && e.key.startsWith('Arrow')) return;

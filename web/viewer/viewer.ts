@@ -359,6 +359,12 @@ export class Viewer {
   }
 
   /** Asks for a render: for things other modules add to the scene (ground overlays). */
+  /** Draws the scene now (so the canvas holds a fresh image for toBlob or a capture stream in this task). */
+  renderNow(): void {
+    this.renderer.render(this.scene, this.camera);
+    this.placeLabels();
+  }
+
   invalidate(): void {
     this.dirty = true;
   }

@@ -47,11 +47,29 @@ export class DanceMode extends LiveMode<DanceMotion> {
     this.style.value = keep;
   }
 
+  /**
+   * The style and seed the next dance starts with (a link, the element's attributes), before the model
+   * has listed its own: kept when the model has the style; the seed counts modulo the style's seed motions.
+   */
+  preset(style: string | undefined, seed: number | undefined): void {
+    if (style !== undefined) this.style.replaceChildren(new Option(style, style));
+    if (seed !== undefined) {
+      this.seed.replaceChildren(new Option(String(seed), String(seed)));
+      this.seed.dataset.style = this.style.value;
+    }
+    this.restartIfActive();
+  }
+
+  /** The style and seed motion shown in the selectors (the seed as the API's `seed`). */
+  get choice(): { model: string; style: string; seed: number } {
+    return { model: this.model.value, style: this.style.value, seed: Number(this.seed.value) || 0 };
+  }
+
   /** The seed selector lists the seed motions of the selected style; option value = the API's `seed`. */
   private listSeeds(info: DanceInitResult, selected: number): void {
     const names = info.seeds.filter((s) => s.style === this.style.value).map((s) => s.name);
     this.seed.replaceChildren(...names.map((name, i) => new Option(name, String(i))));
-    this.seed.value = String(selected < names.length ? selected : 0);
+    this.seed.value = String(names.length ? selected % names.length : 0);
     this.seed.dataset.style = this.style.value;
   }
 

@@ -114,6 +114,8 @@ export class PathMode {
   /** The stroke being drawn. */
   private stroke: { id: number; points: Point[]; x: number; y: number; moved: boolean; follow: boolean } | null = null;
   private followBefore = true;
+  /** A path was given (setPath) and is walked when the mode is entered. */
+  private walkPending = false;
   private readonly raycaster = new THREE.Raycaster();
   private readonly plane = new THREE.Plane(new THREE.Vector3(0, 1, 0), 0);
   private readonly hit = new THREE.Vector3();
@@ -166,6 +168,7 @@ export class PathMode {
       this.app.syncLayers();
     }
     this.showState();
+    this.walkGiven();
   }
 
   leave(): void {
@@ -327,6 +330,33 @@ export class PathMode {
     this.line.set(r && r.points === this.points ? r.path : flat(this.points));
     this.hint.hidden = this.points.length > 0 || r !== null;
     this.app.viewer.invalidate();
+  }
+
+  /** The drawn path, [x, z] per point (empty: none). */
+  get path(): Point[] {
+    return this.points.map(([x, z]) => [x, z]);
+  }
+
+  /**
+   * A path given rather than drawn (a link, the element's `path` attribute): shown, and walked at once
+   * when the mode is on (else when it is entered, by `walkGiven`).
+   */
+  setPath(points: Point[]): void {
+    this.cancelOptimisation();
+    this.points = points.map(([x, z]): Point => [x, z]);
+    this.result = null;
+    this.walkPending = true;
+    if (this.active) this.walkGiven();
+  }
+
+  /** Walks a given path once the mode is on. */
+  private walkGiven(): void {
+    if (!this.walkPending) return;
+    this.walkPending = false;
+    this.line.set(flat(this.points));
+    this.hint.hidden = true;
+    this.app.viewer.frameGround(flat(this.points), RISE);
+    void this.go();
   }
 
   private clear(): void {

@@ -12,7 +12,7 @@ import { angleDifference } from '../../optimizer/path';
 import type { GeneratorClient } from '../../runtime/generatorClient';
 import type { LatentErdClient } from '../../runtime/latentErdClient';
 import { GroundArrow, TARGET_COLOR } from '../../viewer/groundPath';
-import { $, setSliderFill } from '../dom';
+import { $, currentScope, setSliderFill } from '../dom';
 import type { ModeHost } from './host';
 import { LiveMode, type LiveChunk, type LiveStream } from './liveMode';
 import { CONTROL_MODEL_SHORT, type ControlModelId } from './modelChoice';
@@ -80,6 +80,8 @@ export class SteerMode extends LiveMode<SteerChunk> {
   private readonly headingText = $('steer-heading');
   private readonly joystick = $('steer-joystick');
   private readonly knob = $('steer-knob');
+  private readonly statusLine = $('steer-status');
+  private readonly scope = currentScope();
   private readonly arrow = new GroundArrow(TARGET_COLOR, 0.85);
   private client: GeneratorClient | LatentErdClient | undefined;
   /** The model of the stream running (the choice when it started). */
@@ -181,7 +183,7 @@ export class SteerMode extends LiveMode<SteerChunk> {
 
   protected async open(signal: AbortSignal): Promise<LiveStream<SteerChunk>> {
     const model = (this.model = this.app.controlModel.steerable);
-    $('steer-status').dataset.model = model;
+    this.statusLine.dataset.model = model;
     const started = model === 'latent-erd' ? await this.openLatent(signal) : await this.openGenerator(signal);
     // The stream starts at the origin facing +z, at the slider's speed.
     this.heading = 0;
@@ -276,10 +278,10 @@ export class SteerMode extends LiveMode<SteerChunk> {
   // ---------- inputs ----------
 
   private onKey(e: KeyboardEvent, down: boolean): void {
-    if (!this.running || e.altKey || e.ctrlKey || e.metaKey) return;
+    if (!this.running || e.altKey || e.ctrlKey || e.metaKey || (down && !this.scope.ownsEvent(e))) return; // a release always lets go
     const key = KEYS[e.key];
     if (!key) return;
-    const t = e.target as HTMLElement | null;
+    const t = (e.composedPath()[0] ?? e.target) as HTMLElement | null; // inside the shadow root, not the host
     // Typing in a number field keeps its keys.
     if (t && (t.tagName === 'TEXTAREA' || (t.tagName === 'INPUT' && !['range', 'checkbox', 'button'].includes((t as HTMLInputElement).type)))) return;
     e.preventDefault();

@@ -1,0 +1,67 @@
+import { describe, expect, test } from 'vitest';
+import { embedSnippet, parseView, parseViewValue, viewQuery } from '../../web/ui/viewState';
+import { checkSourceUrl, fetchMotionSource, MAX_SOURCE_BYTES } from '../../web/runtime/motionSource';
+
+describe('view state (attributes and links)', () => {
+  test('reads every setting and writes it back the same', () => {
+    const q = new URLSearchParams('mode=path&model=vae-lstm&seed=7&path=0,0;4,2.5;8,0');
+    const { view, errors } = parseView((k) => q.get(k));
+    expect(errors).toEqual([]);
+    expect(view).toEqual({ mode: 'path', model: 'vae-lstm', seed: 7, path: [[0, 0], [4, 2.5], [8, 0]] });
+    const again = new URLSearchParams(viewQuery(view));
+    expect(parseView((k) => again.get(k)).view).toEqual(view);
+  });
+
+  test('refuses bad values with a reason and keeps the rest', () => {
+    const q = new URLSearchParams('mode=fly&seed=-1&temperature=9&refine=maybe&style=<b>x</b>&path=1,2,3');
+    const { view, errors } = parseView((k) => q.get(k));
+    expect(view).toEqual({});
+    expect(errors).toHaveLength(6);
+    expect(errors[0]).toMatch(/^mode="fly": must be one of clip, walk, dance, path, steer$/);
+    expect(errors.join('\n')).toMatch(/seed="-1": must be a whole number/);
+    expect(errors.join('\n')).toMatch(/temperature="9": must be a number from 0 to 1.5/);
+    expect(errors.join('\n')).toMatch(/refine="maybe"/);
+    expect(errors.join('\n')).toMatch(/style="<b>x<\/b>": must be a dance style name/);
+    expect(errors.join('\n')).toMatch(/path="1,2,3": must be x,z pairs/);
+  });
+
+  test('a model the mode does not have is refused', () => {
+    const { view, errors } = parseView((k) => ({ mode: 'steer', model: 'vae-lstm' })[k as 'mode'] ?? null);
+    expect(view).toEqual({ mode: 'steer' });
+    expect(errors).toEqual(['model="vae-lstm": steer mode shows generator, latent-erd']);
+  });
+
+  test('a path too short or too far is refused by the path rules', () => {
+    expect(parseViewValue('path', '0,0')).toMatchObject({ error: expect.stringMatching(/^path="0,0": /) });
+    expect(parseViewValue('path', '0,0;99999,0')).toMatchObject({ error: expect.stringMatching(/10000/) });
+    expect(parseViewValue('path', 'x'.repeat(5000))).toMatchObject({ error: expect.stringMatching(/too long/) });
+  });
+
+  test('the embed snippet escapes what it quotes', () => {
+    const s = embedSnippet({ mode: 'dance', style: 'salsa', seed: 3 }, 'https://example.org/a"b/motion-playground.js');
+    expect(s).toContain('src="https://example.org/a&quot;b/motion-playground.js"');
+    expect(s).toContain('<motion-playground mode="dance" dance-style="salsa" seed="3" autoplay camera-controls controls="minimal"');
+  });
+});
+
+describe('the element src fetch', () => {
+  const page = 'https://site.example/demo/index.html';
+  test('only the page origin or an allowed one, over http(s)', () => {
+    expect(checkSourceUrl('clips/a.bvh', page, []).href).toBe('https://site.example/demo/clips/a.bvh');
+    expect(() => checkSourceUrl('https://other.example/a.bvh', page, [])).toThrow(/https:\/\/other.example is not this page's origin/);
+    expect(checkSourceUrl('https://other.example/a.bvh', page, ['https://other.example']).origin).toBe('https://other.example');
+    expect(() => checkSourceUrl('javascript:alert(1)', page, [])).toThrow(/only http\(s\)/);
+    expect(() => checkSourceUrl('data:text/plain,HIERARCHY', page, ['data:'])).toThrow(/only http\(s\)/);
+  });
+
+  test('reads the text, gunzips, and stops at the size limit', async () => {
+    const text = 'HIERARCHY\nROOT Hips\n';
+    const plain = await fetchMotionSource('a.bvh', page, [], async () => new Response(text));
+    expect(plain).toBe(text);
+    const zipped = new Uint8Array(await new Response(new Blob([text]).stream().pipeThrough(new CompressionStream('gzip'))).arrayBuffer());
+    expect(await fetchMotionSource('a.bvh.gz', page, [], async () => new Response(zipped))).toBe(text);
+    const big = new Response(new Uint8Array(MAX_SOURCE_BYTES + 1));
+    await expect(fetchMotionSource('a.bvh', page, [], async () => big)).rejects.toThrow(/larger than the 33 MB limit/);
+    await expect(fetchMotionSource('a.bvh', page, [], async () => new Response('no', { status: 404 }))).rejects.toThrow(/HTTP 404/);
+  });
+});

@@ -1,0 +1,508 @@
+// The <motion-playground> custom element, after the conventions of Google's <model-viewer>: the whole
+// playground (viewer, modes, panels, workers) in a shadow root, configured by attributes, with events
+// and the window.playground API on the element. The page itself is one of these (web/index.html), so
+// embeds and the page share one code path. Attributes and link parameters are checked by viewState.ts;
+// a bad one fires `error` with the reason and the setting keeps its default.
+
+import css from '../style.css?inline';
+import templateHtml from '../ui/playground.html?raw';
+import { createPlayground, type GenerateOptions, type Playground } from './playground';
+import type { BVHExportOptions } from '../motion/bvh';
+import type { GLBExportOptions } from '../motion/gltf';
+import type { Motion } from '../motion/types';
+import { App } from '../ui/app';
+import { buildIn, errorMessage, type DomScope } from '../ui/dom';
+import { embedSnippet, FIRST_VIEW, formatViewValue, parseView, parseViewValue, viewQuery, VIEW_KEYS, type Mode, type ViewKey, type ViewState } from '../ui/viewState';
+import { fetchMotionSource } from '../runtime/motionSource';
+import { isControlModel } from '../ui/modes/modelChoice';
+
+const OTHER_ATTRIBUTES = ['src', 'autoplay', 'camera-controls', 'controls', 'poster', 'loading', 'link'] as const;
+const CONTROLS = ['full', 'minimal', 'none'] as const;
+type Controls = (typeof CONTROLS)[number];
+
+/** What the element fires: `error` and `progress` carry a detail, `motion` the shown motion's name. */
+export type PlaygroundEventName = 'load' | 'error' | 'progress' | 'play' | 'pause' | 'motion';
+
+export class MotionPlaygroundElement extends HTMLElement {
+  static readonly observedAttributes = [...VIEW_KEYS, 'dance-style', ...OTHER_ATTRIBUTES];
+
+  private readonly shadow: ShadowRoot;
+  private readonly frame: HTMLElement;
+  private readonly posterImage: HTMLImageElement;
+  private app: App | null = null;
+  private api: Playground | null = null;
+  private lazyObserver: IntersectionObserver | null = null;
+  private readonly started: Promise<void>;
+  private markStarted!: () => void;
+  /** Set while the element writes its own attributes (reflecting the UI): no re-apply. */
+  private reflecting = false;
+  private wasPlaying = false;
+  private linkTimer = 0;
+  /** Bumped for every `src` load: a slower earlier one does not replace a later one. */
+  private srcToken = 0;
+
+  constructor() {
+    super();
+    this.shadow = this.attachShadow({ mode: 'open' });
+    const style = document.createElement('style');
+    style.textContent = css;
+    // The template is the element's own static markup (never anything from a file, attribute or URL).
+    const template = document.createElement('template');
+    template.innerHTML = templateHtml;
+    this.shadow.append(style, template.content.cloneNode(true));
+    this.frame = this.shadow.querySelector<HTMLElement>('.app')!;
+    this.posterImage = this.shadow.querySelector<HTMLImageElement>('.poster')!;
+    this.started = new Promise((resolve) => (this.markStarted = resolve));
+  }
+
+  // ---------- lifecycle ----------
+
+  connectedCallback(): void {
+    this.showControls();
+    this.showPoster();
+    if (this.app || this.lazyObserver) return;
+    if (this.getAttribute('loading') === 'lazy' && 'IntersectionObserver' in window) {
+      // Nothing is fetched (onnxruntime-web, models) until the element comes near the viewport.
+      this.lazyObserver = new IntersectionObserver((entries) => {
+        if (entries.some((e) => e.isIntersecting)) this.start();
+      }, { rootMargin: '200px' });
+      this.lazyObserver.observe(this);
+    } else {
+      this.start();
+    }
+  }
+
+  disconnectedCallback(): void {
+    this.lazyObserver?.disconnect();
+    this.lazyObserver = null;
+  }
+
+  attributeChangedCallback(name: string, before: string | null, after: string | null): void {
+    if (this.reflecting || before === after) return;
+    if (name === 'controls') return this.showControls();
+    if (name === 'poster') return this.showPoster();
+    if (name === 'camera-controls' && this.app) this.app.viewer.controls.enabled = after !== null;
+    if (!this.app || !this.api) return; // applied when it starts
+    if (name === 'src') {
+      void this.loadSource();
+      return;
+    }
+    if ((VIEW_KEYS as readonly string[]).includes(name) || name === 'dance-style') void this.api.ready.then(() => this.applyView(this.attributeView(), false));
+  }
+
+  /** Builds the playground (once): its UI in the shadow root, its workers, the API, the view. */
+  private start(): void {
+    if (this.app) return;
+    this.lazyObserver?.disconnect();
+    this.lazyObserver = null;
+    const scope: DomScope = { root: this.shadow, frame: this.frame, ownsEvent: (e) => this.ownsEvent(e) };
+    const app = buildIn(scope, () => new App(scope, {
+      motion: (name) => {
+        this.posterImage.hidden = true;
+        this.fire('motion', { name, frames: app.current?.frames ?? 0 });
+        this.linkSoon();
+      },
+      error: (reason) => this.fire('error', { reason }),
+    }));
+    this.app = app;
+    this.api = createPlayground(app);
+    const version = this.shadow.getElementById('version');
+    if (version) version.textContent = `v${this.api.version}`;
+    app.viewer.controls.enabled = this.hasAttribute('camera-controls');
+    app.frameListeners.push((s) => {
+      if (s.playing !== this.wasPlaying) {
+        this.wasPlaying = s.playing;
+        this.fire(s.playing ? 'play' : 'pause');
+      }
+    });
+    this.watchProgress();
+    this.shadow.addEventListener('change', () => this.linkSoon());
+    for (const m of ['clip', 'walk', 'dance', 'path', 'steer']) this.shadow.getElementById(`mode-${m}`)?.addEventListener('click', () => this.linkSoon());
+    this.installShare();
+    this.markStarted();
+    void this.api.ready.then(async () => {
+      const fromLink = this.hasAttribute('link') ? this.linkView() : null;
+      const attrs = this.attributeView();
+      const hasAny = VIEW_KEYS.some((k) => this.hasAttribute(k)) || this.hasAttribute('src') || (fromLink !== null && Object.keys(fromLink).length > 0);
+      const view = { ...(hasAny ? {} : FIRST_VIEW), ...attrs, ...(fromLink ?? {}) };
+      if (this.hasAttribute('src') && view.mode === undefined) view.mode = 'clip';
+      this.applyView(view, true);
+      if (this.hasAttribute('src')) await this.loadSource();
+      this.fire('load');
+    });
+  }
+
+  // ---------- views: attributes, links, the UI ----------
+
+  /** The view the attributes ask for (bad ones fire `error` and are left out). */
+  private attributeView(): ViewState {
+    const { view, errors } = parseView((k) => (k === 'style' ? this.danceStyleAttribute() : this.getAttribute(k)));
+    for (const reason of errors) this.fire('error', { reason: `attribute ${reason}` });
+    return view;
+  }
+
+  /**
+   * The dance style: `dance-style`, or `style` when it holds a bare style name (`style="salsa"`), since
+   * `style` is also HTML's inline CSS attribute (a value with a colon is CSS and left to the browser).
+   */
+  private danceStyleAttribute(): string | null {
+    const named = this.getAttribute('dance-style');
+    if (named !== null) return named;
+    const style = this.getAttribute('style');
+    return style !== null && /^\s*[a-z][a-z0-9_-]*\s*$/.test(style) ? style.trim() : null;
+  }
+
+  /** The view in the page's URL (query or hash), when the element keeps the link. */
+  private linkView(): ViewState {
+    const params = new URLSearchParams(location.search || location.hash.replace(/^#/, ''));
+    const { view, errors } = parseView((k) => params.get(k));
+    for (const reason of errors) {
+      this.app?.reportError(`Link: ${reason}; using the default`);
+    }
+    return view;
+  }
+
+  /** Applies a view to the UI: each mode's settings first, then the mode (so a stream starts with them). */
+  private applyView(view: ViewState, initial: boolean): void {
+    const app = this.app!;
+    const models = this.api!.models();
+    const mode: Mode = view.mode ?? (initial ? 'clip' : app.currentMode);
+    const control = <T extends HTMLElement>(id: string) => this.shadow.getElementById(id) as T;
+    const set = (id: string, value: string | boolean) => {
+      const el = control<HTMLInputElement | HTMLSelectElement>(id);
+      if (el instanceof HTMLInputElement && el.type === 'checkbox') el.checked = value as boolean;
+      else el.value = String(value);
+      el.dispatchEvent(new Event('input', { bubbles: true }));
+      el.dispatchEvent(new Event('change', { bubbles: true }));
+    };
+    if (mode === 'walk') {
+      if (view.temperature !== undefined) set('walk-temperature', String(view.temperature));
+      if (view.seed !== undefined) set('walk-seed', String(view.seed));
+      if (view.refine !== undefined) set('walk-refine', view.refine);
+    } else if (mode === 'dance') {
+      if (view.model !== undefined) control<HTMLSelectElement>('dance-model').value = view.model;
+      const id = control<HTMLSelectElement>('dance-model').value;
+      const styles = models.find((m) => m.id === id)?.styles ?? [];
+      let style = view.style;
+      if (style !== undefined && styles.length && !styles.includes(style)) {
+        this.fire('error', { reason: `style=${JSON.stringify(style)}: ${id} dances ${styles.join(', ')}` });
+        style = undefined;
+      }
+      app.danceMode.preset(style, view.seed);
+    } else if (mode === 'path' || mode === 'steer') {
+      if (view.model !== undefined && isControlModel(view.model)) app.controlModel.set(view.model);
+      if (mode === 'path' && view.seed !== undefined) set('path-seed', String(view.seed));
+      if (mode === 'path' && view.path) app.pathMode.setPath(view.path);
+    }
+    if (view.mode !== undefined || initial) app.setMode(mode);
+    if (!this.hasAttribute('autoplay') && mode === 'clip') app.viewer.pause();
+    this.linkSoon();
+  }
+
+  /** The view shown now, as a link or the attributes would say it. */
+  get view(): ViewState {
+    const app = this.app;
+    if (!app) return this.attributeView();
+    const value = (id: string) => (this.shadow.getElementById(id) as HTMLInputElement).value;
+    const mode = app.currentMode;
+    const view: ViewState = { mode };
+    if (mode === 'walk') {
+      Object.assign(view, {
+        temperature: Number(value('walk-temperature')),
+        seed: Number(value('walk-seed')) || 0,
+        refine: (this.shadow.getElementById('walk-refine') as HTMLInputElement).checked,
+      });
+    } else if (mode === 'dance') {
+      const { model, style, seed } = app.danceMode.choice;
+      Object.assign(view, { model, ...(style ? { style } : {}), seed });
+    } else if (mode === 'path') {
+      Object.assign(view, { model: app.controlModel.value, seed: Number(value('path-seed')) || 0 });
+      const path = app.pathMode.path;
+      if (path.length >= 2) view.path = path;
+    } else if (mode === 'steer') {
+      view.model = app.controlModel.steerable;
+    }
+    return view;
+  }
+
+  /** Keeps the URL (with `link`) and the attributes in step with the view, a moment after a change. */
+  private linkSoon(): void {
+    clearTimeout(this.linkTimer);
+    this.linkTimer = window.setTimeout(() => {
+      const view = this.view;
+      this.reflecting = true;
+      try {
+        for (const key of VIEW_KEYS) {
+          if (key === 'path' && !this.hasAttribute('path')) continue; // a drawn path stays out of the attributes
+          const attribute = key === 'style' ? 'dance-style' : key; // `style` is the inline CSS attribute
+          const v = view[key];
+          if (v === undefined) this.removeAttribute(attribute);
+          else this.setAttribute(attribute, formatViewValue(key, v));
+        }
+      } finally {
+        this.reflecting = false;
+      }
+      if (this.hasAttribute('link')) history.replaceState(history.state, '', `${location.pathname}?${linkQuery(view)}`);
+    }, 50);
+  }
+
+  /** The link to this view (the page's address with the view in its query). */
+  get link(): string {
+    return `${location.origin}${location.pathname}?${linkQuery(this.view)}`;
+  }
+
+  /** The snippet that embeds this view on another site. */
+  get embedCode(): string {
+    const moduleUrl = new URL('motion-playground.js', new URL('./', location.href)).href;
+    return embedSnippet(this.view, moduleUrl);
+  }
+
+  private installShare(): void {
+    const share = this.shadow.getElementById('share-btn') as HTMLButtonElement;
+    const embed = this.shadow.getElementById('embed-btn') as HTMLButtonElement;
+    const dialog = this.shadow.getElementById('share-dialog') as HTMLDialogElement;
+    const text = this.shadow.getElementById('share-text') as HTMLTextAreaElement;
+    const title = this.shadow.getElementById('share-title')!;
+    const copy = this.shadow.getElementById('share-copy') as HTMLButtonElement;
+    const open = (heading: string, value: string) => {
+      title.textContent = heading;
+      text.value = value; // as text: a joint or file name with markup stays text
+      copy.textContent = 'Copy';
+      if (!dialog.open) dialog.showModal();
+      text.select();
+    };
+    share.addEventListener('click', () => {
+      const link = this.link;
+      open('Link to this view', link);
+      void this.copyText(link, copy);
+    });
+    embed.addEventListener('click', () => open('Embed this view', this.embedCode));
+    copy.addEventListener('click', () => void this.copyText(text.value, copy));
+    this.shadow.getElementById('share-close')!.addEventListener('click', () => dialog.close());
+  }
+
+  private async copyText(value: string, button: HTMLButtonElement): Promise<void> {
+    try {
+      await navigator.clipboard.writeText(value);
+      button.textContent = 'Copied';
+      this.frame.dataset.copied = value;
+    } catch {
+      button.textContent = 'Select and copy'; // no clipboard permission: the text is selected in the box
+    }
+  }
+
+  // ---------- src ----------
+
+  /** Plays the BVH at `src` (same origin or an allowed one, size-limited); a failure keeps what is shown. */
+  private async loadSource(): Promise<void> {
+    const src = this.getAttribute('src');
+    if (!src || !this.app) return;
+    const token = ++this.srcToken;
+    try {
+      const text = await fetchMotionSource(src, location.href, allowedOrigins(this.getAttribute('allowed-origins')));
+      const motion = await this.app.importer.importText(text, 'bvh');
+      if (token !== this.srcToken) return;
+      this.app.show(motion, decodeURIComponent(src.split('/').pop() ?? 'motion').replace(/\.bvh$/i, ''));
+      if (!this.hasAttribute('autoplay')) this.app.viewer.pause();
+    } catch (e) {
+      if (token === this.srcToken) this.app.reportError(`src: ${errorMessage(e)}`);
+    }
+  }
+
+  // ---------- presentation ----------
+
+  private showControls(): void {
+    const text = this.getAttribute('controls');
+    let controls: Controls = 'full';
+    if (text !== null) {
+      if ((CONTROLS as readonly string[]).includes(text)) controls = text as Controls;
+      else this.fire('error', { reason: `attribute controls=${JSON.stringify(text)}: must be one of ${CONTROLS.join(', ')}` });
+    }
+    for (const c of CONTROLS) this.frame.classList.toggle(`controls-${c}`, c === controls);
+  }
+
+  private showPoster(): void {
+    const src = this.getAttribute('poster');
+    if (!src) {
+      this.posterImage.hidden = true;
+      this.posterImage.removeAttribute('src');
+      return;
+    }
+    let url: URL;
+    try {
+      url = new URL(src, document.baseURI);
+    } catch {
+      this.fire('error', { reason: `attribute poster=${JSON.stringify(src)}: not a URL` });
+      return;
+    }
+    if (url.protocol !== 'https:' && url.protocol !== 'http:' && url.protocol !== 'data:') {
+      this.fire('error', { reason: `attribute poster: ${url.protocol} URLs are not allowed` });
+      return;
+    }
+    this.posterImage.src = url.href;
+    this.posterImage.hidden = this.app?.current != null;
+  }
+
+  /** Progress bars and the model indicator inside the shadow root, as `progress` events. */
+  private watchProgress(): void {
+    const kinds: Record<string, string> = { 'path-progress': 'path', 'cleanup-progress': 'cleanup', 'import-progress': 'import', 'model-status': 'model' };
+    new MutationObserver((records) => {
+      for (const r of records) {
+        const el = r.target as HTMLElement;
+        const what = kinds[el.id];
+        if (!what) continue;
+        if (el instanceof HTMLProgressElement) this.fire('progress', { what, fraction: el.value / (el.max || 1) });
+        else this.fire('progress', { what, loading: !el.hidden });
+      }
+    }).observe(this.shadow, { subtree: true, attributes: true, attributeFilter: ['value', 'hidden'] });
+  }
+
+  /** Keys and drops: from inside this element, or on the bare page when this is its only playground. */
+  private ownsEvent(e: Event): boolean {
+    if (e.composedPath().includes(this)) return true;
+    const t = e.target;
+    return (t === document.body || t === document.documentElement || t === document || t === window) && document.querySelectorAll('motion-playground').length === 1;
+  }
+
+  private fire(type: PlaygroundEventName, detail?: object): void {
+    this.dispatchEvent(new CustomEvent(type, { detail }));
+  }
+
+  // ---------- properties and methods ----------
+
+  /** The automation API (docs/api.md) of this element; the page's is also window.playground. */
+  get playground(): Playground {
+    if (!this.api) this.start();
+    return this.api!;
+  }
+
+  /** Resolves once the element has started (lazy: once scrolled near) and its model list is loaded. */
+  get ready(): Promise<void> {
+    return this.started.then(() => this.api!.ready);
+  }
+
+  play(): void {
+    this.playground.play();
+  }
+
+  pause(): void {
+    this.playground.pause();
+  }
+
+  /** The playhead in seconds (setting it seeks). */
+  get currentTime(): number {
+    const s = this.app?.viewer.state();
+    return s && s.fps ? s.frame / s.fps : 0;
+  }
+
+  set currentTime(seconds: number) {
+    const s = this.playground.state();
+    if (s.fps) this.playground.seek(seconds * s.fps);
+  }
+
+  /**
+   * playground.generate(options). Left out: 10 s from the element's view — in Dance mode the dance model,
+   * style and seed; otherwise the generator with the view's seed, temperature and refine. Shows nothing.
+   */
+  generate(options?: GenerateOptions): Promise<Motion> {
+    if (options !== undefined) return this.playground.generate(options);
+    const view = this.view;
+    const frames = 300;
+    if (view.mode === 'dance' && view.model) return this.playground.generate({ model: view.model, seed: view.seed ?? 0, frames, ...(view.style ? { style: view.style } : {}) });
+    const walk: ViewState = view.mode === 'walk' ? view : {};
+    return this.playground.generate({ model: 'generator', seed: walk.seed ?? 0, refine: walk.refine ?? false, frames, ...(walk.temperature !== undefined ? { temperature: walk.temperature } : {}) });
+  }
+
+  /** BVH text of `motion`, or of the shown motion when left out. */
+  exportBVH(motion?: Motion | null, options?: BVHExportOptions): string {
+    return this.playground.exportBVH(motion ?? this.shownMotion(), options);
+  }
+
+  /** GLB bytes of `motion`, or of the shown motion when left out. */
+  exportGLB(motion?: Motion | null, options?: GLBExportOptions): Uint8Array<ArrayBuffer> {
+    return this.playground.exportGLB(motion ?? this.shownMotion(), options);
+  }
+
+  private shownMotion() {
+    const m = this.playground.current();
+    if (!m) throw new Error('nothing is shown to export');
+    return m;
+  }
+}
+
+/** The page's query with `view` in it: other parameters (threads, stats) are kept, the view's own replaced. */
+function linkQuery(view: ViewState): string {
+  const kept = new URLSearchParams(location.search);
+  for (const key of VIEW_KEYS) kept.delete(key);
+  const rest = kept.toString();
+  const own = viewQuery(view);
+  return rest && own ? `${own}&${rest}` : own || rest;
+}
+
+/** The allowed-origins attribute: origins `src` may also be fetched from, space separated. */
+function allowedOrigins(text: string | null): string[] {
+  return (text ?? '').split(/\s+/).filter(Boolean);
+}
+
+/** Reflected properties: each attribute as a property of the same (camel-cased) name. */
+const STRING_PROPERTIES: Record<string, string> = { mode: 'mode', model: 'model', danceStyle: 'dance-style', src: 'src', controls: 'controls', poster: 'poster', loading: 'loading', path: 'path' };
+const NUMBER_PROPERTIES = ['seed', 'temperature'];
+const BOOLEAN_PROPERTIES: Record<string, string> = { autoplay: 'autoplay', cameraControls: 'camera-controls', link: 'link' };
+
+for (const [prop, attr] of Object.entries(STRING_PROPERTIES)) {
+  Object.defineProperty(MotionPlaygroundElement.prototype, prop, {
+    get(this: HTMLElement) {
+      return this.getAttribute(attr);
+    },
+    set(this: HTMLElement, v: string | null) {
+      if (v === null || v === undefined) this.removeAttribute(attr);
+      else this.setAttribute(attr, String(v));
+    },
+  });
+}
+for (const prop of NUMBER_PROPERTIES) {
+  Object.defineProperty(MotionPlaygroundElement.prototype, prop, {
+    get(this: HTMLElement) {
+      const text = this.getAttribute(prop);
+      if (text === null) return null;
+      const r = parseViewValue(prop as ViewKey, text);
+      return 'value' in r ? r.value : null;
+    },
+    set(this: HTMLElement, v: number | null) {
+      if (v === null || v === undefined) this.removeAttribute(prop);
+      else this.setAttribute(prop, String(v));
+    },
+  });
+}
+Object.defineProperty(MotionPlaygroundElement.prototype, 'refine', {
+  get(this: HTMLElement) {
+    const text = this.getAttribute('refine');
+    return text === null ? null : text !== 'false';
+  },
+  set(this: HTMLElement, v: boolean | null) {
+    if (v === null || v === undefined) this.removeAttribute('refine');
+    else this.setAttribute('refine', String(Boolean(v)));
+  },
+});
+for (const [prop, attr] of Object.entries(BOOLEAN_PROPERTIES)) {
+  Object.defineProperty(MotionPlaygroundElement.prototype, prop, {
+    get(this: HTMLElement) {
+      return this.hasAttribute(attr);
+    },
+    set(this: HTMLElement, v: boolean) {
+      this.toggleAttribute(attr, Boolean(v));
+    },
+  });
+}
+
+/** Defines <motion-playground> (once) and returns its class. */
+export function defineMotionPlayground(): typeof MotionPlaygroundElement {
+  if (!customElements.get('motion-playground')) customElements.define('motion-playground', MotionPlaygroundElement);
+  return customElements.get('motion-playground') as typeof MotionPlaygroundElement;
+}
+
+declare global {
+  interface HTMLElementTagNameMap {
+    'motion-playground': MotionPlaygroundElement;
+  }
+}

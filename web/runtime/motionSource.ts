@@ -1,0 +1,74 @@
+// Fetching the <motion-playground> element's `src`: only from the page's own origin or an allowed
+// list, over http(s), at most MAX_SOURCE_BYTES, gunzipped when gzipped. Errors say why, briefly.
+
+export const MAX_SOURCE_BYTES = 32 * 1024 * 1024;
+
+/** An origin as the allowed list compares it ("https://example.org"); null for text that is not one. */
+function originOf(text: string): string | null {
+  try {
+    const u = new URL(text);
+    return u.protocol === 'http:' || u.protocol === 'https:' ? u.origin : null;
+  } catch {
+    return null;
+  }
+}
+
+/** Checks `src` against the rules; returns the absolute URL to fetch. */
+export function checkSourceUrl(src: string, pageHref: string, allowed: readonly string[]): URL {
+  let url: URL;
+  try {
+    url = new URL(src, pageHref);
+  } catch {
+    throw new Error(`${JSON.stringify(src.slice(0, 80))} is not a URL`);
+  }
+  if (url.protocol !== 'http:' && url.protocol !== 'https:') throw new Error(`only http(s) URLs are fetched, not ${url.protocol}`);
+  const page = new URL(pageHref).origin;
+  const origins = allowed.map(originOf).filter((o): o is string => o !== null);
+  if (url.origin !== page && !origins.includes(url.origin)) {
+    throw new Error(`${url.origin} is not this page's origin or in allowed-origins; the file was not fetched`);
+  }
+  return url;
+}
+
+/** The text of the BVH at `src`, checked and size-limited. */
+export async function fetchMotionSource(src: string, pageHref: string, allowed: readonly string[], fetchFn: typeof fetch = fetch): Promise<string> {
+  const url = checkSourceUrl(src, pageHref, allowed);
+  let response: Response;
+  try {
+    response = await fetchFn(url.href, { credentials: 'same-origin' });
+  } catch (e) {
+    throw new Error(`could not fetch ${url.href} (${e instanceof Error ? e.message : String(e)})`);
+  }
+  if (!response.ok) throw new Error(`${url.href}: HTTP ${response.status}`);
+  const declared = Number(response.headers.get('content-length'));
+  if (declared > MAX_SOURCE_BYTES) throw new Error(`${url.href} is ${(declared / 1e6).toFixed(0)} MB; the limit is ${MAX_SOURCE_BYTES / 1e6 | 0} MB`);
+  const bytes = await readLimited(response, url.href);
+  const gzipped = bytes.length > 2 && bytes[0] === 0x1f && bytes[1] === 0x8b;
+  if (!gzipped) return new TextDecoder().decode(bytes);
+  const unzipped = new Response(new Blob([bytes as BlobPart]).stream().pipeThrough(new DecompressionStream('gzip')));
+  return new TextDecoder().decode(await readLimited(unzipped, url.href));
+}
+
+async function readLimited(response: Response, what: string): Promise<Uint8Array> {
+  if (!response.body) return new Uint8Array(await response.arrayBuffer());
+  const reader = response.body.getReader();
+  const parts: Uint8Array[] = [];
+  let total = 0;
+  for (;;) {
+    const { done, value } = await reader.read();
+    if (done) break;
+    total += value.length;
+    if (total > MAX_SOURCE_BYTES) {
+      await reader.cancel();
+      throw new Error(`${what} is larger than the ${MAX_SOURCE_BYTES / 1e6 | 0} MB limit`);
+    }
+    parts.push(value);
+  }
+  const out = new Uint8Array(total);
+  let at = 0;
+  for (const p of parts) {
+    out.set(p, at);
+    at += p.length;
+  }
+  return out;
+}
