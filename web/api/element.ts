@@ -123,8 +123,10 @@ export class MotionPlaygroundElement extends HTMLElement {
     void this.api.ready.then(async () => {
       const fromLink = this.hasAttribute('link') ? this.linkView() : null;
       const attrs = this.attributeView();
-      const hasAny = VIEW_KEYS.some((k) => this.hasAttribute(k)) || this.hasAttribute('src') || (fromLink !== null && Object.keys(fromLink).length > 0);
-      const view = { ...(hasAny ? {} : FIRST_VIEW), ...attrs, ...(fromLink ?? {}) };
+      // No mode from the attributes or the link (none, or a bad one) and no src: the first view (something
+      // alive), under whatever settings were given.
+      const given = { ...attrs, ...(fromLink ?? {}) };
+      const view: ViewState = given.mode === undefined && !this.hasAttribute('src') ? { ...FIRST_VIEW, ...given } : given;
       if (this.hasAttribute('src') && view.mode === undefined) view.mode = 'clip';
       this.applyView(view, true);
       if (this.hasAttribute('src')) await this.loadSource();
@@ -247,7 +249,7 @@ export class MotionPlaygroundElement extends HTMLElement {
   }
 
   /** The link to this view (the page's address with the view in its query). */
-  get link(): string {
+  get shareLink(): string {
     return `${location.origin}${location.pathname}?${linkQuery(this.view)}`;
   }
 
@@ -272,7 +274,7 @@ export class MotionPlaygroundElement extends HTMLElement {
       text.select();
     };
     share.addEventListener('click', () => {
-      const link = this.link;
+      const link = this.shareLink;
       open('Link to this view', link);
       void this.copyText(link, copy);
     });

@@ -10,6 +10,7 @@ import * as ort from 'onnxruntime-web/wasm';
 import ortWasmUrl from 'onnxruntime-web/ort-wasm-simd-threaded.wasm?url';
 import ortGlueUrl from 'onnxruntime-web/ort-wasm-simd-threaded.mjs?url';
 import { WORKER_ERROR_ID, type ModelRequest } from './protocol';
+import type { DownloadReply, DownloadRequest } from './sharedDownloads';
 import { describe, serveRequests, type Progress } from './requestLoop';
 
 declare const self: DedicatedWorkerGlobalScope;
@@ -27,28 +28,46 @@ function absolute(url: string): string {
  * Sets onnxruntime-web up on first use: `requestedThreads` when the page is cross-origin isolated
  * (default 2), else 1. Later calls cannot change it (the wasm is loaded once per worker).
  */
-function configureRuntime(requestedThreads?: number): void {
+async function configureRuntime(requestedThreads?: number): Promise<void> {
   if (requestedThreads !== undefined && !(Number.isInteger(requestedThreads) && requestedThreads >= 1)) {
     throw new Error(`threads must be a positive integer, got ${requestedThreads}`);
   }
-  if (runtimeThreads !== undefined) return;
+  if (runtimeThreads !== undefined || ort.env.wasm.wasmBinary) return;
   ort.env.wasm.numThreads = self.crossOriginIsolated ? (requestedThreads ?? 2) : 1;
   ort.env.wasm.simd = true;
   ort.env.wasm.proxy = false; // already off the main thread
-  ort.env.wasm.wasmPaths = { wasm: absolute(ortWasmUrl), mjs: absolute(ortGlueUrl) };
+  // The wasm (the largest download) comes through the page too, shared by every worker.
+  ort.env.wasm.wasmBinary = await fetchBytes(ortWasmUrl, 'onnxruntime wasm');
+  ort.env.wasm.wasmPaths = { mjs: absolute(ortGlueUrl) };
 }
 
+/** Downloads asked of the page and not yet answered (sharedDownloads.ts). */
+const downloadsWaiting = new Map<number, { resolve: (bytes: ArrayBuffer) => void; reject: (error: Error) => void }>();
+let nextDownload = 1;
+self.addEventListener('message', (event: MessageEvent<DownloadReply | { type?: unknown }>) => {
+  const reply = event.data;
+  if (reply?.type !== 'downloaded') return;
+  const { download } = reply as DownloadReply;
+  const waiting = downloadsWaiting.get(download);
+  downloadsWaiting.delete(download);
+  if ('bytes' in reply) waiting?.resolve(reply.bytes as ArrayBuffer);
+  else waiting?.reject(new Error((reply as { error: string }).error));
+});
+
+/**
+ * The bytes at `url`, fetched by the page (once for every worker and element on it that asks for the same
+ * file: sharedDownloads.ts). `what` names the file in messages ("generator model <url>: HTTP 404 …").
+ */
 async function fetchBytes(url: string, what: string): Promise<Uint8Array> {
-  let response: Response;
+  const href = absolute(url);
+  const download = nextDownload++;
+  const bytes = new Promise<ArrayBuffer>((resolve, reject) => downloadsWaiting.set(download, { resolve, reject }));
+  self.postMessage({ type: 'download', download, url: href } satisfies DownloadRequest);
   try {
-    response = await fetch(url);
+    return new Uint8Array(await bytes);
   } catch (err) {
-    throw new Error(`${what} ${url}: could not fetch (${describe(err)})`);
+    throw new Error(`${what} ${url}: ${describe(err)}`);
   }
-  if (!response.ok) throw new Error(`${what} ${url}: HTTP ${response.status} ${response.statusText}`);
-  // Dev servers answer unknown paths with the app's index.html; say so rather than "protobuf parsing failed".
-  if (response.headers.get('content-type')?.includes('text/html')) throw new Error(`${what} ${url}: got an HTML page, not a model file (wrong URL?)`);
-  return new Uint8Array(await response.arrayBuffer());
 }
 
 /** A wasm session on fetched ONNX bytes; `modelUrl` names the file in messages. */
@@ -76,8 +95,7 @@ async function loadSession<Info>(
   what: string,
   requestedThreads?: number,
 ): Promise<{ session: ort.InferenceSession; info: Info; threads: number }> {
-  configureRuntime(requestedThreads);
-  const [info, bytes] = await Promise.all([loadInfo(infoUrl), fetchBytes(modelUrl, what)]);
+  const [info, bytes] = await Promise.all([loadInfo(infoUrl), fetchBytes(modelUrl, what), configureRuntime(requestedThreads)]);
   const session = await createSession(bytes, modelUrl);
   runtimeThreads ??= ort.env.wasm.numThreads ?? 1; // onnxruntime lowers it to 1 where threads are unavailable
   return { session, info, threads: runtimeThreads };

@@ -84,6 +84,7 @@ export function serveRequests<Request extends { type: string }, Report = number>
 
   port.addEventListener('message', (event: MessageEvent<({ id: number } & Request) | CancelMessage>) => {
     const message = event.data;
+    if ((message as { type?: unknown }).type === 'downloaded') return; // a file the page fetched (ortWorker.ts), not a request
     if (message.type === 'cancel') {
       const { request } = message as CancelMessage;
       if (running?.id === request) {

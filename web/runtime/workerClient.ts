@@ -7,6 +7,7 @@ import type { Motion } from '../motion/types';
 import { CANCELLED_ERROR_NAME, CancelledError } from './cancellation';
 import { WORKER_ERROR_ID, type BenchmarkResult, type CancelMessage, type WorkerMessage } from './protocol';
 import { assetUrl } from './assetBase';
+import { answerDownload, type DownloadRequest } from './sharedDownloads';
 
 /** Options of any request: `signal` cancels it (cancellation.ts). */
 export interface RequestOptions {
@@ -36,7 +37,7 @@ export class WorkerClient {
   /** `worker` must be created by the subclass with a literal `new URL('./x.worker.ts', import.meta.url)` (Vite bundles it). */
   constructor(worker: Worker, protected readonly label: string) {
     this.worker = worker;
-    worker.addEventListener('message', (event: MessageEvent<WorkerMessage>) => this.onReply(event.data));
+    worker.addEventListener('message', (event: MessageEvent<WorkerMessage | DownloadRequest>) => this.onReply(event.data));
     worker.addEventListener('error', (event) => {
       event.preventDefault();
       this.fail(new Error(`${label} worker failed: ${event.message || 'could not load or run the worker script'}`));
@@ -85,7 +86,12 @@ export class WorkerClient {
     });
   }
 
-  private onReply(message: WorkerMessage): void {
+  private onReply(data: WorkerMessage | DownloadRequest): void {
+    if ('type' in data && data.type === 'download') {
+      if (this.worker) answerDownload(this.worker, data);
+      return;
+    }
+    const message = data as WorkerMessage;
     if ('progress' in message) {
       this.pending.get(message.id)?.onProgress?.(message.progress);
       return;
