@@ -1,12 +1,33 @@
 // The production build: `vite build` into a temporary folder, served by `vite preview` (which must send
 // the cross-origin isolation headers too), and the page works from it.
 import assert from 'node:assert/strict';
-import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { createReadStream, existsSync, mkdtempSync, readFileSync, rmSync, statSync } from 'node:fs';
+import { createServer } from 'node:http';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import { after, before, describe, test } from 'node:test';
 import { build, preview } from 'vite';
-import { corpusText, freePort, launchBrowser, openPlayground, ROOT } from './harness.mjs';
+import { corpusText, freePort, installUiLookups, launchBrowser, openPlayground, ROOT, waitUntil } from './harness.mjs';
+
+const TYPES = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript', '.json': 'application/json', '.wasm': 'application/wasm', '.onnx': 'application/octet-stream', '.css': 'text/css', '.png': 'image/png' };
+
+/**
+ * A plain static file server (no special headers: not cross-origin isolated) with `folder` under `prefix`,
+ * as a project website would host a copy of the built folder.
+ */
+function staticServer(folder, prefix) {
+  const server = createServer((req, res) => {
+    const pathname = decodeURIComponent(new URL(req.url, 'http://x').pathname);
+    const file = pathname.startsWith(prefix) ? path.join(folder, pathname.slice(prefix.length)) : '';
+    if (!file || !file.startsWith(folder) || !existsSync(file) || !statSync(file).isFile()) {
+      res.writeHead(404).end('not found');
+      return;
+    }
+    res.writeHead(200, { 'Content-Type': TYPES[path.extname(file)] ?? 'application/octet-stream' });
+    createReadStream(file).pipe(res);
+  });
+  return new Promise((resolve) => server.listen(0, '127.0.0.1', () => resolve(server)));
+}
 
 describe('production build', { timeout: 120_000 }, () => {
   let outDir, server, browser;
@@ -51,5 +72,40 @@ describe('production build', { timeout: 120_000 }, () => {
     assert.equal(r.version, JSON.parse(readFileSync(path.join(ROOT, 'package.json'), 'utf8')).version);
     assert.equal(r.frames, 450);
     assert.deepEqual(problems, []);
+  });
+
+  test('examples/embed.html runs from the built folder copied to a plain static host', async () => {
+    assert.ok(existsSync(path.join(outDir, 'motion-playground.js')), 'the element is one module at the top of the folder');
+    const host = await staticServer(outDir, '/site/playground/');
+    try {
+      const base = `http://127.0.0.1:${host.address().port}/site/playground/`;
+      const context = await browser.newContext({ viewport: { width: 1000, height: 900 } });
+      const page = await context.newPage();
+      const problems = [];
+      const missing = [];
+      page.on('console', (m) => m.type() === 'error' && problems.push(m.text()));
+      page.on('pageerror', (e) => problems.push(e.message));
+      page.on('response', (r) => r.status() >= 400 && missing.push(`${r.status()} ${r.url()}`));
+      await page.addInitScript(installUiLookups);
+      await page.goto(`${base}examples/embed.html`, { waitUntil: 'load' });
+      await waitUntil(page, () => document.getElementById('dance').playground?.current()?.frames > 0, null, { timeout: 90_000, message: 'the dance element dances' });
+      await page.evaluate(() => document.getElementById('walk').scrollIntoView());
+      await waitUntil(page, () => document.getElementById('walk').playground?.current()?.frames > 0, null, { timeout: 90_000, message: 'the lazy path element walks its path once scrolled to' });
+      const r = await page.evaluate(() => ({
+        isolated: crossOriginIsolated,
+        views: ['dance', 'walk'].map((id) => document.getElementById(id).view),
+        errors: ['dance', 'walk'].map((id) => document.getElementById(id).playground.lastError()),
+      }));
+      await context.close();
+      assert.equal(r.isolated, false, 'a plain host: no isolation headers, one thread');
+      assert.deepEqual(r.views[0], { mode: 'dance', model: 'aclstm', style: 'salsa', seed: 1 });
+      assert.equal(r.views[1].mode, 'path');
+      assert.equal(r.views[1].model, 'vae-lstm');
+      assert.deepEqual(r.errors, [null, null]);
+      assert.deepEqual(missing, [], 'every file is found under the copied folder (relative URLs)');
+      assert.deepEqual(problems, []);
+    } finally {
+      await new Promise((resolve) => host.close(resolve));
+    }
   });
 });
