@@ -50,6 +50,14 @@ function layoutProblems(target) {
     const s = getComputedStyle(el);
     return (/auto|scroll/.test(s.overflowX) && el.scrollWidth > el.clientWidth + 1) || (/auto|scroll/.test(s.overflowY) && el.scrollHeight > el.clientHeight + 1);
   };
+  /** `el` is (inside) a sticky element and `other` scrolls in the same scrolling panel. */
+  const underSticky = (el, other) => {
+    let sticky = el;
+    while (sticky && getComputedStyle(sticky).position !== 'sticky') sticky = parentOf(sticky);
+    if (!sticky) return false;
+    const panel = clippers(sticky).find(scrollable);
+    return !!panel && panel.contains(other) && !sticky.contains(other);
+  };
   const visibleBox = (el) => clippers(el).reduce((r, c) => meet(r, box(c.getBoundingClientRect())), meet(box(el.getBoundingClientRect()), hostBox));
 
   const scope = scopeSelector ? root.querySelector(scopeSelector) : null;
@@ -87,6 +95,8 @@ function layoutProblems(target) {
         if (a.el.closest('.controls') && b.el.closest('.controls')) continue;
       }
       if (a.el.contains(b.el) || b.el.contains(a.el)) continue;
+      // A sticky header covers what scrolls under it in its own panel (the hit test below scrolls each into view).
+      if (underSticky(a.el, b.el) || underSticky(b.el, a.el)) continue;
       const m = meet(a.r, b.r);
       if (m.right - m.left > TOL && m.bottom - m.top > TOL) problems.push(`${name(a.el)} ${fmt(a.r)} overlaps ${name(b.el)} ${fmt(b.r)}`);
     }
@@ -171,6 +181,18 @@ async function touchDrag(cdp, from, to, { steps = 8, hold = false } = {}) {
 const canvasShot = (page) => page.locator('canvas.viewer-canvas').screenshot();
 const pixelsDiffer = (a, b) => a.length !== b.length || !a.equals(b);
 
+/** The canvas once it stands still (two shots a few frames apart the same): the camera has settled. */
+async function stillShot(page) {
+  let last = await canvasShot(page);
+  for (let i = 0; i < 40; i++) {
+    await nextFrames(page, 3);
+    const next = await canvasShot(page);
+    if (!pixelsDiffer(last, next)) return next;
+    last = next;
+  }
+  throw new assert.AssertionError({ message: 'paused, the picture never stood still' });
+}
+
 describe('layout on a phone and in a small embed', { timeout: 900_000 }, () => {
   let server, url, browser;
   const problems = [];
@@ -226,10 +248,8 @@ describe('layout on a phone and in a small embed', { timeout: 900_000 }, () => {
 
     test('touch in Clip: a one-finger drag on the stage orbits, a drag on the timeline scrubs', async () => {
       await page.evaluate(() => { window.playground.pause(); window.playground.seek(100); });
-      await nextFrames(page, 4);
       const stage = await page.locator('canvas.viewer-canvas').boundingBox();
-      const before = await canvasShot(page);
-      assert.equal(pixelsDiffer(before, await canvasShot(page)), false, 'paused, the picture stands still');
+      const before = await stillShot(page);
       const cy = stage.y + stage.height * 0.45;
       await touchDrag(cdp, [stage.x + stage.width * 0.3, cy], [stage.x + stage.width * 0.75, cy]);
       await nextFrames(page, 20);
@@ -278,7 +298,7 @@ describe('layout on a phone and in a small embed', { timeout: 900_000 }, () => {
       await waitUntil(page, () => Number($ui('steer-status').dataset.frame) > 15, null, { timeout: 60_000, message: 'the steered stream starts' });
       await shot(page, 'phone-steer');
       await checkLayout(page, 'phone, Steer');
-      await checkExportMenu(page, 'phone, Steer');
+      await checkExportMenu(page, 'phone, Steer', 'motion-playground', 'phone-steer-export');
       const slider = Number(await page.locator('#steer-speed').inputValue());
       const pad = await page.locator('#steer-joystick').boundingBox();
       const cx = pad.x + pad.width / 2, cy = pad.y + pad.height / 2;
@@ -337,7 +357,7 @@ describe('layout on a phone and in a small embed', { timeout: 900_000 }, () => {
       for (const id of ['#share-btn', '#embed-btn']) assert.equal(await host.locator(id).isVisible(), true, `${id} shows with the link attribute`);
       await shot(page, 'embed-full-link', host);
       await checkLayout(page, 'embed, full, link, Random walk', '#embed-full');
-      await checkExportMenu(page, 'embed, full, link', '#embed-full');
+      await checkExportMenu(page, 'embed, full, link', '#embed-full', 'embed-full-link-export');
       await host.evaluate((el) => el.removeAttribute('link'));
       await clickMode(page, 'dance', host);
       await waitUntil(page, (id) => Number(document.getElementById('embed-full').shadowRoot.getElementById(id).dataset.frame) > 5, 'dance-status', { timeout: 60_000, message: 'the embed dances' });
@@ -361,6 +381,16 @@ describe('layout on a phone and in a small embed', { timeout: 900_000 }, () => {
       await host.locator('#cleanup-toggle').click();
       await shot(page, 'embed-full-clip', host);
       await checkLayout(page, 'embed, full, Clip, Clean up open', '#embed-full');
+      // Scrolled to its end, the panel's header stays in sight and closes it.
+      await host.locator('#cleanup-card').evaluate((el) => { el.scrollTop = el.scrollHeight; });
+      await shot(page, 'embed-full-clip-scrolled', host);
+      await checkLayout(page, 'embed, full, Clip, Clean up scrolled', '#embed-full');
+      const headHit = await host.evaluate((el) => {
+        const head = el.shadowRoot.getElementById('cleanup-toggle'), r = head.getBoundingClientRect();
+        const hit = el.shadowRoot.elementFromPoint(r.left + r.width / 2, r.top + r.height / 2);
+        return { scrolled: el.shadowRoot.getElementById('cleanup-card').scrollTop > 0, hit: !!hit && head.contains(hit) };
+      });
+      assert.deepEqual(headHit, { scrolled: true, hit: true }, 'scrolled, the header is still where a tap finds it');
       await host.locator('#cleanup-toggle').click();
       for (const mode of ['walk', 'clip']) await clickMode(page, mode, host);
       assert.deepEqual(problems.splice(0), []);
