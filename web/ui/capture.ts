@@ -113,7 +113,7 @@ export class Capture {
     if (!this.recorder) return;
     this.host.viewer.invalidate(); // keep frames coming into the capture stream
     const elapsed = (performance.now() - this.startedAt) / 1000;
-    this.status.textContent = `● ${elapsed.toFixed(0)} s${this.seconds ? ` of ${this.seconds} s` : ''}`;
+    this.status.textContent = `● ${Math.floor(elapsed)} s${this.seconds ? ` of ${this.seconds} s` : ''}`;
   }
 
   private setIdle(): void {
