@@ -241,8 +241,8 @@ describe('motion playground page', { timeout: 150_000 }, () => {
     const bvh = readFileSync(file, 'utf8');
     assert.match(bvh, /^HIERARCHY/);
     assert.match(bvh, /Frames:\s*534/);
-    const same = await page.evaluate((t) => window.playground.exportBVH(window.playground.current()) === t, bvh);
-    assert.ok(same, 'download equals exportBVH(current())');
+    const same = await page.evaluate((t) => window.playground.exportBVH(window.playground.current(), { restPose: 'tpose' }) === t, bvh);
+    assert.ok(same, 'download equals exportBVH(current(), { restPose: "tpose" }), the menu default');
   });
 
   test('importMotion parses in the import worker: the motion comes back whole, a parser error keeps its name, format and line', async () => {
