@@ -133,3 +133,27 @@ def test_shipped_dance_model(model_id):
     # Style is a real input: the same seed under another style gives other motion.
     other = model.generate(np.array([seeds[0]["frames"]]), ["martial"], 120)
     assert np.abs(other[0] - feats[0]).max() > 1e-3
+
+
+def test_freeze_rule_judges_against_the_real_clips():
+    """The fairer freeze rule (issue 18): (a) low share at most twice the real one, (b) no 5 s low stretch,
+    (c) a median of at least half the real one; a low-energy collapse fails (c) though it never stops."""
+    import numpy as np
+
+    from training.aclstm.freeze_rule import judge, longest_run
+
+    assert longest_run(np.array([0, 1, 1, 0, 1, 1, 1, 0], bool)) == 3
+    assert longest_run(np.zeros(4, bool)) == 0
+    ref = {"median": 1.0, "low_share": 0.05, "longest_low_s": 3}
+    alive = np.full(100, 1.0)
+    alive[[10, 50, 90]] = 0.1  # three single low seconds: 3% low
+    assert judge(alive, ref)["passes"]
+    paused = alive.copy()
+    paused[20:25] = 0.1  # a 5 s pause
+    r = judge(paused, ref)
+    assert (r["pass_a"], r["pass_b"], r["longest_low_s"]) == (True, False, 5)
+    collapsed = np.full(100, 0.3)  # never below the 20% line, at 30% of the real intensity
+    r = judge(collapsed, ref)
+    assert (r["low_share"], r["pass_a"], r["pass_b"], r["pass_c"]) == (0.0, True, True, False)
+    frozen = np.full(100, 0.01)
+    assert not judge(frozen, ref)["pass_a"]

@@ -19,6 +19,10 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--run", default="aclstm", help="run name under runs/")
     parser.add_argument("--condition", type=int, default=5, help="v: self-fed frames per cycle (0: vanilla teacher forcing)")
     parser.add_argument("--ground-truth", type=int, default=5, help="u: real frames per cycle")
+    parser.add_argument("--condition-max", type=int, default=0,
+                        help="grow v linearly from --condition to this over the time budget (0: v stays fixed)")
+    parser.add_argument("--input-noise", type=float, nargs=2, default=(0.0, 0.0), metavar=("START", "END"),
+                        help="Gaussian noise on the real input frames (normalised units), growing from START to END over the time budget")
     parser.add_argument("--hidden", type=int, default=256)
     parser.add_argument("--layers", type=int, default=3)
     parser.add_argument("--batch", type=int, default=32)

@@ -139,11 +139,23 @@ def train_dance_model(args: argparse.Namespace) -> tuple[str, float, Path]:
                 "rng": rng.bit_generator.state, "torch_rng": torch.get_rng_state(), "iteration": iteration,
                 "best": best, "elapsed": elapsed(), "history": history, "meta": meta}
 
+    noise_rng = torch.Generator().manual_seed(args.seed + iteration)
     bar = tqdm(total=args.iterations, initial=iteration, desc=args.run, unit="it")
     losses, stopped = [], "iterations done"
     while iteration < args.iterations:
         x, style = corpus.batch(rng, args.batch)
-        pred = model.auto_conditioned(x[:, :-1], style, args.ground_truth, args.condition)
+        # Schedules over the time budget (so a resumed run continues them): the self-fed stretch grows from
+        # v = condition to condition_max, and noise on the real input frames from noise[0] to noise[1]
+        # (normalised units; the targets stay clean).
+        progress = min(1.0, elapsed() / (args.minutes * 60))
+        condition = args.condition
+        if args.condition and args.condition_max:
+            condition = int(round(args.condition + (args.condition_max - args.condition) * progress))
+        inputs = x[:, :-1]
+        sigma = args.input_noise[0] + (args.input_noise[1] - args.input_noise[0]) * progress
+        if sigma > 0:
+            inputs = inputs + sigma * torch.randn(inputs.shape, generator=noise_rng)
+        pred = model.auto_conditioned(inputs, style, args.ground_truth, condition)
         loss = ((pred - x[:, 1:]) ** 2).mean()
         optimiser.zero_grad()
         loss.backward()
@@ -152,7 +164,7 @@ def train_dance_model(args: argparse.Namespace) -> tuple[str, float, Path]:
         iteration += 1
         losses.append(loss.item())
         bar.update(1)
-        bar.set_postfix(loss=f"{np.mean(losses[-50:]):.4f}")
+        bar.set_postfix(loss=f"{np.mean(losses[-50:]):.4f}", v=condition, noise=f"{sigma:.2f}")
         if iteration % args.iters_per_epoch == 0:
             scheduler.step()
             val = validation_losses(model, corpus, args.condition)
