@@ -11,8 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import metrics
-from ..data.dance import MODEL_FPS, STYLES, DanceClip, resample_positions
+from ..data.dance import STYLES, DanceClip, held_out_pose_change
 
 LOW_FRACTION = 0.2      # of the real median: a "low" second
 SHARE_FACTOR = 2.0      # (a) at most this many times the real share of low seconds
@@ -34,11 +33,7 @@ def real_reference(clips: list[DanceClip]) -> dict:
     of low seconds and the longest low stretch (s) of any clip (clips are measured one by one, never joined)."""
     out = {}
     for style in STYLES:
-        curves = []
-        for c in clips:
-            if c.style == style and c.held_out:
-                pos = resample_positions(c.positions, c.fps, 0.0, int(len(c.positions) / c.fps * MODEL_FPS) - 1)
-                curves.append(metrics.pose_change_per_second(pos, MODEL_FPS))
+        curves = held_out_pose_change(clips, style)
         median = float(np.median(np.concatenate(curves)))
         low = [curve < LOW_FRACTION * median for curve in curves]
         out[style] = {"median": median, "low_share": float(np.concatenate(low).mean()),

@@ -189,14 +189,17 @@ def bone_length_error(pos: np.ndarray, skel: DanceSkeleton, min_length: float = 
     return np.abs(got / lengths[bones] - 1).mean(axis=1)
 
 
+def held_out_pose_change(clips: list[DanceClip], style: str) -> list[np.ndarray]:
+    """Per-second pose change (m/s, joints relative to the root) of each real held-out clip of `style`, at the
+    model's rate, one curve per clip (clips are measured one by one, never joined)."""
+    curves = []
+    for c in clips:
+        if c.style == style and c.held_out:
+            pos = resample_positions(c.positions, c.fps, 0.0, int(len(c.positions) / c.fps * MODEL_FPS) - 1)
+            curves.append(metrics.pose_change_per_second(pos, MODEL_FPS))
+    return curves
+
+
 def real_pose_change(clips: list[DanceClip]) -> dict:
-    """Median per-second pose change (m/s, joints relative to the root) of the real held-out clips, per style."""
-    out = {}
-    for style in STYLES:
-        changes = []
-        for c in clips:
-            if c.style == style and c.held_out:
-                pos = resample_positions(c.positions, c.fps, 0.0, int(len(c.positions) / c.fps * MODEL_FPS) - 1)
-                changes.append(metrics.pose_change_per_second(pos, MODEL_FPS))
-        out[style] = round(float(np.median(np.concatenate(changes))), 4)
-    return out
+    """Median per-second pose change (m/s) of the real held-out clips, per style."""
+    return {style: round(float(np.median(np.concatenate(held_out_pose_change(clips, style)))), 4) for style in STYLES}
