@@ -1,4 +1,4 @@
-"""Measure dance-model training runs quickly (issue 18's pilots) and add them to docs/models/aclstm-pilots.json.
+"""Measure dance-model training runs quickly (issue 18's pilots) and add them to docs/models/aclstm-pilots.{json,md}.
 
     python -m training.aclstm.pilot RUN [RUN ...] [--frames 3000] [--seeds 3] [--which best|last]
 
@@ -12,7 +12,7 @@ import json
 
 from ..paths import REPORTS_DIR
 from ..runs import RUNS_DIR
-from .pilots import measure_run, summary_line
+from .pilots import measure_run, pilot_markdown, summary_line
 
 PILOTS = REPORTS_DIR / "aclstm-pilots.json"
 
@@ -33,8 +33,9 @@ def main(argv: list[str] | None = None) -> None:
         m.pop("details")
         table[f"{name}:{args.which}"] = {**m, "summary": summary}
         print(summary_line(f"{name}:{args.which}", m))
-    PILOTS.write_text(json.dumps(table, indent=1))
-    print(f"wrote {PILOTS}")
+    PILOTS.write_text(json.dumps(table, indent=1, default=str))
+    PILOTS.with_suffix(".md").write_text(pilot_markdown(table))
+    print(f"wrote {PILOTS} and {PILOTS.with_suffix('.md')}")
 
 
 if __name__ == "__main__":

@@ -60,8 +60,8 @@ def measure_run(checkpoint: Path, frames: int = 3000, seeds_per_style: int = 3, 
                             "longest_low_s_worst": max(r["longest_low_s"] for r in mine),
                             "median_ratio_worst": min(r["median_ratio"] for r in mine),
                             "diverged": sum(r["diverged"] for r in mine)}
-    valid = state.get("valid") or {}
-    return {"checkpoint": str(checkpoint), "iteration": state.get("iteration"), "frames": frames,
+    valid = state.get("valid") or (state.get("history") or [{}])[-1].get("valid") or {}  # best.pt, else the last epoch
+    return {"checkpoint": str(checkpoint), "iteration": state.get("iteration"), "frames": frames, "args": meta.get("args", {}),
             "valid": {s: valid.get(s) for s in STYLES} if valid else None, "real": ref, "per_style": per_style,
             "passes": sum(p["passes"] for p in per_style.values()), "runs": len(runs), "details": runs}
 
@@ -77,5 +77,44 @@ def summary_line(name: str, m: dict) -> str:
     return f"{name} (it {m['iteration']}): {m['passes']}/{m['runs']} pass; " + "; ".join(cells) + f"; valid ac {ac}"
 
 
-def write_pilot_table(results: dict, out: Path) -> None:
-    out.write_text(json.dumps(results, indent=1))
+def recipe(args: dict) -> str:
+    """A training run's recipe in a few words, from its arguments."""
+    parts = [f"{args.get('layers', 3)}x{args.get('hidden', 256)}",
+             f"u={args.get('ground_truth', 5)} v={args.get('condition', 5)}"
+             + (f"->{args['condition_max']}" if args.get("condition_max") else ""),
+             f"lr {args.get('lr', 1e-3):g} x{args.get('decay', 0.95):g}/epoch"]
+    noise = args.get("input_noise") or (0, 0)
+    if any(noise):
+        parts.append(f"input noise {noise[0]:g}->{noise[1]:g}")
+    return ", ".join(parts)
+
+
+def pilot_markdown(table: dict) -> str:
+    """docs/models/aclstm-pilots.md: the real clips' reference, then one row per measured run."""
+    if not table:
+        return "# acLSTM pilots (issue 18)\n\nNo pilot measured yet.\n"
+    first = next(iter(table.values()))
+    lines = ["# acLSTM pilots (issue 18)", "",
+             "Written by `python -m training.aclstm.pilot`. Each pilot is a short training run; its checkpoint rolls out "
+             f"{first['frames']} self-fed frames in torch from 3 real seed motions per style (held-out clips), judged by the "
+             "fairer freeze rule (`training/aclstm/freeze_rule.py`): a *low* second is below 20% of the style's real median "
+             "pose change; a run passes when (a) its share of low seconds is at most twice the real clips' share, (b) no low "
+             "stretch lasts 5 s or more, and (c) its median is at least 50% of the real median. Each style's cell gives the "
+             "passes and, over its seeds, the worst low share, the longest low stretch and the lowest median (share of real).",
+             "",
+             "Real held-out clips, measured the same way (each clip alone): "
+             + "; ".join(f"{s} median {r['median']:.3f} m/s, low share {r['low_share']:.1%}, longest low stretch "
+                         f"{r['longest_low_s']} s, over {r['seconds']} s" for s, r in first["real"].items()) + ".", "",
+             "| run | recipe | iterations | minutes | " + " | ".join(STYLES) + " | held-out loss, self-fed (" + "/".join(STYLES) + ") |",
+             "|---|---|---|---|" + "---|" * len(STYLES) + "---|"]
+    for name, m in table.items():
+        cells = []
+        for style in STYLES:
+            p = m["per_style"][style]
+            cells.append(f"{p['passes']}/{p['runs']}: {p['low_share_worst']:.0%} low, {p['longest_low_s_worst']} s, "
+                         f"median {p['median_ratio_worst']:.0%}" + (f", {p['diverged']} diverged" if p["diverged"] else ""))
+        valid = "/".join(f"{m['valid'][s]['auto_conditioned']:.3f}" for s in STYLES) if m.get("valid") else "—"
+        minutes = m.get("summary", {}).get("minutes")
+        lines.append(f"| {name} | {recipe(m.get('args', {}))} | {m['iteration']} | "
+                     f"{'—' if minutes is None else f'{minutes:.0f}'} | " + " | ".join(cells) + f" | {valid} |")
+    return "\n".join(lines) + "\n"
