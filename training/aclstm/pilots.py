@@ -83,6 +83,8 @@ def recipe(args: dict) -> str:
              f"u={args.get('ground_truth', 5)} v={args.get('condition', 5)}"
              + (f"->{args['condition_max']}" if args.get("condition_max") else ""),
              f"lr {args.get('lr', 1e-3):g} x{args.get('decay', 0.95):g}/epoch"]
+    if args.get("energy"):
+        parts.append(f"energy {args['energy']:g}")
     noise = args.get("input_noise") or (0, 0)
     if any(noise):
         parts.append(f"input noise {noise[0]:g}->{noise[1]:g}")

@@ -23,6 +23,8 @@ def main(argv: list[str] | None = None) -> None:
                         help="grow v linearly from --condition to this over the time budget (0: v stays fixed)")
     parser.add_argument("--input-noise", type=float, nargs=2, default=(0.0, 0.0), metavar=("START", "END"),
                         help="Gaussian noise on the real input frames (normalised units), growing from START to END over the time budget")
+    parser.add_argument("--energy", type=float, default=0.0,
+                        help="weight of the motion-energy term (each channel's RMS frame-to-frame change against the real window's)")
     parser.add_argument("--hidden", type=int, default=256)
     parser.add_argument("--layers", type=int, default=3)
     parser.add_argument("--batch", type=int, default=32)

@@ -25,6 +25,7 @@ from tqdm import tqdm
 from ..data.dance import MODEL_FPS, STYLES, DanceClip, encode, load_clips, mirror, mirror_pairs, resample_positions, rotate_y
 from ..models.aclstm import DanceLSTM
 from ..runs import Run
+from ..vae_lstm.training import energy_loss
 
 SPEEDS = (0.8, 1.2)
 
@@ -157,6 +158,10 @@ def train_dance_model(args: argparse.Namespace) -> tuple[str, float, Path]:
             inputs = inputs + sigma * torch.randn(inputs.shape, generator=noise_rng)
         pred = model.auto_conditioned(inputs, style, args.ground_truth, condition)
         loss = ((pred - x[:, 1:]) ** 2).mean()
+        if args.energy:
+            # Motion energy: each channel's RMS change between frames over the window should match the real
+            # window's. A frozen pose is the mean regression's cheapest answer; this term prices it.
+            loss = loss + args.energy * energy_loss(pred, x[:, 1:])
         optimiser.zero_grad()
         loss.backward()
         torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
