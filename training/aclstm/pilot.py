@@ -1,8 +1,10 @@
 """Measure dance-model training runs quickly (issue 18's pilots) and add them to docs/models/aclstm-pilots.{json,md}.
 
     python -m training.aclstm.pilot RUN [RUN ...] [--frames 3000] [--seeds 3] [--which best|last]
+    python -m training.aclstm.pilot --feedback-noise 0.1 0.15 [--rho 0.9] [--pose-only] [--model aclstm] [--frames 20000]
 
-Each RUN is a folder under runs/ (its best.pt, or last.pt with --which last). What is measured:
+Each RUN is a folder under runs/ (its best.pt, or last.pt with --which last). --feedback-noise measures an exported
+model (public/models/) with noise on each fed-back frame instead, 5 seeds per style. What is measured:
 training/aclstm/pilots.py.
 """
 from __future__ import annotations
@@ -10,31 +12,46 @@ from __future__ import annotations
 import argparse
 import json
 
-from ..paths import REPORTS_DIR
+from ..paths import MODELS_DIR, REPORTS_DIR
 from ..runs import RUNS_DIR
-from .pilots import measure_run, pilot_markdown, summary_line
+from .pilots import feedback_noise_runs, measure_run, pilot_markdown, summary_line
 
 PILOTS = REPORTS_DIR / "aclstm-pilots.json"
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("runs", nargs="+")
-    parser.add_argument("--frames", type=int, default=3000)
+    parser.add_argument("runs", nargs="*")
+    parser.add_argument("--frames", type=int, default=None, help="frames per seed (default 3000 for runs, 20000 for --feedback-noise)")
     parser.add_argument("--seeds", type=int, default=3)
     parser.add_argument("--which", choices=["best", "last"], default="best")
     parser.add_argument("--mocap", default=None)
+    parser.add_argument("--feedback-noise", type=float, nargs="+", default=[], metavar="SIGMA")
+    parser.add_argument("--rho", type=float, default=0.0, help="AR(1) coefficient of the feedback noise (0: white)")
+    parser.add_argument("--pose-only", action="store_true", help="no feedback noise on the root's three channels")
+    parser.add_argument("--model", default="aclstm", help="exported model id for --feedback-noise")
     args = parser.parse_args(argv)
-    table = json.loads(PILOTS.read_text()) if PILOTS.exists() else {}
+    if not args.runs and not args.feedback_noise:
+        parser.error("give RUN names or --feedback-noise")
+    saved = json.loads(PILOTS.read_text()) if PILOTS.exists() else {}
+    if "pilots" not in saved:  # the first format: the pilot rows alone
+        saved = {"pilots": saved, "feedback_noise": {}}
+    table, sweeps = saved["pilots"], saved["feedback_noise"]
+    for sigma in args.feedback_noise:
+        frames = args.frames or 20000
+        w = feedback_noise_runs(MODELS_DIR, args.model, frames, sigma, args.rho, args.pose_only, mocap=args.mocap)
+        sweeps[f"{args.model} sigma {sigma:g} rho {args.rho:g} {'pose' if args.pose_only else 'all'} {frames}"] = w
+        print(f"{args.model} feedback noise {sigma:g} (rho {args.rho:g}, {'pose' if args.pose_only else 'all'}): "
+              f"{w['passes']}/{len(w['runs'])} pass, {w['diverged']} diverged")
     for name in args.runs:
         run_dir = RUNS_DIR / name
-        m = measure_run(run_dir / f"{args.which}.pt", args.frames, args.seeds, args.mocap)
+        m = measure_run(run_dir / f"{args.which}.pt", args.frames or 3000, args.seeds, args.mocap)
         summary = json.loads((run_dir / "summary.json").read_text()) if (run_dir / "summary.json").exists() else {}
         m.pop("details")
         table[f"{name}:{args.which}"] = {**m, "summary": summary}
         print(summary_line(f"{name}:{args.which}", m))
-    PILOTS.write_text(json.dumps(table, indent=1, default=str))
-    PILOTS.with_suffix(".md").write_text(pilot_markdown(table))
+    PILOTS.write_text(json.dumps({"pilots": table, "feedback_noise": sweeps}, indent=1, default=str))
+    PILOTS.with_suffix(".md").write_text(pilot_markdown(table, sweeps))
     print(f"wrote {PILOTS} and {PILOTS.with_suffix('.md')}")
 
 

@@ -14,7 +14,7 @@ import numpy as np
 import torch
 
 from .. import metrics
-from ..data.dance import LIMB_MIN_LENGTH, MODEL_FPS, STYLES, bone_length_error, decode, load_clips
+from ..data.dance import LIMB_MIN_LENGTH, MODEL_FPS, STYLES, bone_length_error, decode, load_clips, resample_positions
 from .exporting import load_dance_model, pick_seeds
 from .freeze_rule import judge, real_reference
 from .report import BONE_ERROR_LIMIT, HEIGHT_BAND, per_second
@@ -91,10 +91,10 @@ def recipe(args: dict) -> str:
     return ", ".join(parts)
 
 
-def pilot_markdown(table: dict) -> str:
-    """docs/models/aclstm-pilots.md: the real clips' reference, then one row per measured run."""
+def pilot_markdown(table: dict, sweeps: dict | None = None) -> str:
+    """docs/models/aclstm-pilots.md: the real clips' reference, one row per measured run, then the feedback-noise sweeps."""
     if not table:
-        return "# acLSTM pilots (issue 18)\n\nNo pilot measured yet.\n"
+        return "# acLSTM pilots (issue 18)\n\nNo pilot measured yet.\n" + "\n".join(feedback_markdown(sweeps or {})) + "\n"
     first = next(iter(table.values()))
     lines = ["# acLSTM pilots (issue 18)", "",
              "Written by `python -m training.aclstm.pilot`. Each pilot is a short training run; its checkpoint rolls out "
@@ -119,4 +119,81 @@ def pilot_markdown(table: dict) -> str:
         minutes = m.get("summary", {}).get("minutes")
         lines.append(f"| {name} | {recipe(m.get('args', {}))} | {m['iteration']} | "
                      f"{'—' if minutes is None else f'{minutes:.0f}'} | " + " | ".join(cells) + f" | {valid} |")
+    lines += feedback_markdown(sweeps or {})
     return "\n".join(lines) + "\n"
+
+
+def jitter_cm(pos: np.ndarray) -> float:
+    """Mean |second difference| of the joints relative to the root (cm per frame²): frame-to-frame shake."""
+    local = pos - pos[:, :1]
+    return float(np.linalg.norm(np.diff(local, 2, axis=0), axis=-1).mean() * 100)
+
+
+def feedback_noise_runs(models_dir: Path, model_id: str, frames: int, sigma: float, rho: float = 0.0,
+                        pose_only: bool = False, seeds_per_style: int = 5, mocap: str | None = None) -> dict:
+    """An inference-time lever on an exported model: Gaussian noise (normalised units; AR(1) with coefficient rho,
+    so rho = 0 is white) added to each fed-back frame, on every channel or on the pose channels only (not the root's
+    three). The output frames are the network's own predictions; only what it reads next is perturbed. Judged by
+    the fairer freeze rule and the report's divergence rules, with the jitter against the real clips'."""
+    from .shipped import ShippedDance
+
+    skel, clips = load_clips(mocap)
+    ref = real_reference(clips)
+    real_jitter = {s: float(np.mean([jitter_cm(resample_positions(c.positions, c.fps, 0.0, int(c.seconds * MODEL_FPS) - 1))
+                                     for c in clips if c.style == s and c.held_out])) for s in STYLES}
+    model = ShippedDance(models_dir, model_id)
+    chosen = [(style, seed) for style in STYLES for seed in model.seeds_of(style)[:seeds_per_style]]
+    rng = np.random.default_rng(0)
+    b = len(chosen)
+    style = np.eye(len(model.styles), dtype=np.float32)[[model.styles.index(s) for s, _ in chosen]]
+    h = np.zeros((model.layers, b, model.hidden), np.float32)
+    c = np.zeros_like(h)
+    seed = ((np.array([s["frames"] for _, s in chosen], np.float32) - model.mean) / model.std).astype(np.float32)
+    for t in range(seed.shape[1]):
+        y, h, c = model.session.run(None, {"x": seed[:, t], "style": style, "h": h, "c": c})
+    mask = np.ones(y.shape[-1], np.float32)
+    if pose_only:
+        mask[:3] = 0.0
+    noise = np.zeros(y.shape, np.float32)
+    out = np.zeros((b, frames, y.shape[-1]), np.float32)
+    for t in range(frames):
+        out[:, t] = y
+        noise = rho * noise + np.sqrt(1 - rho * rho) * sigma * rng.standard_normal(y.shape).astype(np.float32)
+        y, h, c = model.session.run(None, {"x": (y + noise * mask).astype(np.float32), "style": style, "h": h, "c": c})
+    runs = []
+    for (style_name, s), f in zip(chosen, out * model.std + model.mean):
+        finite = bool(np.isfinite(f).all())
+        pos = decode(np.nan_to_num(f.astype(np.float64)))
+        limb = per_second(bone_length_error(pos, skel, LIMB_MIN_LENGTH), MODEL_FPS)
+        height = pos[:, 0, 1]
+        diverged = (not finite or float(limb.max()) > BONE_ERROR_LIMIT
+                    or not (HEIGHT_BAND[0] <= height.min() and height.max() <= HEIGHT_BAND[1]))
+        runs.append({"style": style_name, "seed": s["name"], "diverged": diverged, "limb_error_worst_second": float(limb.max()),
+                     "root_height": [float(height.min()), float(height.max())],
+                     "jitter_vs_real": jitter_cm(pos) / real_jitter[style_name],
+                     **judge(metrics.pose_change_per_second(pos, MODEL_FPS), ref[style_name])})
+    return {"model": model_id, "frames": frames, "sigma": sigma, "rho": rho, "pose_only": pose_only, "real": ref,
+            "real_jitter_cm": real_jitter, "runs": runs,
+            "passes": sum(r["passes"] and not r["diverged"] for r in runs), "diverged": sum(r["diverged"] for r in runs)}
+
+
+def feedback_markdown(sweeps: dict) -> list[str]:
+    """The feedback-noise table of aclstm-pilots.md."""
+    if not sweeps:
+        return []
+    lines = ["", "## Inference-time lever: noise on the fed-back frame (shipped model, no retraining)", "",
+             "Each step the network reads its own last output plus Gaussian noise (normalised units; AR(1) with coefficient "
+             "ρ, ρ = 0 white; on every channel, or the pose channels only), and the output frames are its predictions. "
+             "Same seeds, rule and divergence checks as the report (limb-length error over 25% in a second, root outside "
+             "0.2–1.6 m); jitter is the mean second difference of the joints relative to the root against the real clips'.", "",
+             "| model | σ | ρ | channels | frames | pass (a)–(c), no divergence | diverged | " + " | ".join(f"{s}: passes, worst low share, lowest median, jitter × real" for s in STYLES) + " |",
+             "|---|---|---|---|---|---|---|" + "---|" * len(STYLES)]
+    for key, w in sweeps.items():
+        cells = []
+        for style in STYLES:
+            rs = [r for r in w["runs"] if r["style"] == style]
+            cells.append(f"{sum(r['passes'] and not r['diverged'] for r in rs)}/{len(rs)}, {max(r['low_share'] for r in rs):.0%}, "
+                         f"{min(r['median_ratio'] for r in rs):.0%}, {min(r['jitter_vs_real'] for r in rs):.1f}–{max(r['jitter_vs_real'] for r in rs):.1f}")
+        lines.append(f"| {w['model']} | {w['sigma']:g} | {w['rho']:g} | {'pose' if w['pose_only'] else 'all'} | {w['frames']} | "
+                     f"{w['passes']}/{len(w['runs'])} | {w['diverged']} | " + " | ".join(cells) + " |")
+    return lines
