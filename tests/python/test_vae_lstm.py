@@ -14,7 +14,8 @@ from training.models.vae_lstm import POOLING, VaeLstm
 from training.vae_lstm.exporting import PRIOR_FIXTURE_SEED, generate_rows
 from training.vae_lstm.generation import SEED_FRAMES, SEED_PAD, prior_latents, seed_window
 from training.vae_lstm.measures import ShippedVae
-from training.vae_lstm.training import energy_loss, kl_per_step, losses
+from training.models.losses import energy_loss
+from training.vae_lstm.training import kl_per_step, losses
 
 FIXTURE = REPO / "tests" / "fixtures" / "vae_lstm_reference.json"
 

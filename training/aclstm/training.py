@@ -24,8 +24,8 @@ from tqdm import tqdm
 
 from ..data.dance import MODEL_FPS, STYLES, DanceClip, encode, load_clips, mirror, mirror_pairs, resample_positions, rotate_y
 from ..models.aclstm import DanceLSTM
+from ..models.losses import energy_loss
 from ..runs import Run
-from ..vae_lstm.training import energy_loss
 
 SPEEDS = (0.8, 1.2)
 

@@ -23,7 +23,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--dropout", type=float, default=0.1, help="dropout on the positions and the control")
     parser.add_argument("--beta", type=float, default=0.02, help="KL weight against the mean squared error (2 sigma^2)")
     parser.add_argument("--free", type=float, default=1.0, help="weight of the free-mode reconstruction (0: the paper's recipe)")
-    parser.add_argument("--energy", type=float, default=5.0, help="weight of the free mode's motion-energy term (training.py energy_loss)")
+    parser.add_argument("--energy", type=float, default=5.0, help="weight of the free mode's motion-energy term (models/losses.py energy_loss)")
     parser.add_argument("--l1", type=float, default=L1_PAPER, help="l1 on the weights, against the summed loss")
     parser.add_argument("--control-sigma", type=float, default=10.0, help="frames of smoothing on the control the cell reads")
     parser.add_argument("--batch", type=int, default=32)

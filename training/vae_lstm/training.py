@@ -18,7 +18,7 @@ reconstruction error (and that z_1's KL) counts `free` times. Pilots compare the
 Motion energy (`energy`): a free-mode window that has lost the stride's phase costs least under the squared
 error as the average over phases, a body that glides: free-mode pilots moved their pose at a third of the
 real clips' rate after 1,000 iterations, the paper's recipe at 4%. The term asks each channel's RMS change
-between frames over the window to match the real window's (latent_erd/training.py energy_loss), which does
+between frames over the window to match the real window's (models/losses.py energy_loss), which does
 not depend on the phase.
 
 The control the cell reads is the rows' own signal smoothed over `control_sigma` frames: a drawn path or a
@@ -37,6 +37,7 @@ from tqdm import tqdm
 
 from ..data.locomotion import FPS, load_clips
 from ..data.windows import CONTROL_SLICE, POSITION_DIM, ROW_DIM, WINDOW, WindowCorpus, smooth, window_at
+from ..models.losses import energy_loss
 from ..models.vae_lstm import VaeLstm
 from ..runs import Run
 from .generation import SEED_FRAMES, seed_window
@@ -94,12 +95,6 @@ def kl_per_step(mean: torch.Tensor, log_var: torch.Tensor) -> torch.Tensor:
 
 def sample(mean: torch.Tensor, log_var: torch.Tensor) -> torch.Tensor:
     return mean + torch.randn_like(mean) * (0.5 * log_var).exp()
-
-
-def energy_loss(pred: torch.Tensor, real: torch.Tensor) -> torch.Tensor:
-    """Mean over windows and channels of (RMS frame-to-frame change of pred - of real)^2."""
-    rms = lambda x: torch.sqrt(((x[:, 1:] - x[:, :-1]) ** 2).mean(1) + 1e-6)
-    return ((rms(pred) - rms(real)) ** 2).mean()
 
 
 def losses(model: VaeLstm, x: torch.Tensor, control: torch.Tensor) -> dict:
