@@ -1,6 +1,6 @@
 // The <motion-playground> element (issue 17) on pages of its own, served by the dev server: attributes and
 // properties reflect each other and events fire; two elements run on one page with their own workers and
-// one download per model file; loading="lazy" fetches nothing until scrolled to; bad attributes and link
+// one download per model file, and one taken off the page stops until put back; loading="lazy" fetches nothing until scrolled to; bad attributes and link
 // parameters fire `error` with a reason and keep the defaults; `src` is fetched from the page's origin only;
 // a link round trip gives the same view and the same motion; Share copies the link and Embed shows the
 // snippet; a file or joint name holding markup is shown as text.
@@ -100,6 +100,25 @@ describe('the <motion-playground> element', { timeout: 240_000 }, () => {
     const counts = [...perFile].map(([u, n]) => [u.split('/').pop(), n]);
     assert.ok(counts.some(([f]) => /\.onnx$/.test(f)) && counts.some(([f]) => /\.wasm$/.test(f)), `the model and the runtime were fetched: ${JSON.stringify(counts)}`);
     assert.deepEqual(counts.filter(([, n]) => n > 1), [], `each model file is downloaded once for both elements: ${JSON.stringify(counts)}`);
+    // Taken off the page, an element stops drawing and streaming; put back, it dances again.
+    const pausedAt = await page.evaluate(() => {
+      const a = document.getElementById('a');
+      a.play();
+      return a.playground.state().frame;
+    });
+    await waitUntil(page, (n) => document.getElementById('a').playground.state().frame > n + 5, pausedAt, { message: 'the first element plays again' });
+    const removedAt = await page.evaluate(() => {
+      const a = document.getElementById('a');
+      window.removedA = a;
+      a.remove();
+      return a.playground.state().frame;
+    });
+    const bNow = await page.evaluate(() => document.getElementById('b').playground.state().frame);
+    await waitUntil(page, (n) => document.getElementById('b').playground.state().frame > n + 30, bNow, { message: 'the other element plays on' });
+    assert.equal(await page.evaluate(() => window.removedA.playground.state().frame), removedAt, 'the removed element is still');
+    const motions = (await events(page, 'a', 'motion')).length;
+    await page.evaluate(() => document.body.prepend(window.removedA));
+    await waitUntil(page, (n) => window.events.filter((e) => e.id === 'a' && e.type === 'motion').length > n && document.getElementById('a').playground.state().frame > 10, motions, { message: 'put back, it streams a dance again' });
     assert.deepEqual(problems, []);
     await context.close();
   });

@@ -37,6 +37,8 @@ export class MotionPlaygroundElement extends HTMLElement {
   /** Set while the element writes its own attributes (reflecting the UI): no re-apply. */
   private reflecting = false;
   private wasPlaying = false;
+  /** Taken off the page (disconnectedCallback): its frame loop and live stream are stopped until it is back. */
+  private suspended = false;
   private linkTimer = 0;
   /** Bumped for every `src` load: a slower earlier one does not replace a later one. */
   private srcToken = 0;
@@ -60,6 +62,10 @@ export class MotionPlaygroundElement extends HTMLElement {
   connectedCallback(): void {
     this.showControls();
     this.showPoster();
+    if (this.suspended) {
+      this.suspended = false;
+      this.app?.resume();
+    }
     if (this.app || this.lazyObserver) return;
     if (this.getAttribute('loading') === 'lazy' && 'IntersectionObserver' in window) {
       // Nothing is fetched (onnxruntime-web, models) until the element comes near the viewport.
@@ -75,6 +81,12 @@ export class MotionPlaygroundElement extends HTMLElement {
   disconnectedCallback(): void {
     this.lazyObserver?.disconnect();
     this.lazyObserver = null;
+    // Taken off the page: stop drawing and streaming, unless it was only moved (connected again in this task).
+    queueMicrotask(() => {
+      if (this.isConnected || !this.app || this.suspended) return;
+      this.suspended = true;
+      this.app.suspend();
+    });
   }
 
   attributeChangedCallback(name: string, before: string | null, after: string | null): void {

@@ -137,6 +137,20 @@ export class App implements ModeHost {
     return host;
   }
 
+  /**
+   * Off the page (its element removed): the frame loop stops and a live stream ends, so a removed element costs
+   * nothing. `resume` starts both again (a live mode restarts its stream from its settings).
+   */
+  suspend(): void {
+    this.viewer.setRunning(false);
+    this.liveMode(this.mode)?.stop();
+  }
+
+  resume(): void {
+    this.viewer.setRunning(true);
+    void this.liveMode(this.mode)?.begin();
+  }
+
   private liveMode(mode: Mode): LiveMode<LiveChunk> | null {
     return mode === 'walk' ? this.walk : mode === 'dance' ? this.danceMode : mode === 'steer' ? this.steerMode : null;
   }

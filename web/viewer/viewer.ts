@@ -111,8 +111,13 @@ export class Viewer {
 
     new ResizeObserver(() => this.resize()).observe(container);
     this.resize();
+    this.setRunning(true);
+  }
+
+  /** Starts or stops the frame loop (an element taken off the page draws nothing and costs nothing). */
+  setRunning(running: boolean): void {
     this.last = performance.now();
-    this.renderer.setAnimationLoop((t) => this.tick(t));
+    this.renderer.setAnimationLoop(running ? (t) => this.tick(t) : null);
   }
 
   get current(): Motion | null {
