@@ -30,6 +30,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--rho", type=float, default=0.0, help="AR(1) coefficient of the feedback noise (0: white)")
     parser.add_argument("--pose-only", action="store_true", help="no feedback noise on the root's three channels")
     parser.add_argument("--model", default="aclstm", help="exported model id for --feedback-noise")
+    parser.add_argument("--rollout-noise", type=float, default=0.0, help="white noise on each fed-back frame of a RUN's rollouts")
     args = parser.parse_args(argv)
     if not args.runs and not args.feedback_noise:
         parser.error("give RUN names or --feedback-noise")
@@ -45,11 +46,12 @@ def main(argv: list[str] | None = None) -> None:
               f"{w['passes']}/{len(w['runs'])} pass, {w['diverged']} diverged")
     for name in args.runs:
         run_dir = RUNS_DIR / name
-        m = measure_run(run_dir / f"{args.which}.pt", args.frames or 3000, args.seeds, args.mocap)
+        m = measure_run(run_dir / f"{args.which}.pt", args.frames or 3000, args.seeds, args.mocap, args.rollout_noise)
         summary = json.loads((run_dir / "summary.json").read_text()) if (run_dir / "summary.json").exists() else {}
         m.pop("details")
-        table[f"{name}:{args.which}"] = {**m, "summary": summary}
-        print(summary_line(f"{name}:{args.which}", m))
+        key = f"{name}:{args.which}" + (f" +noise {args.rollout_noise:g}" if args.rollout_noise else "")
+        table[key] = {**m, "summary": summary}
+        print(summary_line(key, m))
     PILOTS.write_text(json.dumps({"pilots": table, "feedback_noise": sweeps}, indent=1, default=str))
     PILOTS.with_suffix(".md").write_text(pilot_markdown(table, sweeps))
     print(f"wrote {PILOTS} and {PILOTS.with_suffix('.md')}")

@@ -20,8 +20,9 @@ from .freeze_rule import judge, real_reference
 from .report import BONE_ERROR_LIMIT, HEIGHT_BAND, per_second
 
 
-def rollout(model, meta: dict, seed_frames: np.ndarray, styles: list[str], frames: int) -> np.ndarray:
-    """Warm up on the seeds (batch, seed, dim; physical units), then feed outputs back: (batch, frames, dim)."""
+def rollout(model, meta: dict, seed_frames: np.ndarray, styles: list[str], frames: int, feedback_noise: float = 0.0) -> np.ndarray:
+    """Warm up on the seeds (batch, seed, dim; physical units), then feed outputs back (plus white noise of
+    `feedback_noise`, normalised units, seeded): (batch, frames, dim)."""
     mean, std = np.array(meta["mean"], np.float32), np.array(meta["std"], np.float32)
     style = torch.eye(len(meta["styles"]))[[meta["styles"].index(s) for s in styles]]
     x = torch.from_numpy(((seed_frames - mean) / std).astype(np.float32))
@@ -29,19 +30,23 @@ def rollout(model, meta: dict, seed_frames: np.ndarray, styles: list[str], frame
     with torch.no_grad():
         y, state = model(x, style)
         y = y[:, -1:]
+        noise = torch.Generator().manual_seed(0)
         for t in range(frames):
             out[:, t] = y[:, 0].numpy()
-            y, state = model(y, style, state)
+            fed = y + feedback_noise * torch.randn(y.shape, generator=noise) if feedback_noise else y
+            y, state = model(fed, style, state)
     return out * std + mean
 
 
-def measure_run(checkpoint: Path, frames: int = 3000, seeds_per_style: int = 3, mocap: str | None = None) -> dict:
+def measure_run(checkpoint: Path, frames: int = 3000, seeds_per_style: int = 3, mocap: str | None = None,
+                feedback_noise: float = 0.0) -> dict:
     """The pilot measure of one checkpoint: per style and seed the freeze-rule numbers; validation from the run."""
     skel, clips = load_clips(mocap)
     model, meta, state = load_dance_model(checkpoint)
     ref = real_reference(clips)
     chosen = [s for style in STYLES for s in [x for x in pick_seeds(clips) if x["style"] == style][:seeds_per_style]]
-    feats = rollout(model, meta, np.array([s["frames"] for s in chosen], np.float32), [s["style"] for s in chosen], frames)
+    feats = rollout(model, meta, np.array([s["frames"] for s in chosen], np.float32), [s["style"] for s in chosen], frames,
+                    feedback_noise)
     runs = []
     for seed, f in zip(chosen, feats):
         finite = bool(np.isfinite(f).all())
@@ -62,6 +67,7 @@ def measure_run(checkpoint: Path, frames: int = 3000, seeds_per_style: int = 3, 
                             "diverged": sum(r["diverged"] for r in mine)}
     valid = state.get("valid") or (state.get("history") or [{}])[-1].get("valid") or {}  # best.pt, else the last epoch
     return {"checkpoint": str(checkpoint), "iteration": state.get("iteration"), "frames": frames, "args": meta.get("args", {}),
+            "rollout_feedback_noise": feedback_noise,
             "valid": {s: valid.get(s) for s in STYLES} if valid else None, "real": ref, "per_style": per_style,
             "passes": sum(p["passes"] for p in per_style.values()), "runs": len(runs), "details": runs}
 
@@ -83,6 +89,8 @@ def recipe(args: dict) -> str:
              f"u={args.get('ground_truth', 5)} v={args.get('condition', 5)}"
              + (f"->{args['condition_max']}" if args.get("condition_max") else ""),
              f"lr {args.get('lr', 1e-3):g} x{args.get('decay', 0.95):g}/epoch"]
+    if args.get("feedback_noise"):
+        parts.append(f"feedback noise {args['feedback_noise']:g}")
     if args.get("energy"):
         parts.append(f"energy {args['energy']:g}")
     noise = args.get("input_noise") or (0, 0)

@@ -25,6 +25,8 @@ def main(argv: list[str] | None = None) -> None:
                         help="Gaussian noise on the real input frames (normalised units), growing from START to END over the time budget")
     parser.add_argument("--energy", type=float, default=0.0,
                         help="weight of the motion-energy term (each channel's RMS frame-to-frame change against the real window's)")
+    parser.add_argument("--feedback-noise", type=float, default=0.0,
+                        help="Gaussian noise (normalised units) on each self-fed frame in training, as the inference-time lever adds it")
     parser.add_argument("--hidden", type=int, default=256)
     parser.add_argument("--layers", type=int, default=3)
     parser.add_argument("--batch", type=int, default=32)

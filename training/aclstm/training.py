@@ -156,7 +156,7 @@ def train_dance_model(args: argparse.Namespace) -> tuple[str, float, Path]:
         sigma = args.input_noise[0] + (args.input_noise[1] - args.input_noise[0]) * progress
         if sigma > 0:
             inputs = inputs + sigma * torch.randn(inputs.shape, generator=noise_rng)
-        pred = model.auto_conditioned(inputs, style, args.ground_truth, condition)
+        pred = model.auto_conditioned(inputs, style, args.ground_truth, condition, args.feedback_noise)
         loss = ((pred - x[:, 1:]) ** 2).mean()
         if args.energy:
             # Motion energy: each channel's RMS change between frames over the window should match the real

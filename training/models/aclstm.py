@@ -26,10 +26,13 @@ class DanceLSTM(nn.Module):
         y, state = self.lstm(torch.cat([x, s], dim=-1), state)
         return self.decoder(y), state
 
-    def auto_conditioned(self, x: torch.Tensor, style: torch.Tensor, ground_truth: int, condition: int):
+    def auto_conditioned(self, x: torch.Tensor, style: torch.Tensor, ground_truth: int, condition: int,
+                         feedback_noise: float = 0.0):
         """The acRNN unroll: `ground_truth` real input frames, then `condition` frames of the network's own
         output fed back as input, alternating; returns the prediction for every input position.
-        With condition=0 this is plain teacher forcing. Gradients flow through the fed-back frames."""
+        With condition=0 this is plain teacher forcing. Gradients flow through the fed-back frames.
+        `feedback_noise`: Gaussian noise (normalised units) added to each fed-back frame, as at generation
+        with the inference-time lever (the prediction itself is returned clean)."""
         if condition == 0:
             return self(x, style)[0]
         outs, state, t, total = [], None, 0, x.shape[1]
@@ -40,7 +43,8 @@ class DanceLSTM(nn.Module):
             t += n
             prev = y[:, -1:]
             for _ in range(min(condition, total - t)):
-                prev, state = self(prev, style, state)
+                fed = prev + feedback_noise * torch.randn_like(prev) if feedback_noise else prev
+                prev, state = self(fed, style, state)
                 outs.append(prev)
                 t += 1
         return torch.cat(outs, dim=1)
