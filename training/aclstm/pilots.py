@@ -110,7 +110,8 @@ def pilot_markdown(table: dict, sweeps: dict | None = None) -> str:
              "fairer freeze rule (`training/aclstm/freeze_rule.py`): a *low* second is below 20% of the style's real median "
              "pose change; a run passes when (a) its share of low seconds is at most twice the real clips' share, (b) no low "
              "stretch lasts 5 s or more, and (c) its median is at least 50% of the real median. Each style's cell gives the "
-             "passes and, over its seeds, the worst low share, the longest low stretch and the lowest median (share of real).",
+             "passes and, over its seeds, the worst low share, the longest low stretch and the lowest median (share of real). "
+             "Rows marked *+noise σ* are rolled out with white noise σ (normalised units) on each fed-back frame.",
              "",
              "Real held-out clips, measured the same way (each clip alone): "
              + "; ".join(f"{s} median {r['median']:.3f} m/s, low share {r['low_share']:.1%}, longest low stretch "
