@@ -152,25 +152,10 @@ def feedback_noise_runs(models_dir: Path, model_id: str, frames: int, sigma: flo
                                      for c in clips if c.style == s and c.held_out])) for s in STYLES}
     model = ShippedDance(models_dir, model_id)
     chosen = [(style, seed) for style in STYLES for seed in model.seeds_of(style)[:seeds_per_style]]
-    rng = np.random.default_rng(0)
-    b = len(chosen)
-    style = np.eye(len(model.styles), dtype=np.float32)[[model.styles.index(s) for s, _ in chosen]]
-    h = np.zeros((model.layers, b, model.hidden), np.float32)
-    c = np.zeros_like(h)
-    seed = ((np.array([s["frames"] for _, s in chosen], np.float32) - model.mean) / model.std).astype(np.float32)
-    for t in range(seed.shape[1]):
-        y, h, c = model.session.run(None, {"x": seed[:, t], "style": style, "h": h, "c": c})
-    mask = np.ones(y.shape[-1], np.float32)
-    if pose_only:
-        mask[:3] = 0.0
-    noise = np.zeros(y.shape, np.float32)
-    out = np.zeros((b, frames, y.shape[-1]), np.float32)
-    for t in range(frames):
-        out[:, t] = y
-        noise = rho * noise + np.sqrt(1 - rho * rho) * sigma * rng.standard_normal(y.shape).astype(np.float32)
-        y, h, c = model.session.run(None, {"x": (y + noise * mask).astype(np.float32), "style": style, "h": h, "c": c})
+    feats = model.generate(np.array([s["frames"] for _, s in chosen], np.float32), [style for style, _ in chosen], frames,
+                           feedback_noise=sigma, rho=rho, pose_only=pose_only)
     runs = []
-    for (style_name, s), f in zip(chosen, out * model.std + model.mean):
+    for (style_name, s), f in zip(chosen, feats):
         finite = bool(np.isfinite(f).all())
         pos = decode(np.nan_to_num(f.astype(np.float64)))
         limb = per_second(bone_length_error(pos, skel, LIMB_MIN_LENGTH), MODEL_FPS)

@@ -22,18 +22,30 @@ class ShippedDance:
     def seeds_of(self, style: str) -> list[dict]:
         return [s for s in self.info["seeds"] if s["style"] == style]
 
-    def generate(self, seed_frames: np.ndarray, styles: list[str], frames: int, progress: bool = False) -> np.ndarray:
+    def generate(self, seed_frames: np.ndarray, styles: list[str], frames: int, progress: bool = False,
+                 feedback_noise: float = 0.0, rho: float = 0.0, pose_only: bool = False, seed: int = 0) -> np.ndarray:
         """Warm up on seed_frames (batch, seed, dim; physical units), then feed outputs back for `frames` steps.
-        Returns the generated features (batch, frames, dim) in physical units."""
+        Returns the generated features (batch, frames, dim) in physical units. `feedback_noise`: Gaussian noise
+        (normalised units, AR(1) with coefficient `rho`, seeded by `seed`) added to what the network reads back,
+        on every channel or, with `pose_only`, not the root's three; the outputs stay its own predictions."""
         b = len(seed_frames)
         style = np.eye(len(self.styles), dtype=np.float32)[[self.styles.index(s) for s in styles]]
         h = np.zeros((self.layers, b, self.hidden), np.float32)
         c = np.zeros_like(h)
-        seed = ((np.asarray(seed_frames) - self.mean) / self.std).astype(np.float32)
-        for t in range(seed.shape[1]):
-            y, h, c = self.session.run(None, {"x": seed[:, t], "style": style, "h": h, "c": c})
+        warm = ((np.asarray(seed_frames) - self.mean) / self.std).astype(np.float32)
+        for t in range(warm.shape[1]):
+            y, h, c = self.session.run(None, {"x": warm[:, t], "style": style, "h": h, "c": c})
         out = np.zeros((b, frames, len(self.mean)), np.float32)
+        rng = np.random.default_rng(seed)
+        mask = np.ones(len(self.mean), np.float32)
+        if pose_only:
+            mask[:3] = 0.0
+        noise = np.zeros(y.shape, np.float32)
         for t in tqdm(range(frames), desc="dance", unit="frame", disable=not progress):
             out[:, t] = y
-            y, h, c = self.session.run(None, {"x": y, "style": style, "h": h, "c": c})
+            x = y
+            if feedback_noise:
+                noise = rho * noise + np.sqrt(1 - rho * rho) * feedback_noise * rng.standard_normal(y.shape).astype(np.float32)
+                x = (y + noise * mask).astype(np.float32)
+            y, h, c = self.session.run(None, {"x": x, "style": style, "h": h, "c": c})
         return out * self.std + self.mean

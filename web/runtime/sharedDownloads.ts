@@ -15,16 +15,12 @@ export type DownloadReply = { type: 'downloaded'; download: number; bytes: Array
 
 const downloads = new Map<string, Promise<ArrayBuffer>>();
 
-/** How many fetches this page made per URL (tests and the bench read it through the API's diagnostics). */
-export const downloadCounts = new Map<string, number>();
-
 /** The bytes at `url`, fetched once for the page; rejects with a short reason ("HTTP 404 Not Found"). */
 export function sharedDownload(url: string): Promise<ArrayBuffer> {
   const known = downloads.get(url);
   if (known) return known;
   const started = fetchBytes(url);
   downloads.set(url, started);
-  downloadCounts.set(url, (downloadCounts.get(url) ?? 0) + 1);
   started.catch(() => downloads.delete(url));
   return started;
 }
