@@ -131,24 +131,26 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
     assert.ok(m.worstBone < 1e-4, `worst bone error ${m.worstBone}`);
   });
 
-  test('ONNX parity in the browser: one step matches the Python reference within 1e-4', async () => {
-    const outputs = await suite.page.evaluate(async (inputs) => {
-      const { DanceClient } = await import('/runtime/danceClient.ts');
-      const client = new DanceClient({ model: 'aclstm', threads: 1 });
-      try {
-        await client.init();
-        const r = await client.parity(inputs);
-        return Object.fromEntries(Object.entries(r.outputs).map(([k, v]) => [k, Array.from(v)]));
-      } finally {
-        client.dispose();
+  test('ONNX parity in the browser: one step and a many-step call match the Python reference within 1e-4', async () => {
+    for (const which of ['step', 'steps']) {
+      const outputs = await suite.page.evaluate(async (inputs) => {
+        const { DanceClient } = await import('/runtime/danceClient.ts');
+        const client = new DanceClient({ model: 'aclstm', threads: 1 });
+        try {
+          await client.init();
+          const r = await client.parity(inputs);
+          return Object.fromEntries(Object.entries(r.outputs).map(([k, v]) => [k, Array.from(v)]));
+        } finally {
+          client.dispose();
+        }
+      }, REFERENCE[which].inputs);
+      for (const key of ['ys', 'h_out', 'c_out']) {
+        const expected = REFERENCE[which].outputs[key];
+        assert.equal(outputs[key].length, expected.length, `${which} ${key} length`);
+        let worst = 0;
+        for (let i = 0; i < expected.length; i++) worst = Math.max(worst, Math.abs(outputs[key][i] - expected[i]));
+        assert.ok(worst <= 1e-4, `${which} ${key}: worst |a−b| = ${worst}`);
       }
-    }, REFERENCE.step.inputs);
-    for (const key of ['y', 'h_out', 'c_out']) {
-      const expected = REFERENCE.step.outputs[key];
-      assert.equal(outputs[key].length, expected.length, `${key} length`);
-      let worst = 0;
-      for (let i = 0; i < expected.length; i++) worst = Math.max(worst, Math.abs(outputs[key][i] - expected[i]));
-      assert.ok(worst <= 1e-4, `${key}: worst |a−b| = ${worst}`);
     }
   });
 

@@ -72,7 +72,7 @@ describe('parseDanceInfo', () => {
       edit(j);
       return () => parseDanceInfo(j, 'test.json');
     };
-    expect(broken((j) => (j.onnx.inputs = ['x', 'h', 'c']))).toThrow(/test\.json: onnx\.inputs is \[x,h,c\], expected \[x,style,h,c\]/);
+    expect(broken((j) => (j.onnx.inputs = ['x', 'h', 'c']))).toThrow(/test\.json: onnx\.inputs is \[x,h,c\], expected \[x,style,h,c,steps\]/);
     expect(broken((j) => (j.onnx.dim = 170))).toThrow(/onnx\.dim is 170 but 57 skeleton points need 171/);
     expect(broken((j) => (j.seeds[3].style = 'tango'))).toThrow(/seeds\[3\]\.style must be one of salsa, indian, martial/);
     expect(broken((j) => j.seeds[0].frames.pop())).toThrow(/seeds\[0\]\.frames must hold 10 frames/);

@@ -2,6 +2,7 @@
 
     python -m training.aclstm.export [--run aclstm] [--id aclstm]
     python -m training.aclstm.export --run aclstm-vanilla --id aclstm-vanilla
+    python -m training.aclstm.export --id aclstm --from-shipped [--weights int8]   # no checkpoint: rewrite the shipped file
 
 What the files hold: training/aclstm/exporting.py.
 """
@@ -12,7 +13,8 @@ from pathlib import Path
 
 from ..paths import MODELS_DIR
 from ..runs import RUNS_DIR
-from .exporting import export_dance_model
+from ..onnx.compact import FORMATS
+from .exporting import export_dance_model, rewrite_dance_model
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -22,12 +24,19 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--id", default=None, help="model id and file name (default: the run name)")
     parser.add_argument("--out", type=Path, default=MODELS_DIR)
     parser.add_argument("--mocap", default=None)
+    parser.add_argument("--weights", choices=FORMATS, default="float16", help="how the file stores its large weights")
+    parser.add_argument("--from-shipped", type=Path, nargs="?", const=MODELS_DIR, default=None, metavar="DIR",
+                        help="no checkpoint: read the network back from DIR/<id>.onnx (default the shipped one) and keep its JSON")
     args = parser.parse_args(argv)
     model_id = args.id or args.run
+    if args.from_shipped is not None:
+        onnx_path = rewrite_dance_model(args.from_shipped, model_id, args.out, args.weights)
+        print(f"wrote {onnx_path} ({onnx_path.stat().st_size / 1e6:.2f} MB) and {model_id}.json")
+        return
     checkpoint = RUNS_DIR / args.run / args.checkpoint
     if not checkpoint.exists():
         raise SystemExit(f"error: no checkpoint at {checkpoint}; train first with python -m training.aclstm.train")
-    onnx_path = export_dance_model(checkpoint, model_id, args.out, args.mocap)
+    onnx_path = export_dance_model(checkpoint, model_id, args.out, args.mocap, args.weights)
     print(f"wrote {onnx_path} ({onnx_path.stat().st_size / 1e6:.2f} MB) and {model_id}.json")
 
 

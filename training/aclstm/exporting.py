@@ -1,6 +1,7 @@
 """Exporting the dance models (acLSTM and its vanilla baseline): ONNX step plus JSON, parity checked.
 
-public/models/<id>.onnx is one step: x, style, h, c -> y, h_out, c_out (the batch dimension is dynamic);
+public/models/<id>.onnx runs K steps in one call: x, style, h, c, steps -> ys (steps frames), h_out, c_out (the batch
+dimension is dynamic; training/aclstm/graph.py); its large weights are stored as float16 or int8 (training/onnx/compact.py).
 <id>.json holds the skeleton, feature layout, normalisation, per-style seed motions (10 real frames each,
 from held-out clips), the real per-second pose change per style, training and parity numbers.
 """
@@ -10,17 +11,17 @@ import json
 from pathlib import Path
 
 import numpy as np
+import onnx
 import torch
 
 from ..data.dance import STYLES, DanceClip, decode, encode, load_clips, real_pose_change, resample_positions
-from ..models.aclstm import DanceLSTM, DanceStep
+from ..models.aclstm import DanceLSTM
+from ..onnx.compact import compact_weights, weight_format
 from ..onnx.manifest import register_model
 from ..onnx.sessions import cpu_session
 from ..paths import MODELS_DIR, REPO_ROOT
+from .graph import INPUTS, OUTPUTS, check_parity, dance_graph, dance_model_from_onnx
 
-
-INPUTS, OUTPUTS = ["x", "style", "h", "c"], ["y", "h_out", "c_out"]
-PARITY_TOLERANCE = 1e-4
 SEED_FRAMES = 10  # the paper's seed length (about 170 ms at 60 fps)
 SEEDS_PER_STYLE = 8
 FIXTURE = REPO_ROOT / "tests" / "fixtures" / "aclstm_reference.json"
@@ -34,35 +35,11 @@ def load_dance_model(checkpoint: Path) -> tuple[DanceLSTM, dict, dict]:
     return model.eval(), meta, state
 
 
-def export_onnx(model: DanceLSTM, path: Path) -> None:
-    step = DanceStep(model).eval()
-    x, style = torch.zeros(1, model.dim), torch.zeros(1, model.styles)
-    h, c = model.zero_state(1)
-    b = {0: "batch"}
-    torch.onnx.export(step, (x, style, h, c), str(path), input_names=INPUTS, output_names=OUTPUTS, opset_version=17,
-                      dynamo=False, dynamic_axes={"x": b, "style": b, "h": {1: "batch"}, "c": {1: "batch"}, "y": b,
-                                                  "h_out": {1: "batch"}, "c_out": {1: "batch"}})
-
-
-def check_parity(model: DanceLSTM, path: Path, steps: int = 20) -> dict:
-    """torch against onnxruntime for several steps at batch 1 and 5, feeding outputs and states back."""
-    session = cpu_session(path)
-    step = DanceStep(model).eval()
-    rng = np.random.default_rng(1)
-    worst = 0.0
-    for batch in (1, 5):
-        x = rng.normal(size=(batch, model.dim)).astype(np.float32)
-        style = np.eye(model.styles, dtype=np.float32)[rng.integers(0, model.styles, batch)]
-        h, c = (s.numpy() for s in model.zero_state(batch))
-        for _ in range(steps):
-            with torch.no_grad():
-                ref = [t.numpy() for t in step(*(torch.from_numpy(a) for a in (x, style, h, c)))]
-            got = session.run(OUTPUTS, {"x": x, "style": style, "h": h, "c": c})
-            worst = max(worst, max(float(np.abs(a - b).max()) for a, b in zip(ref, got)))
-            x, h, c = ref
-    if worst > PARITY_TOLERANCE:
-        raise SystemExit(f"error: ONNX parity failed, max |torch - onnxruntime| = {worst:.2e} > {PARITY_TOLERANCE:.0e}")
-    return {"max_abs_diff": worst, "tolerance": PARITY_TOLERANCE, "batches": [1, 5], "steps": steps}
+def export_onnx(model: DanceLSTM, path: Path, weights: str = "float32") -> DanceLSTM:
+    """Writes the step graph with its large weights stored as `weights`; returns the network the file computes
+    (the weights as stored), the reference for the parity check."""
+    onnx.save(compact_weights(dance_graph(model), weights), str(path))
+    return dance_model_from_onnx(path, model.dim, model.styles, model.hidden, model.layers)
 
 
 def pick_seeds(clips: list[DanceClip]) -> list[dict]:
@@ -82,8 +59,12 @@ def pick_seeds(clips: list[DanceClip]) -> list[dict]:
     return seeds
 
 
+FIXTURE_STEPS = 24
+
+
 def write_reference_fixture(onnx_path: Path, info: dict) -> None:
-    """One ONNX step at batch 2 (onnxruntime-web parity) and a decoded seed (TypeScript decoder parity)."""
+    """ONNX calls at batch 2 for onnxruntime-web parity, one step and FIXTURE_STEPS steps from the same inputs, and a
+    decoded seed (TypeScript decoder parity)."""
     session = cpu_session(onnx_path)
     mean, std = np.array(info["normalisation"]["mean"]), np.array(info["normalisation"]["std"])
     seeds = [info["seeds"][0], info["seeds"][-1]]
@@ -92,13 +73,15 @@ def write_reference_fixture(onnx_path: Path, info: dict) -> None:
     rng = np.random.default_rng(3)
     shape = (info["onnx"]["layers"], 2, info["onnx"]["hidden"])
     h, c = (rng.normal(scale=0.3, size=shape).astype(np.float32) for _ in range(2))
-    outs = session.run(OUTPUTS, {"x": x, "style": style, "h": h, "c": c})
+    inputs = {"x": x.ravel().tolist(), "style": style.ravel().tolist(), "h": h.ravel().tolist(), "c": c.ravel().tolist(), "batch": 2}
+
+    def case(steps: int) -> dict:
+        outs = session.run(OUTPUTS, {"x": x, "style": style, "h": h, "c": c, "steps": np.array([steps], np.int64)})
+        return {"inputs": {**inputs, "steps": steps}, "outputs": {n: np.asarray(o).ravel().tolist() for n, o in zip(OUTPUTS, outs)}}
+
     feats = np.array(seeds[0]["frames"])
-    step = {"inputs": {"x": x.ravel().tolist(), "style": style.ravel().tolist(), "h": h.ravel().tolist(),
-                       "c": c.ravel().tolist(), "batch": 2},
-            "outputs": {n: np.asarray(o).ravel().tolist() for n, o in zip(OUTPUTS, outs)}}
     decoded = {"features": feats.ravel().tolist(), "frames": len(feats), "positions": decode(feats).ravel().tolist()}
-    FIXTURE.write_text(json.dumps({"model": info["file"], "step": step, "decode": decoded}) + "\n")
+    FIXTURE.write_text(json.dumps({"model": info["file"], "step": case(1), "steps": case(FIXTURE_STEPS), "decode": decoded}) + "\n")
     print(f"wrote {FIXTURE}")
 
 
@@ -112,19 +95,41 @@ def training_minutes(checkpoint: Path, iteration: int | None) -> float | None:
     return round(upto[-1], 1) if upto else None
 
 
-def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | None) -> Path:
-    """Writes out/<model_id>.onnx (parity checked) and out/<model_id>.json; into MODELS_DIR also the manifest
-    entry and, for the auto-conditioned model, the browser fixture. Returns the ONNX path."""
+def _write_graph(model: DanceLSTM, onnx_path: Path, weights: str) -> tuple[dict, dict]:
+    """Writes and parity-checks the graph; returns the JSON's `onnx` and `parity` fields."""
+    stored = export_onnx(model, onnx_path, weights)
+    parity = {**check_parity(stored, onnx_path), "reference": f"torch with the weights as stored ({weights})"}
+    print(f"parity ok: max |torch - onnxruntime| = {parity['max_abs_diff']:.2e}")
+    fields = {"inputs": INPUTS, "outputs": OUTPUTS, "opset": 17, "layers": model.layers, "hidden": model.hidden,
+              "dim": model.dim, "styles": model.styles, "weights": weight_format(onnx.load(str(onnx_path))),
+              "style_input": "one-hot over `styles`; x and ys are normalised features",
+              "steps_input": "int64 (1,): steps run in the call, each output frame fed back as the next input; "
+                             "ys is (steps, batch, dim)"}
+    return fields, parity
+
+
+def _publish(info: dict, onnx_path: Path, model_id: str, out: Path) -> None:
+    """The JSON beside the graph; into MODELS_DIR also the manifest entry and, for the auto-conditioned model, the
+    browser fixture."""
+    info["bytes"] = onnx_path.stat().st_size
+    (out / f"{model_id}.json").write_text(json.dumps(info) + "\n")
+    if info["training_scheme"] == "auto-conditioned" and out == MODELS_DIR:
+        write_reference_fixture(onnx_path, info)
+    if out == MODELS_DIR:
+        register_model({"id": model_id, "kind": "aclstm", "skeleton": "aclstm-standard", "fps": info["fps"],
+                        "styles": info["styles"], "bytes": info["bytes"], "file": info["file"]})
+
+
+def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | None, weights: str = "float16") -> Path:
+    """Writes out/<model_id>.onnx (parity checked) and out/<model_id>.json (see _publish). Returns the ONNX path."""
     model, meta, state = load_dance_model(checkpoint)
     out.mkdir(parents=True, exist_ok=True)
     onnx_path = out / f"{model_id}.onnx"
-    export_onnx(model, onnx_path)
-    parity = check_parity(model, onnx_path)
-    print(f"parity ok: max |torch - onnxruntime| = {parity['max_abs_diff']:.2e}")
+    onnx_fields, parity = _write_graph(model, onnx_path, weights)
     _, clips = load_clips(mocap)
     vanilla = meta["args"]["condition"] == 0
     info = {
-        "id": model_id, "kind": "aclstm", "fps": meta["fps"], "file": onnx_path.name, "bytes": onnx_path.stat().st_size,
+        "id": model_id, "kind": "aclstm", "fps": meta["fps"], "file": onnx_path.name,
         "description": ("Vanilla 3-layer LSTM trained with teacher forcing only (the acLSTM paper's baseline)" if vanilla else
                         "Auto-conditioned LSTM (Zhou et al.), u = v = 5") + ", one model for salsa, Indian and martial-arts dance.",
         "training_scheme": "teacher-forced" if vanilla else "auto-conditioned",
@@ -133,9 +138,7 @@ def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | 
         "features": {"dim": meta["dim"], "seed_frames": SEED_FRAMES,
                      "layout": "x = [root dx (m/frame), root height y (m), root dz (m/frame), then for each skeleton point "
                                "after the root: its position minus the root's (m, world axes)]; y up, " f"{meta['fps']:g} fps"},
-        "onnx": {"inputs": INPUTS, "outputs": OUTPUTS, "opset": 17, "layers": meta["layers"], "hidden": meta["hidden"],
-                 "dim": meta["dim"], "styles": len(meta["styles"]),
-                 "style_input": "one-hot over `styles`; x and y are normalised features"},
+        "onnx": onnx_fields,
         "normalisation": {"mean": [round(float(v), 7) for v in meta["mean"]], "std": [round(float(v), 7) for v in meta["std"]]},
         "real_pose_change": real_pose_change(clips),
         "seeds": pick_seeds(clips),
@@ -143,10 +146,19 @@ def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | 
                      "valid": state.get("valid"), "valid_files": meta["valid_files"], "args": meta["args"]},
         "parity": parity,
     }
-    (out / f"{model_id}.json").write_text(json.dumps(info) + "\n")
-    if not vanilla and out == MODELS_DIR:
-        write_reference_fixture(onnx_path, info)
-    if out == MODELS_DIR:
-        register_model({"id": model_id, "kind": "aclstm", "skeleton": "aclstm-standard", "fps": info["fps"],
-                        "styles": info["styles"], "bytes": info["bytes"], "file": info["file"]})
+    _publish(info, onnx_path, model_id, out)
+    return onnx_path
+
+
+def rewrite_dance_model(source: Path, model_id: str, out: Path, weights: str) -> Path:
+    """The exported model `source`/<model_id>.{json,onnx} written again with this graph and weight format, without
+    its checkpoint: the network is read back from the ONNX file, everything else of the JSON is kept."""
+    info = json.loads((source / f"{model_id}.json").read_text())
+    o = info["onnx"]
+    model = dance_model_from_onnx(source / info["file"], o["dim"], o["styles"], o["hidden"], o["layers"])
+    out.mkdir(parents=True, exist_ok=True)
+    onnx_path = out / f"{model_id}.onnx"
+    info["onnx"], info["parity"] = _write_graph(model, onnx_path, weights)
+    info["file"] = onnx_path.name
+    _publish(info, onnx_path, model_id, out)
     return onnx_path

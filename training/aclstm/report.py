@@ -145,7 +145,7 @@ def plot(report: dict) -> None:
     import matplotlib.pyplot as plt
 
     fig, axes = plt.subplots(1, len(STYLES), figsize=(16, 4), sharey=False)
-    colours = dict(zip(report["models"], ["tab:blue", "tab:red", "tab:green", "tab:purple"]))
+    colours = {label: f"C{k}" for k, label in enumerate(report["models"])}
     for ax, style in zip(axes, STYLES):
         for label, m in report["models"].items():
             for k, run in enumerate(r for r in m["runs"] if r["style"] == style):

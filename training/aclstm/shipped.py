@@ -11,6 +11,8 @@ from ..onnx.sessions import cpu_session
 
 
 class ShippedDance:
+    STEPS_PER_CALL = 32  # as the page's DanceCore
+
     def __init__(self, models_dir: Path, model_id: str = "aclstm"):
         self.info = json.loads((models_dir / f"{model_id}.json").read_text())
         self.session = cpu_session(models_dir / self.info["file"], threads=1)
@@ -34,8 +36,17 @@ class ShippedDance:
         c = np.zeros_like(h)
         warm = ((np.asarray(seed_frames) - self.mean) / self.std).astype(np.float32)
         for t in range(warm.shape[1]):
-            y, h, c = self.session.run(None, {"x": warm[:, t], "style": style, "h": h, "c": c})
+            y, h, c = self._steps(warm[:, t], style, h, c, 1)
+        y = y[-1]
         out = np.zeros((b, frames, len(self.mean)), np.float32)
+        if not feedback_noise:  # the page's way: many steps per call, each output fed back inside the graph
+            for t in tqdm(range(0, frames, self.STEPS_PER_CALL), desc="dance", unit="call", disable=not progress):
+                n = min(self.STEPS_PER_CALL, frames - t)
+                out[:, t] = y
+                ys, h, c = self._steps(y, style, h, c, n)
+                out[:, t + 1:t + n] = np.swapaxes(ys[:n - 1], 0, 1)
+                y = ys[-1]
+            return out * self.std + self.mean
         rng = np.random.default_rng(seed)
         mask = np.ones(len(self.mean), np.float32)
         if pose_only:
@@ -47,5 +58,10 @@ class ShippedDance:
             if feedback_noise:
                 noise = rho * noise + np.sqrt(1 - rho * rho) * feedback_noise * rng.standard_normal(y.shape).astype(np.float32)
                 x = (y + noise * mask).astype(np.float32)
-            y, h, c = self.session.run(None, {"x": x, "style": style, "h": h, "c": c})
+            ys, h, c = self._steps(x, style, h, c, 1)
+            y = ys[-1]
         return out * self.std + self.mean
+
+    def _steps(self, x, style, h, c, steps: int):
+        """One session call: `steps` steps from x; returns ys (steps, batch, dim), h, c."""
+        return self.session.run(None, {"x": x, "style": style, "h": h, "c": c, "steps": np.array([steps], np.int64)})

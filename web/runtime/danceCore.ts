@@ -1,8 +1,10 @@
 // The dance models' step loop (acLSTM and its vanilla baseline), independent of where it runs: an
 // onnxruntime session, the feature decoder and the skeleton fit. dance.worker.ts wraps it in messages;
 // unit tests drive it directly with onnxruntime-web's Node build. The loop is training/aclstm/shipped.py's:
-// h = c = 0, the seed motion's frames are fed one by one (normalised), then each output y is one new
-// frame and is fed back as the next input. No randomness: the same style and seed give the same dance.
+// h = c = 0, the seed motion's frames are fed one by one (normalised), then each output is one new
+// frame and is fed back as the next input. That feedback happens inside the graph (an ONNX Loop), so one
+// call makes up to STEPS_PER_CALL frames. No randomness: the same style and seed give the same dance, however
+// the frames are split into calls.
 import type { InferenceSession, TensorConstructor } from 'onnxruntime-web';
 import { SkeletonFitter } from '../motion/fitSkeleton';
 import { PlantedFeet } from '../motion/footLock';
@@ -34,6 +36,12 @@ export interface DanceStream {
  */
 export const DANCE_TOE_GROUND_HEIGHT = 0.012;
 
+/**
+ * Most steps one session call runs. A call's fixed cost (feeds, copies into wasm, scheduling) is paid once per
+ * call instead of once per frame; 16-64 measured alike, 32 keeps a cancellable call near 5 ms (docs/bench.md).
+ */
+export const STEPS_PER_CALL = 32;
+
 export class DanceCore extends SessionCore<DanceInfo> {
   private readonly fitter: SkeletonFitter;
   private readonly L: number;
@@ -54,7 +62,7 @@ export class DanceCore extends SessionCore<DanceInfo> {
   /** One step at batch 1 from zeros: a model whose sizes disagree with the JSON fails here, not mid-dance. */
   async check(): Promise<void> {
     const { L, H, D, S } = this;
-    await this.step(1, new Float32Array(D), new Float32Array(S), new Float32Array(L * H), new Float32Array(L * H));
+    await this.step(1, new Float32Array(D), new Float32Array(S), new Float32Array(L * H), new Float32Array(L * H), 1);
   }
 
   describe(loadMs: number): DanceInitResult {
@@ -75,11 +83,17 @@ export class DanceCore extends SessionCore<DanceInfo> {
     };
   }
 
-  /** One raw session call: x (B×D normalised), style (B×S one-hot), h and c (layers×B×H); with `signal`, a cancellation checkpoint first. */
-  async step(batch: number, x: Float32Array, style: Float32Array, h: Float32Array, c: Float32Array, signal?: AbortSignal): Promise<DanceStepOutputs> {
+  /**
+   * One raw session call of `steps` steps: x (B×D normalised), style (B×S one-hot), h and c (layers×B×H); ys holds
+   * steps × B × D output frames. With `signal`, a cancellation checkpoint first.
+   */
+  async step(batch: number, x: Float32Array, style: Float32Array, h: Float32Array, c: Float32Array, steps: number, signal?: AbortSignal): Promise<DanceStepOutputs> {
     const { L, H, D, S } = this;
-    const read = await this.run({ x: [x, [batch, D]], style: [style, [batch, S]], h: [h, [L, batch, H]], c: [c, [L, batch, H]] }, signal);
-    return { y: read('y', batch * D), h_out: read('h_out', L * batch * H), c_out: read('c_out', L * batch * H) };
+    const read = await this.run(
+      { x: [x, [batch, D]], style: [style, [batch, S]], h: [h, [L, batch, H]], c: [c, [L, batch, H]], steps: [BigInt64Array.of(BigInt(steps)), [1]] },
+      signal,
+    );
+    return { ys: read('ys', steps * batch * D), h_out: read('h_out', L * batch * H), c_out: read('c_out', L * batch * H) };
   }
 
   /** Index into info.seeds of the seed motion for `style` and `seed` (seed mod the style's seed count). */
@@ -105,7 +119,7 @@ export class DanceCore extends SessionCore<DanceInfo> {
     for (const frame of this.info.seeds[seedIndex].frames) {
       const input = new Float32Array(D);
       for (let d = 0; d < D; d++) input[d] = (frame[d] - this.mean[d]) / this.std[d];
-      ({ y: x, h_out: h, c_out: c } = await this.step(1, input, style, h, c, signal));
+      ({ ys: x, h_out: h, c_out: c } = await this.step(1, input, style, h, c, 1, signal));
     }
     const { joints, offsets } = this.info.skeleton;
     const feet = new PlantedFeet(joints, offsets, this.info.fps, { groundHeight: DANCE_TOE_GROUND_HEIGHT });
@@ -126,12 +140,16 @@ export class DanceCore extends SessionCore<DanceInfo> {
     checkFrameCount(frames);
     const { D } = this;
     const features = new Float32Array(frames * D);
-    for (let t = 0; t < frames; t++) {
-      const row = features.subarray(t * D, (t + 1) * D);
-      denormalise(stream.x, this.mean, this.std, row);
-      if (!row.every(Number.isFinite)) throw new Error(`the model produced a non-finite value at frame ${stream.frame + t}`);
-      const out = await this.step(1, stream.x, stream.style, stream.h, stream.c, signal);
-      stream.x = out.y;
+    for (let t = 0; t < frames; ) {
+      // Frame t is the pending input; the call's first steps − 1 outputs are frames t + 1 …, its last the next input.
+      const steps = Math.min(STEPS_PER_CALL, frames - t);
+      const out = await this.step(1, stream.x, stream.style, stream.h, stream.c, steps, signal);
+      for (let k = 0; k < steps; k++, t++) {
+        const row = features.subarray(t * D, (t + 1) * D);
+        denormalise(k === 0 ? stream.x : out.ys.subarray((k - 1) * D, k * D), this.mean, this.std, row);
+        if (!row.every(Number.isFinite)) throw new Error(`the model produced a non-finite value at frame ${stream.frame + t}`);
+      }
+      stream.x = out.ys.slice((steps - 1) * D);
       stream.h = out.h_out;
       stream.c = out.c_out;
     }
@@ -161,8 +179,11 @@ export class DanceCore extends SessionCore<DanceInfo> {
     return this.advance(await this.createStream(streamParams, signal), frames, signal);
   }
 
-  /** Times `steps` raw session calls at `batch` rows, each feeding its output and state back (the dance loop). */
-  benchmark(batch: number, steps: number): Promise<BenchmarkResult> {
+  /**
+   * Times `steps` raw steps at `batch` rows, each feeding its output and state back (the dance loop), in calls of
+   * `perCall` steps (1: one call per step, as before the Loop graph).
+   */
+  benchmark(batch: number, steps: number, perCall = STEPS_PER_CALL): Promise<BenchmarkResult> {
     return timeSteps(batch, steps, this.threads, () => {
       const { L, H, D, S } = this;
       let x: Float32Array = new Float32Array(batch * D);
@@ -171,16 +192,20 @@ export class DanceCore extends SessionCore<DanceInfo> {
       let h: Float32Array = new Float32Array(L * batch * H);
       let c: Float32Array = new Float32Array(L * batch * H);
       return async () => {
-        ({ y: x, h_out: h, c_out: c } = await this.step(batch, x, style, h, c));
+        const out = await this.step(batch, x, style, h, c, perCall);
+        ({ h_out: h, c_out: c } = out);
+        x = out.ys.slice((perCall - 1) * batch * D);
       };
-    });
+    }, perCall);
   }
 
-  /** One raw step on the given inputs (tests/fixtures/aclstm_reference.json's `step.inputs`). */
+  /** One raw call on the given inputs (tests/fixtures/aclstm_reference.json's `step.inputs` and `steps.inputs`). */
   async parity(inputs: DanceStepInputs): Promise<DanceParityResult> {
     const { L, H, D, S } = this;
     const batch = inputs?.batch;
     if (!Number.isInteger(batch) || batch < 1) throw new Error(`parity needs inputs { batch, x, style, h, c }, got batch ${String(batch)}`);
+    const steps = inputs.steps ?? 1;
+    if (!Number.isInteger(steps) || steps < 1 || steps > 10_000) throw new Error(`parity steps must be an integer from 1 to 10000, got ${String(steps)}`);
     const x = Float32Array.from(inputs.x ?? []);
     const style = Float32Array.from(inputs.style ?? []);
     const h = Float32Array.from(inputs.h ?? []);
@@ -191,6 +216,6 @@ export class DanceCore extends SessionCore<DanceInfo> {
           `h ${h.length} and c ${c.length} (expected ${L * batch * H})`,
       );
     }
-    return { outputs: await this.step(batch, x, style, h, c) };
+    return { outputs: await this.step(batch, x, style, h, c, steps) };
   }
 }

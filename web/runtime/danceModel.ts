@@ -28,8 +28,8 @@ export interface DanceInfo {
     layout?: string;
   };
   onnx: {
-    inputs: string[]; // [x, style, h, c]
-    outputs: string[]; // [y, h_out, c_out]
+    inputs: string[]; // [x, style, h, c, steps]
+    outputs: string[]; // [ys, h_out, c_out]
     opset?: number;
     layers: number;
     hidden: number;
@@ -51,8 +51,9 @@ export interface DanceSeed {
   frames: number[][];
 }
 
-export const DANCE_INPUTS = ['x', 'style', 'h', 'c'] as const;
-export const DANCE_OUTPUTS = ['y', 'h_out', 'c_out'] as const;
+/** One call runs `steps` steps, each output frame fed back inside the graph: ys is steps × batch × dim. */
+export const DANCE_INPUTS = ['x', 'style', 'h', 'c', 'steps'] as const;
+export const DANCE_OUTPUTS = ['ys', 'h_out', 'c_out'] as const;
 
 const format = modelInfoFormat<DanceInfo>('DanceInfoError', 'aclstm.json', (check, root) => {
   const { fail, obj, posInt, numbers, strings } = check;

@@ -15,9 +15,10 @@ export interface DanceGenerateParams extends DanceStreamParams {
   frames: number;
 }
 
-/** The ONNX step's inputs, flattened: x (B×D), style (B×S), h and c (layers×B×H). */
+/** The ONNX call's inputs, flattened: x (B×D), style (B×S), h and c (layers×B×H), and the steps to run (default 1). */
 export interface DanceStepInputs {
   batch: number;
+  steps?: number;
   x: ArrayLike<number>;
   style: ArrayLike<number>;
   h: ArrayLike<number>;
@@ -25,7 +26,8 @@ export interface DanceStepInputs {
 }
 
 export interface DanceStepOutputs {
-  y: Float32Array;
+  /** steps × B × D: each step's output frame (normalised), the last one the next input. */
+  ys: Float32Array;
   h_out: Float32Array;
   c_out: Float32Array;
 }

@@ -38,19 +38,26 @@ export function checkFrameCount(frames: number): void {
 }
 
 /**
- * Checks batch and steps, then `setup()` builds the inputs and returns one step (which may feed its
- * state forward); 3 warm-up calls, then `steps` timed ones.
+ * Checks batch and steps, then `setup()` builds the inputs and returns one call (which may feed its
+ * state forward) of `stepsPerCall` steps; 3 warm-up calls, then enough timed ones for `steps` steps.
  */
-export async function timeSteps(batch: number, steps: number, threads: number, setup: () => () => Promise<void>): Promise<BenchmarkResult> {
+export async function timeSteps(
+  batch: number,
+  steps: number,
+  threads: number,
+  setup: () => () => Promise<void>,
+  stepsPerCall = 1,
+): Promise<BenchmarkResult> {
   if (!Number.isInteger(batch) || batch < 1 || batch > MAX_BENCHMARK_BATCH) throw new Error(`batch must be an integer from 1 to ${MAX_BENCHMARK_BATCH}, got ${batch}`);
   if (!Number.isInteger(steps) || steps < 1) throw new Error(`steps must be a positive integer, got ${steps}`);
   const step = setup();
   for (let i = 0; i < 3; i++) await step(); // warm-up
+  const calls = Math.ceil(steps / stepsPerCall);
   const started = performance.now();
-  for (let i = 0; i < steps; i++) await step();
+  for (let i = 0; i < calls; i++) await step();
   const ms = performance.now() - started;
-  const stepsPerSecond = (steps * 1000) / ms;
-  return { batch, steps, threads, stepsPerSecond, msPerCall: ms / steps, particleStepsPerSecond: stepsPerSecond * batch };
+  const stepsPerSecond = (calls * stepsPerCall * 1000) / ms;
+  return { batch, steps: calls * stepsPerCall, threads, stepsPerSecond, msPerCall: ms / calls, particleStepsPerSecond: stepsPerSecond * batch };
 }
 
 interface SessionModelInfo {
@@ -86,15 +93,17 @@ export abstract class SessionCore<Info extends SessionModelInfo> {
   }
 
   /**
-   * One session call on float32 feeds (`name: [data, dims]`); returns a reader for outputs of known
+   * One session call on float32 (or int64: a BigInt64Array) feeds (`name: [data, dims]`); returns a reader for outputs of known
    * size, which names the files to blame when a size disagrees with the JSON. With `signal`, passes a
    * checkpoint first (cancellation.ts): throws CancelledError instead of running once it has aborted.
    */
-  protected async run(feeds: Record<string, [Float32Array, number[]]>, signal?: AbortSignal): Promise<(name: string, size: number) => Float32Array> {
+  protected async run(feeds: Record<string, [Float32Array | BigInt64Array, number[]]>, signal?: AbortSignal): Promise<(name: string, size: number) => Float32Array> {
     const look = signal && checkpoint(signal);
     if (look) await look;
     const tensors: Record<string, Tensor> = {};
-    for (const [name, [data, dims]] of Object.entries(feeds)) tensors[name] = new this.Tensor('float32', data, dims);
+    for (const [name, [data, dims]] of Object.entries(feeds)) {
+      tensors[name] = data instanceof BigInt64Array ? new this.Tensor('int64', data, dims) : new this.Tensor('float32', data, dims);
+    }
     const out = await this.session.run(tensors);
     const files = `${this.info.id ?? 'the model'}.json match ${this.info.file}`;
     return (name, size) => readOutput(out, name, size, files);

@@ -1,0 +1,88 @@
+"""Lighter model files (training/onnx/compact.py): weights stored as float16 or int8 come back as the float32 values
+the graph computes with, and a dance model reads back from its file whatever the format."""
+import numpy as np
+import onnx
+import pytest
+import torch
+from onnx import TensorProto, helper, numpy_helper
+
+from training.aclstm.exporting import export_onnx
+from training.aclstm.graph import check_parity, dance_model_from_onnx
+from training.models.aclstm import DanceLSTM, DanceStep
+from training.onnx.compact import compact_weights, quantise_int8, stored_float_weights, weight_format
+from training.onnx.sessions import cpu_session
+
+
+def matmul_model(w: np.ndarray) -> onnx.ModelProto:
+    graph = helper.make_graph([helper.make_node("MatMul", ["x", "w"], ["y"])], "g",
+                              [helper.make_tensor_value_info("x", TensorProto.FLOAT, ["b", w.shape[0]])],
+                              [helper.make_tensor_value_info("y", TensorProto.FLOAT, ["b", w.shape[1]])],
+                              [numpy_helper.from_array(w, "w")])
+    model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", 17)])
+    model.ir_version = 8
+    return model
+
+
+@pytest.mark.parametrize("fmt, bytes_per_weight, tolerance", [("float16", 2, 1e-3), ("int8", 1, 1e-2)])
+def test_stored_weights_compute_as_their_float_values(tmp_path, fmt, bytes_per_weight, tolerance):
+    rng = np.random.default_rng(0)
+    w = rng.normal(size=(128, 64)).astype(np.float32)
+    w[:, 3] *= 50  # one loud output channel must not cost the others their precision (int8: a scale per column)
+    compact = compact_weights(matmul_model(w), fmt)
+    assert weight_format(compact) == fmt
+    path = tmp_path / "m.onnx"
+    onnx.save(compact, path)
+    assert path.stat().st_size < w.size * bytes_per_weight + 2000
+    stored = stored_float_weights(compact)["w"]
+    rel = np.abs(stored - w) / np.abs(w).max(axis=0)
+    assert rel.max() < tolerance and rel.max() > 0  # lossy, but within the format's step
+    x = rng.normal(size=(5, 128)).astype(np.float32)
+    y = cpu_session(path).run(None, {"x": x})[0]
+    assert np.abs(y - x @ stored).max() < 1e-4  # the graph computes with exactly the stored values
+
+
+def test_small_weights_stay_float32_and_unknown_formats_are_refused():
+    w = np.ones((8, 8), np.float32)
+    assert weight_format(compact_weights(matmul_model(w), "int8")) == "float32"
+    with pytest.raises(ValueError, match="unknown weight format 'bf16'"):
+        compact_weights(matmul_model(w), "bf16")
+
+
+def test_int8_scales_per_channel():
+    w = np.array([[1.0, -100.0], [0.5, 50.0]], np.float32)
+    q, scale = quantise_int8(w, axis=1)
+    assert q.dtype == np.int8 and scale.shape == (1, 2)
+    assert np.allclose(q * scale, w, atol=scale.max() / 2)
+    assert q[0, 0] == 127 and q[0, 1] == -127
+
+
+@pytest.mark.parametrize("fmt", ["float32", "float16", "int8"])
+def test_dance_graph_parity_and_read_back(tmp_path, fmt):
+    torch.manual_seed(2)
+    model = DanceLSTM(9, 3, hidden=64, layers=3).eval()
+    path = tmp_path / "dance.onnx"
+    stored = export_onnx(model, path, fmt)
+    assert check_parity(stored, path)["max_abs_diff"] < 1e-4
+    # The stored network is the trained one up to the format's rounding.
+    x, style = torch.randn(2, 9), torch.eye(3)[:2]
+    h, c = model.zero_state(2)
+    with torch.no_grad():
+        a, b = DanceStep(model)(x, style, h, c)[0], DanceStep(stored)(x, style, h, c)[0]
+    assert (a - b).abs().max() < {"float32": 1e-6, "float16": 1e-2, "int8": 5e-2}[fmt]
+
+
+def test_dance_model_reads_back_from_the_earlier_one_step_export(tmp_path):
+    """The torch export with ONNX LSTM nodes (the files shipped before the Loop graph) reads back exactly."""
+    torch.manual_seed(3)
+    model = DanceLSTM(9, 3, hidden=16, layers=3).eval()
+    x, style = torch.zeros(1, 9), torch.zeros(1, 3)
+    h, c = model.zero_state(1)
+    path = tmp_path / "old.onnx"
+    torch.onnx.export(DanceStep(model).eval(), (x, style, h, c), str(path), input_names=["x", "style", "h", "c"],
+                      output_names=["y", "h_out", "c_out"], opset_version=17, dynamo=False)
+    back = dance_model_from_onnx(path, 9, 3, 16, 3)
+    xs = torch.randn(4, 9)
+    with torch.no_grad():
+        a = DanceStep(model)(xs, torch.eye(3)[[0, 1, 2, 0]], *model.zero_state(4))[0]
+        b = DanceStep(back)(xs, torch.eye(3)[[0, 1, 2, 0]], *model.zero_state(4))[0]
+    assert (a - b).abs().max() < 1e-6
