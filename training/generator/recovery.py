@@ -23,10 +23,10 @@ from pathlib import Path
 import numpy as np
 import onnx
 import torch
-from onnx import numpy_helper
 
 from ..mocap.rotations import quat_to_matrix
 from ..models.generator import MixtureLSTM
+from ..onnx.compact import float_initializers
 from .graph import GATE_ORDER, parity_error
 
 ONNX_TO_TORCH_GATES = [0, 2, 3, 1]  # torch (i, f, g, o) from ONNX LSTM blocks (i, o, f, c)
@@ -103,7 +103,7 @@ def _named_weights(inits: dict[str, np.ndarray], hidden: int) -> dict[str, np.nd
 def model_from_onnx(path: Path, dim: int, hidden: int, mixtures: int) -> MixtureLSTM:
     """A MixtureLSTM (eval mode) holding the weights of the exported generator step at `path`."""
     graph = onnx.load(str(path)).graph
-    inits = {i.name: numpy_helper.to_array(i).astype(np.float32) for i in graph.initializer}
+    inits = float_initializers(onnx.load(str(path)))
     if "fc1.weight_t" in inits:
         state = _named_weights(inits, hidden)
     elif any(n.op_type == "LSTM" for n in graph.node):

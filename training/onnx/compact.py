@@ -11,6 +11,9 @@ Weights smaller than MIN_ELEMENTS (biases, small tables) stay float32.
 """
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import onnx
 from onnx import TensorProto, helper, numpy_helper
@@ -52,22 +55,24 @@ def quantise_int8(w: np.ndarray, axis: int) -> tuple[np.ndarray, np.ndarray]:
     return np.clip(np.rint(w / scale), -127, 127).astype(np.int8), scale
 
 
-def compact_weights(model: onnx.ModelProto, fmt: str) -> onnx.ModelProto:
-    """A copy of `model` with every float32 initialiser of MIN_ELEMENTS or more stored as `fmt`."""
-    if fmt not in FORMATS:
-        raise ValueError(f"unknown weight format {fmt!r} (one of {', '.join(FORMATS)})")
+def compact_weights(model: onnx.ModelProto, fmt: str, overrides: dict[str, str] | None = None) -> onnx.ModelProto:
+    """A copy of `model` with every float32 initialiser of MIN_ELEMENTS or more stored as `fmt`, or as
+    `overrides[name]` for the weights it names (a layer the coarser format measurably hurts)."""
+    overrides = overrides or {}
+    for f in {fmt, *overrides.values()}:
+        if f not in FORMATS:
+            raise ValueError(f"unknown weight format {f!r} (one of {', '.join(FORMATS)})")
     out = onnx.ModelProto()
     out.CopyFrom(model)
-    if fmt == "float32":
-        return out
     graph = out.graph
     kept, nodes = [], []
     for init in graph.initializer:
         w = numpy_helper.to_array(init)
-        if init.data_type != TensorProto.FLOAT or w.size < MIN_ELEMENTS:
+        stored = overrides.get(init.name, fmt)
+        if init.data_type != TensorProto.FLOAT or w.size < MIN_ELEMENTS or stored == "float32":
             kept.append(init)
             continue
-        if fmt == "float16":
+        if stored == "float16":
             kept.append(numpy_helper.from_array(w.astype(np.float16), f"{init.name}.f16"))
             nodes.append(helper.make_node("Cast", [f"{init.name}.f16"], [init.name], to=TensorProto.FLOAT))
         else:
@@ -105,8 +110,39 @@ def float_initializers(model: onnx.ModelProto) -> dict[str, np.ndarray]:
 
 
 def weight_format(model: onnx.ModelProto) -> str:
-    """How the file stores its large weights: 'int8', 'float16' or 'float32'."""
+    """How the file stores its large weights: 'int8', 'float16', 'float32', or for a mix e.g. 'int8+float16'."""
     names = [t.name for t in model.graph.initializer]
-    if any(n.endswith(".i8") for n in names):
-        return "int8"
-    return "float16" if any(n.endswith(".f16") for n in names) else "float32"
+    formats = [f for f, suffix in (("int8", ".i8"), ("float16", ".f16")) if any(n.endswith(suffix) for n in names)]
+    return "+".join(formats) or "float32"
+
+
+def compact_file(path: Path, fmt: str) -> tuple[int, int]:
+    """Rewrites the float32 export at `path` with its large weights stored as `fmt`; returns (bytes before, after).
+    A file already stored in lower precision is refused: compacting twice would round twice."""
+    model = onnx.load(str(path))
+    if weight_format(model) != "float32":
+        raise ValueError(f"{path.name} already stores its weights as {weight_format(model)}; compact its float32 export")
+    before = path.stat().st_size
+    onnx.save(compact_weights(model, fmt), str(path))
+    return before, path.stat().st_size
+
+
+def model_files(info: dict) -> list[str]:
+    """The ONNX files of a model JSON or manifest entry: `files` (several graphs) or `file`."""
+    return sorted(set(info["files"].values())) if "files" in info else [info["file"]]
+
+
+def refresh_bytes(models_dir: Path) -> None:
+    """Sets `bytes` (the model's ONNX files together) and `weights` (their storage format) in each model JSON, and
+    `bytes` in the manifest, from the files as they are now."""
+    manifest_path = models_dir / "index.json"
+    manifest = json.loads(manifest_path.read_text())
+    for entry in manifest["models"]:
+        info_path = models_dir / f"{entry['id']}.json"
+        info = json.loads(info_path.read_text())
+        files = model_files(info)
+        entry["bytes"] = info["bytes"] = sum((models_dir / f).stat().st_size for f in files)
+        formats = {weight_format(onnx.load(str(models_dir / f), load_external_data=False)) for f in files}
+        info["weights"] = "/".join(sorted(formats))
+        info_path.write_text(json.dumps(info) + "\n")
+    manifest_path.write_text(json.dumps(manifest, indent=1) + "\n")

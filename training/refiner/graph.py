@@ -24,9 +24,9 @@ from pathlib import Path
 import numpy as np
 import onnx
 import torch
-from onnx import numpy_helper
 
 from ..models.refiner import Refiner, RefinerStep
+from ..onnx.compact import float_initializers
 from ..onnx.graph import GraphBuilder
 from ..onnx.sessions import cpu_session
 
@@ -170,7 +170,7 @@ def refiner_from_onnx(path: Path, meta: dict) -> Refiner:
     """The torch Refiner computing what an export of sequence_graph computes: FC1 unfolded from the folded weights
     (the end-effector normalisation comes from `meta`, any run's; the function does not depend on it), the
     LSTM gates back in PyTorch's order, the summed LSTM bias as bias_ih."""
-    inits = {t.name: numpy_helper.to_array(t).astype(np.float64) for t in onnx.load(str(path)).graph.initializer}
+    inits = {n: v.astype(np.float64) for n, v in float_initializers(onnx.load(str(path))).items()}
     model = Refiner(np.array(meta["mean"]), np.array(meta["std"]), np.array(meta["references"]),
                     inits["lstm.R"].shape[-1], np.array(meta["end_mean"]), np.array(meta["end_std"]), fps=meta["fps"])
     g, D, E3, H = model.geometry, model.dim, 3 * model.ends, model.hidden
