@@ -1,9 +1,11 @@
 """The VAE-LSTM's pieces: the cell of eqs. 7-9 in its two modes, generation chunk by chunk against one pass, the
-4-frame posterior seed, the shipped export against its fixture, the page's z1 draws (control.Rng.normal), and a
-training step that lowers the loss on a fixed batch."""
+4-frame posterior seed, the shipped export against its fixture, the page's z1 draws (control.Rng.normal), a
+training step that lowers the loss on a fixed batch, and the network read back from its ONNX graphs (recovery.py)
+in each weight format, the shipped int8 files included."""
 import json
 
 import numpy as np
+import onnx
 import pytest
 import torch
 
@@ -11,10 +13,11 @@ from conftest import REPO
 from training.control import Rng
 from training.data.windows import ROW_DIM
 from training.models.vae_lstm import POOLING, VaeLstm
-from training.vae_lstm.exporting import PRIOR_FIXTURE_SEED, generate_rows
+from training.vae_lstm.exporting import FILES, PRIOR_FIXTURE_SEED, check_parity, export_graphs, files_format, generate_rows
 from training.vae_lstm.generation import SEED_FRAMES, SEED_PAD, prior_latents, seed_window
 from training.vae_lstm.measures import ShippedVae
 from training.models.losses import energy_loss
+from training.vae_lstm.recovery import vae_lstm_from_onnx
 from training.vae_lstm.training import kl_per_step, losses
 
 FIXTURE = REPO / "tests" / "fixtures" / "vae_lstm_reference.json"
@@ -111,3 +114,52 @@ def test_the_shipped_graphs_reproduce_the_fixture_generation():
     zs = np.array(fixture["generate_steps"]["zs"], np.float32).reshape(-1, len(g["z1"]))
     teacher = (vae.rows(control, np.array(g["z1"], np.float32), zs) - vae.mean) / vae.std
     np.testing.assert_allclose(teacher.ravel(), fixture["generate_steps"]["rows"], atol=fixture["tolerance"])
+
+
+def test_the_network_reads_back_from_the_shipped_graphs():
+    """The recovered torch module computes what onnxruntime computes on the shipped files, every graph, batches 1
+    and 3, two lengths (the anonymous MatMul weights placed by the graph's structure, recovery.py)."""
+    models = REPO / "public" / "models"
+    info = json.loads((models / "vae-lstm.json").read_text())
+    model = vae_lstm_from_onnx(models, info["files"])
+    assert (model.dim, model.latent, model.cell.gates_control.in_features) == (info["rows"]["dim"], info["latent"], info["control_features"])
+    worst = check_parity(model, models)
+    assert max(worst.values()) < 2e-5, worst
+    assert info["weights"] == files_format(models)
+
+
+@pytest.mark.parametrize("fmt", ["float32", "int8"])
+def test_export_reads_back_what_it_stored(tmp_path, fmt):
+    """export_graphs returns the network its files compute: float32 exactly the trained one, int8 within a step of
+    each channel's scale; parity against it holds either way, and writing its int8 weights again stores the same."""
+    torch.manual_seed(4)
+    net = VaeLstm(ROW_DIM, latent=64, control_features=64, inference_features=32, decoder_hidden=16).eval()
+    stored = export_graphs(net, tmp_path, fmt)
+    assert files_format(tmp_path) == fmt
+    assert max(check_parity(stored, tmp_path).values()) < 2e-5
+    for (name, a), b in zip(net.state_dict().items(), stored.state_dict().values()):
+        if fmt == "float32" or a.numel() < 4096:  # small weights (biases) stay float32
+            assert torch.equal(a, b), name
+        else:  # a scale per output channel: torch's first axis, whatever the graph's layout
+            step = a.abs().amax(dim=tuple(range(1, a.dim())), keepdim=True) / 127
+            assert bool(((a - b).abs() <= step / 2 * 1.001).all()), name
+            assert bool((a != b).any()), name
+    again = tmp_path / "again"
+    again.mkdir()
+    assert all(torch.equal(a, b) for a, b in zip(stored.state_dict().values(), export_graphs(stored, again, fmt).state_dict().values()))
+
+
+def test_recovery_refuses_a_graph_it_cannot_place(tmp_path):
+    torch.manual_seed(5)
+    net = VaeLstm(ROW_DIM, latent=16, control_features=8, inference_features=12, decoder_hidden=8).eval()
+    export_graphs(net, tmp_path)
+    cell = onnx.load(str(tmp_path / FILES["cell"]))
+    for n in cell.graph.node:  # the content MatMuls now read the control encoding only: two weights for one role
+        if n.op_type == "MatMul":
+            producer = next(m for m in cell.graph.node if n.input[0] in m.output)
+            if producer.op_type != "Gather":
+                hc_step = next(m for m in cell.graph.node if m.op_type == "Gather" and m.input[0] == "hc")
+                n.input[0] = hc_step.output[0]
+    onnx.save(cell, str(tmp_path / FILES["cell"]))
+    with pytest.raises(ValueError, match="two weights for the cell's content_control"):
+        vae_lstm_from_onnx(tmp_path, FILES)

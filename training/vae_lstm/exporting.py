@@ -12,7 +12,11 @@ tests/fixtures/vae_lstm_reference.json for the browser's parity tests.
 - vae-lstm-inference.onnx, the inference network: rows (batch, frames, 80) normalised -> mean and log_var
   (batch, frames / 4, latent) of the posterior of each step.
 
-The batch dimension is dynamic in all four, and so are frames and steps in the convolutional three.
+The batch dimension is dynamic in all four, and so are frames and steps in the convolutional three. Large
+weights are stored as int8 with a float32 scale per output channel (or float16, or left float32: `weights`;
+training/onnx/compact.py), turned back into float32 inside the graph when the session is created. The parity
+check, the JSON's parity numbers and the fixture use torch holding the weights as stored: the network read back
+from the written files (recovery.py), so the browser's tolerances hold whatever the format.
 """
 from __future__ import annotations
 
@@ -20,16 +24,19 @@ import json
 from pathlib import Path
 
 import numpy as np
+import onnx
 import torch
 from torch import nn
 
 from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, JOINTS, POSITION_DIM
 from ..mocap.skeleton import canonical_skeleton
 from ..models.vae_lstm import KERNEL, POOLING, VaeLstm
+from ..onnx.compact import compact_weights, weight_format
 from ..onnx.manifest import register_model
 from ..onnx.sessions import cpu_session
 from ..paths import MODELS_DIR, REPO_ROOT
 from .generation import CHUNK_STEPS, SEED_FRAMES, SEED_PAD, prior_latents
+from .recovery import vae_lstm_from_onnx
 
 PARITY_TOLERANCE = 1e-4
 PRIOR_FIXTURE_SEED = 3
@@ -76,7 +83,9 @@ def example_inputs(model: VaeLstm, batch: int = 1, frames: int = 40) -> dict[str
             "inference": (torch.zeros(batch, frames, model.dim),)}
 
 
-def export_graphs(model: VaeLstm, out: Path) -> None:
+def export_graphs(model: VaeLstm, out: Path, weights: str = "float32") -> VaeLstm:
+    """Writes the four graphs into `out` with their large weights stored as `weights`; returns the network the files
+    compute (the weights as stored, read back from them), the reference for the parity check and the fixture."""
     b = {0: "batch"}
     dynamic = {"cell": {"hc": b, "state": b, "z": b, "canvas": b, "state_out": b},
                "control": {"control": {0: "batch", 1: "frames"}, "hc": {0: "batch", 1: "steps"}},
@@ -85,8 +94,12 @@ def export_graphs(model: VaeLstm, out: Path) -> None:
     examples = example_inputs(model)
     for key, graph in graphs(model).items():
         inputs, outputs = NAMES[key]
-        torch.onnx.export(graph.eval(), examples[key], str(out / FILES[key]), input_names=inputs, output_names=outputs,
+        path = out / FILES[key]
+        torch.onnx.export(graph.eval(), examples[key], str(path), input_names=inputs, output_names=outputs,
                           opset_version=17, dynamo=False, dynamic_axes=dynamic[key])
+        if weights != "float32":
+            onnx.save(compact_weights(onnx.load(str(path)), weights), str(path))
+    return vae_lstm_from_onnx(out, FILES)
 
 
 def random_inputs(model: VaeLstm, rng: np.random.Generator, batch: int, frames: int) -> dict[str, list[np.ndarray]]:
@@ -189,18 +202,53 @@ def write_fixture(model: VaeLstm, info: dict, path: Path = FIXTURE) -> None:
     path.write_text(json.dumps(fixture) + "\n")
 
 
-def export_vae_lstm(model: VaeLstm, meta: dict, report: dict, sampling: dict, out: Path = MODELS_DIR) -> dict:
-    model.eval()
+def files_format(out: Path) -> str:
+    """How the four files store their large weights ("int8", or e.g. "float32/int8" when they differ)."""
+    return "/".join(sorted({weight_format(onnx.load(str(out / f), load_external_data=False)) for f in FILES.values()}))
+
+
+def _write_checked(model: VaeLstm, out: Path, weights: str) -> tuple[VaeLstm, dict]:
+    """The four graphs written and parity-checked against torch with the weights as stored; returns that network
+    and the JSON's parity fields."""
     out.mkdir(parents=True, exist_ok=True)
-    export_graphs(model, out)
-    parity = check_parity(model, out)
-    info = vae_lstm_info(meta, model, report, sampling)
-    info["parity_max_abs"] = parity
+    stored = export_graphs(model.eval(), out, weights)
+    fields = {"parity_max_abs": check_parity(stored, out),
+              "parity_reference": f"torch with the weights as stored ({files_format(out)})"}
+    return stored, fields
+
+
+def _publish(info: dict, stored: VaeLstm, out: Path) -> None:
+    """vae-lstm.json beside the graphs; into MODELS_DIR also the manifest entry and the browser fixture (written
+    from the network as stored)."""
     info["bytes"] = sum((out / f).stat().st_size for f in FILES.values())
+    info["weights"] = files_format(out)
     (out / "vae-lstm.json").write_text(json.dumps(info) + "\n")
-    if out == MODELS_DIR:
-        register_model({"id": "vae-lstm", "kind": "vae-lstm", "skeleton": "cmu-canonical", "fps": meta["fps"],
+    if out.resolve() == MODELS_DIR.resolve():
+        register_model({"id": "vae-lstm", "kind": "vae-lstm", "skeleton": "cmu-canonical", "fps": info["fps"],
                         "bytes": info["bytes"], "file": FILES["cell"], "files": FILES})
-        write_fixture(model, info)
-    print(f"wrote {', '.join(FILES.values())} in {out} ({info['bytes'] / 1e6:.1f} MB), parity {parity}")
+        write_fixture(stored, info)
+    print(f"wrote {', '.join(FILES.values())} in {out} ({info['bytes'] / 1e6:.2f} MB, {info['weights']}), "
+          f"parity {info['parity_max_abs']}")
+
+
+def export_vae_lstm(model: VaeLstm, meta: dict, report: dict, sampling: dict, out: Path = MODELS_DIR,
+                    weights: str = "int8") -> dict:
+    stored, parity = _write_checked(model, out, weights)
+    info = vae_lstm_info(meta, model, report, sampling) | parity
+    _publish(info, stored, out)
+    return info
+
+
+def rewrite_vae_lstm(source: Path, out: Path = MODELS_DIR, weights: str = "int8") -> dict:
+    """The export in `source` (vae-lstm.json and its four graphs) written again into `out` with its weights stored
+    as `weights`, without a checkpoint: the network is read back from the graphs (recovery.py), the JSON is kept
+    but for its parity, bytes and weights fields. Rewriting int8 files as int8 stores the same values again (each
+    channel's largest weight is already ±127 steps), but the float32 export is the one to start from."""
+    info = json.loads((source / "vae-lstm.json").read_text())
+    if info.get("files") != FILES:
+        raise ValueError(f"{source / 'vae-lstm.json'} names the graphs {info.get('files')}, not {FILES}")
+    model = vae_lstm_from_onnx(source, FILES)
+    stored, parity = _write_checked(model, out, weights)
+    info |= parity
+    _publish(info, stored, out)
     return info

@@ -81,6 +81,7 @@ def evaluate(mocap: str | None, previous: dict, models_dir: Path = MODELS_DIR) -
     if BROWSER_JSON.exists():
         report["browser"] = json.loads(BROWSER_JSON.read_text())
     report["sizes_bytes"] = {f: (models_dir / f).stat().st_size for f in vae.info["files"].values()}
+    report["weights"] = vae.info.get("weights")
     report["training"] = dict(previous.get("training", {}))
     for name in TRAINING_RUNS:
         summary = REPO_ROOT / "runs" / name / "summary.json"
@@ -185,7 +186,8 @@ def write_markdown(r: dict, notes: dict, path: Path) -> None:
         lines += browser_table(b)
     lines += ["", "## Model and training", ""] + notes.get("model", [])
     lines += ["", _row(["file", "bytes"]), _row(["---", "---"])] + [_row([f, n]) for f, n in r["sizes_bytes"].items()]
-    lines += [f"", f"In all {sum(r['sizes_bytes'].values()) / 1e6:.2f} MB."]
+    stored = f", large weights stored as {r['weights']}" if r.get("weights") else ""
+    lines += [f"", f"In all {sum(r['sizes_bytes'].values()) / 1e6:.2f} MB{stored}."]
     if r.get("training"):
         lines += ["", _row(["run", "minutes", "iterations", "best held-out error from 4 frames (cm)", "parameters"]), _row(["---"] * 5)]
         for name, t in r["training"].items():
@@ -195,10 +197,14 @@ def write_markdown(r: dict, notes: dict, path: Path) -> None:
     path.write_text("\n".join(lines) + "\n")
 
 
-def write_report(mocap: str | None) -> dict:
-    previous = json.loads(REPORT_JSON.read_text()) if REPORT_JSON.exists() else {}
+def write_report(mocap: str | None, models_dir: Path = MODELS_DIR, out_dir: Path = REPORTS_DIR) -> dict:
+    """Measures the export in `models_dir` and writes vae-lstm.{md,json} into `out_dir` (the training rows kept from
+    the JSON already there, else from docs/models/vae-lstm.json)."""
+    previous_path = out_dir / REPORT_JSON.name if (out_dir / REPORT_JSON.name).exists() else REPORT_JSON
+    previous = json.loads(previous_path.read_text()) if previous_path.exists() else {}
     notes = json.loads(NOTES_JSON.read_text()) if NOTES_JSON.exists() else {}
-    report = evaluate(mocap, previous)
-    REPORT_JSON.write_text(json.dumps(report, indent=1) + "\n")
-    write_markdown(report, notes, REPORTS_DIR / "vae-lstm.md")
+    report = evaluate(mocap, previous, models_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / REPORT_JSON.name).write_text(json.dumps(report, indent=1) + "\n")
+    write_markdown(report, notes, out_dir / "vae-lstm.md")
     return report
