@@ -1,9 +1,14 @@
 """Export the trained motion autoencoder to public/models/manifold-{encoder,decoder}.onnx and manifold.json.
 
-    python -m training.autoencoder.export [--checkpoint runs/autoencoder/best.pt] [--out public/models]
+    python -m training.autoencoder.export [--checkpoint runs/autoencoder/best.pt] [--out public/models] [--weights int8]
+    python -m training.autoencoder.export --from-shipped [DIR] [--weights int8]   # no checkpoint: rewrite DIR's files
 
-Parity (torch against onnxruntime) is checked before anything is written to the manifest; the held-out
-reconstruction errors go into the JSON.
+The large weights are stored as --weights (int8 with a scale per output channel by default; training/onnx/compact.py).
+Parity (torch holding the weights as stored against onnxruntime) is checked before anything is written to the
+manifest; the held-out reconstruction errors of the network as stored go into the JSON. --from-shipped reads the
+network back from DIR's graphs (default public/models) and its meta from DIR/manifold.json; compact from a float32
+export. Then export the latent ERD again (python -m training.latent_erd.export --from-shipped): its seeds and
+fixture come from this autoencoder.
 """
 from __future__ import annotations
 
@@ -12,9 +17,10 @@ from pathlib import Path
 
 from ..data.locomotion import load_clips
 from ..data.windows import WindowCorpus
+from ..onnx.compact import FORMATS
 from ..paths import MODELS_DIR, REPO_ROOT, add_mocap_argument
-from .exporting import export_autoencoder
-from .training import control_rmse, live_channels, load_autoencoder, position_error_cm
+from .exporting import export_autoencoder, rewrite_autoencoder
+from .training import load_autoencoder
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -22,16 +28,19 @@ def main(argv: list[str] | None = None) -> None:
     add_mocap_argument(parser)
     parser.add_argument("--checkpoint", default=str(REPO_ROOT / "runs" / "autoencoder" / "best.pt"))
     parser.add_argument("--out", default=str(MODELS_DIR))
+    parser.add_argument("--weights", choices=FORMATS, default="int8", help="how the files store their large weights")
+    parser.add_argument("--from-shipped", type=Path, nargs="?", const=MODELS_DIR, default=None, metavar="DIR",
+                        help="no checkpoint: read the network back from DIR's graphs and manifold.json")
     args = parser.parse_args(argv)
-    model, meta = load_autoencoder(Path(args.checkpoint))
     corpus = WindowCorpus(load_clips(args.mocap))
-    windows = corpus.valid_windows()
-    report = {"held_out_windows": len(windows),
-              "reconstruction_cm_clean": round(position_error_cm(model, corpus, windows), 3),
-              "reconstruction_cm_masked_0.3": round(position_error_cm(model, corpus, windows, 0.3), 3),
-              "control_rmse": [round(float(v), 4) for v in control_rmse(model, corpus, windows)],
-              "live_latent_channels": live_channels(model, corpus)}
-    export_autoencoder(model, meta, windows, report, Path(args.out))
+    if args.from_shipped is not None:
+        try:
+            rewrite_autoencoder(args.from_shipped, corpus, Path(args.out), args.weights)
+        except (OSError, ValueError, KeyError) as error:
+            raise SystemExit(f"error: cannot read the autoencoder back from {args.from_shipped}: {error}")
+        return
+    model, meta = load_autoencoder(Path(args.checkpoint))
+    export_autoencoder(model, meta, corpus, Path(args.out), args.weights)
 
 
 if __name__ == "__main__":

@@ -3,7 +3,8 @@
 
 For when runs/autoencoder/best.pt is gone (runs/ is not in git) but the models built on the manifold (the
 latent ERD) have to be trained or exported again. The four convolutions come from the initializers of
-manifold-encoder.onnx (the encoder's two) and manifold-decoder.onnx (the decoder's two); the meta (dim,
+manifold-encoder.onnx (the encoder's two) and manifold-decoder.onnx (the decoder's two), as the graphs compute
+with them whatever their storage format (float32, float16 or int8: exporting.py autoencoder_from_onnx); the meta (dim,
 hidden, latent, fps, window, normalisation) from manifold.json, in the format training/autoencoder/training.py
 saves. The rebuilt model is checked against both graphs with onnxruntime before anything is written.
 
@@ -17,33 +18,17 @@ import json
 from pathlib import Path
 
 import numpy as np
-import onnx
 import torch
-from onnx import numpy_helper
 
 from ..models.autoencoder import MotionAutoencoder
 from ..onnx.sessions import cpu_session
-from .exporting import PARITY_TOLERANCE, RADIUS, ValidDecoder
-
-# Initializer names of the exported graphs -> the trained model's state dict.
-ENCODER_WEIGHTS = {f"model.encoder.{i}.{p}": f"encoder.{i}.{p}" for i in (0, 3) for p in ("weight", "bias")}
-DECODER_WEIGHTS = {f"{conv}.{p}": f"decoder.{i}.{p}" for conv, i in (("conv1", 2), ("conv2", 6)) for p in ("weight", "bias")}
-
-
-def _initializers(path: Path, names: dict[str, str]) -> dict[str, torch.Tensor]:
-    inits = {i.name: numpy_helper.to_array(i) for i in onnx.load(str(path)).graph.initializer}
-    missing = sorted(set(names) - set(inits))
-    if missing:
-        raise ValueError(f"{path.name} has no initializer {', '.join(missing)}: not an export of training/autoencoder/exporting.py")
-    return {key: torch.from_numpy(np.array(inits[name])) for name, key in names.items()}
+from .exporting import PARITY_TOLERANCE, RADIUS, ValidDecoder, autoencoder_from_onnx, shipped_meta
 
 
 def rebuild(info: dict, encoder_path: Path, decoder_path: Path) -> tuple[MotionAutoencoder, float]:
     """The model (eval mode) from the two graphs, and its largest difference from them in onnxruntime."""
     rows = info["rows"]["dim"]
-    model = MotionAutoencoder(rows, info["hidden"], info["latent"])
-    model.load_state_dict(_initializers(encoder_path, ENCODER_WEIGHTS) | _initializers(decoder_path, DECODER_WEIGHTS))
-    model.eval()
+    model = autoencoder_from_onnx(encoder_path, decoder_path, rows, info["hidden"], info["latent"])
     x = np.random.default_rng(0).normal(size=(2, 4 * (2 * RADIUS + 3), rows)).astype(np.float32)
     with torch.no_grad():
         z = model.encode(torch.from_numpy(x))
@@ -60,10 +45,8 @@ def recover_checkpoint(info_path: Path, out: Path) -> tuple[dict, float]:
     info = json.loads(info_path.read_text())
     encoder_path, decoder_path = (info_path.parent / info["files"][k] for k in ("encoder", "decoder"))
     model, worst = rebuild(info, encoder_path, decoder_path)
-    meta = {"dim": info["rows"]["dim"], "hidden": info["hidden"], "latent": info["latent"], "fps": info["fps"],
-            "window": info["window"], "mean": info["normalisation"]["mean"], "std": info["normalisation"]["std"]}
     digest = {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in (encoder_path, decoder_path)}
-    state = {"model": model.state_dict(), "meta": meta, "recovered_from": digest}
+    state = {"model": model.state_dict(), "meta": shipped_meta(info), "recovered_from": digest}
     out.parent.mkdir(parents=True, exist_ok=True)
     torch.save(state, out)
     return state, worst

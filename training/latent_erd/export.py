@@ -2,8 +2,15 @@
 tests/fixtures/latent_erd_reference.json. Export the autoencoder first (python -m training.autoencoder.export):
 the fixture runs the exported decoder.
 
-    python -m training.latent_erd.export [--checkpoint runs/latent-erd/best.pt] [--out public/models]
-    python -m training.latent_erd.export --seeds-only [--out public/models]   # new seeds for the exported network
+    python -m training.latent_erd.export [--checkpoint runs/latent-erd/best.pt] [--out public/models] [--weights int8]
+    python -m training.latent_erd.export --from-shipped [DIR] [--weights int8]   # no checkpoint: rewrite DIR's file
+    python -m training.latent_erd.export --seeds-only [--out public/models]       # new seeds for the exported network
+
+The large weights are stored as --weights (int8 with a scale per output channel by default; training/onnx/compact.py),
+parity checked against torch holding the weights as stored. --from-shipped reads the network back from
+DIR/latent-erd.onnx (default public/models) and keeps its JSON but for the parity fields, the seeds (picked again
+through --out's exported autoencoder) and the bytes; compact from a float32 export. --seeds-only and --from-shipped
+need no checkpoint: the autoencoder is read from --out's manifold graphs.
 """
 from __future__ import annotations
 
@@ -13,8 +20,9 @@ from pathlib import Path
 from ..autoencoder.training import load_autoencoder
 from ..data.locomotion import load_clips
 from ..data.windows import WindowCorpus
+from ..onnx.compact import FORMATS
 from ..paths import MODELS_DIR, REPO_ROOT, add_mocap_argument
-from .exporting import export_latent_erd, reseed
+from .exporting import export_latent_erd, reseed, rewrite_latent_erd
 from .training import load_erd
 
 
@@ -23,20 +31,29 @@ def main(argv: list[str] | None = None) -> None:
     add_mocap_argument(parser)
     parser.add_argument("--checkpoint", default=str(REPO_ROOT / "runs" / "latent-erd" / "best.pt"))
     parser.add_argument("--out", default=str(MODELS_DIR))
+    parser.add_argument("--weights", choices=FORMATS, default="int8", help="how the file stores its large weights")
+    parser.add_argument("--from-shipped", type=Path, nargs="?", const=MODELS_DIR, default=None, metavar="DIR",
+                        help="no checkpoint: read the network back from DIR/latent-erd.onnx and keep DIR/latent-erd.json")
     parser.add_argument("--seeds-only", action="store_true",
-                        help="rewrite only the seeds of --out's latent-erd.json (and the fixture), for its ONNX as it is; "
-                             "needs runs/autoencoder/best.pt (python -m training.autoencoder.recover), not the ERD's checkpoint")
+                        help="rewrite only the seeds of --out's latent-erd.json (and the fixture), for its ONNX as it is")
     args = parser.parse_args(argv)
-    if args.seeds_only:
-        autoencoder, _ = load_autoencoder(REPO_ROOT / "runs" / "autoencoder" / "best.pt")
-        reseed(Path(args.out), autoencoder, WindowCorpus(load_clips(args.mocap)))
+    out = Path(args.out)
+    if args.seeds_only or args.from_shipped is not None:
+        corpus = WindowCorpus(load_clips(args.mocap))
+        try:
+            if args.seeds_only:
+                reseed(out, corpus)
+            else:
+                rewrite_latent_erd(args.from_shipped, out, corpus, args.weights)
+        except (OSError, ValueError, KeyError) as error:
+            raise SystemExit(f"error: cannot rewrite the exported latent ERD: {error}")
         return
     erd, meta = load_erd(Path(args.checkpoint))
     if meta["space"] != "latent":
         raise SystemExit(f"error: {args.checkpoint} is a {meta['space']}-space ERD; only the latent ERD ships")
     autoencoder, _ = load_autoencoder(Path(meta["autoencoder"]))
     corpus = WindowCorpus(load_clips(args.mocap))
-    export_latent_erd(erd, meta, autoencoder, corpus, {}, Path(args.out))
+    export_latent_erd(erd, meta, autoencoder, corpus, {}, out, args.weights)
 
 
 if __name__ == "__main__":

@@ -2,7 +2,12 @@
 tests/fixtures/latent_erd_reference.json for the browser's parity tests.
 
 latent-erd.onnx is one step: z (batch, latent) normalised, control (batch, 12) normalised, h and c
-(layers, batch, hidden) -> z_next, h_out, c_out. The batch dimension is dynamic.
+(layers, batch, hidden) -> z_next, h_out, c_out. The batch dimension is dynamic. Its large weights are stored as
+float32, float16 or int8 with a scale per output channel (training/onnx/compact.py; the export command's default is
+int8), made float32 again inside the graph when the session is created; the parity check compares onnxruntime with
+torch holding the weights as stored (`erd_from_onnx`, read back from the file). `rewrite_latent_erd` writes the
+exported file again (another weight format, new seeds through the shipped autoencoder, the fixture) without the
+checkpoint.
 """
 from __future__ import annotations
 
@@ -10,13 +15,15 @@ import json
 from pathlib import Path
 
 import numpy as np
+import onnx
 import torch
 from torch import nn
 
-from ..autoencoder.exporting import RADIUS
+from ..autoencoder.exporting import RADIUS, shipped_autoencoder
 from ..data.windows import CONTROL_SLICE, WindowCorpus
 from ..models.autoencoder import POOLING, MotionAutoencoder
 from ..models.erd import ControlERD
+from ..onnx.compact import compact_weights, float_initializers, weight_format
 from ..onnx.manifest import register_model
 from ..onnx.sessions import cpu_session
 from ..paths import MODELS_DIR, REPO_ROOT
@@ -31,6 +38,9 @@ PARITY_TOLERANCE = 1e-4
 # follow better (the report's prediction tables keep their own 16-frame seeds).
 SEED_STEPS = 8
 FIXTURE = REPO_ROOT / "tests" / "fixtures" / "latent_erd_reference.json"
+# ONNX LSTM nodes keep the gate blocks in the order (i, o, f, c); PyTorch's is (i, f, g, o): torch block k is ONNX
+# block ONNX_TO_TORCH[k].
+ONNX_TO_TORCH = [0, 2, 3, 1]
 
 
 class ERDStep(nn.Module):
@@ -43,13 +53,51 @@ class ERDStep(nn.Module):
         return y[:, 0], h2, c2
 
 
-def export_step(erd: ControlERD, path: Path) -> None:
+def export_step(erd: ControlERD, path: Path, weights: str = "float32") -> ControlERD:
+    """Writes the step graph with its large weights stored as `weights`; returns the ERD the file computes (the
+    weights as stored, eval mode), the reference for the parity check."""
     z, control = torch.zeros(1, erd.dim), torch.zeros(1, erd.control)
     h, c = erd.zero_state(1)
     b, s = {0: "batch"}, {1: "batch"}
     torch.onnx.export(ERDStep(erd).eval(), (z, control, h, c), str(path), input_names=INPUTS, output_names=OUTPUTS,
                       opset_version=17, dynamo=False,
                       dynamic_axes={"z": b, "control": b, "h": s, "c": s, "z_next": b, "h_out": s, "c_out": s})
+    onnx.save(compact_weights(onnx.load(str(path)), weights), str(path))
+    return erd_from_onnx(path, erd.dim, erd.control, erd.hidden, erd.layers)
+
+
+def erd_from_onnx(path: Path, dim: int, control: int, hidden: int, layers: int) -> ControlERD:
+    """The ControlERD (eval mode) an export_step file holds, whatever its weight format: the encoder's and the
+    decoder's MatMul and the Add of its bias, one ONNX LSTM node per layer (W, R (1, 4H, in), B (1, 8H): input and
+    recurrent biases), and the output clamp's Max and Min. Weights stored in lower precision come back as the float32
+    values the graph computes with."""
+    graph = onnx.load(str(path))
+    w = float_initializers(graph)
+    nodes = list(graph.graph.node)
+    lstms = [n for n in nodes if n.op_type == "LSTM"]
+    matmuls = [n for n in nodes if n.op_type == "MatMul" and n.input[1] in w]
+    if len(lstms) != layers or len(matmuls) != 2:
+        raise ValueError(f"{path.name} has {len(lstms)} LSTM and {len(matmuls)} weight MatMul nodes (expected {layers} and 2): "
+                         "not an export of training/latent_erd/exporting.py")
+
+    def bias_of(matmul) -> np.ndarray:
+        add = next(n for n in nodes if n.op_type == "Add" and matmul.output[0] in n.input)
+        return w[next(i for i in add.input if i in w)]
+
+    def clamp(op: str) -> np.ndarray:
+        return w[next(i for n in nodes if n.op_type == op for i in n.input if i in w)]
+
+    gates = lambda a: a.reshape(4, hidden, *a.shape[1:])[ONNX_TO_TORCH].reshape(4 * hidden, *a.shape[1:])
+    sd = {"encoder.0.weight": w[matmuls[0].input[1]].T, "encoder.0.bias": bias_of(matmuls[0]),
+          "decoder.weight": w[matmuls[1].input[1]].T, "decoder.bias": bias_of(matmuls[1]),
+          "low": clamp("Max"), "high": clamp("Min")}
+    for l, n in enumerate(lstms):
+        bias = w[n.input[3]][0]
+        sd[f"lstms.{l}.weight_ih_l0"], sd[f"lstms.{l}.weight_hh_l0"] = gates(w[n.input[1]][0]), gates(w[n.input[2]][0])
+        sd[f"lstms.{l}.bias_ih_l0"], sd[f"lstms.{l}.bias_hh_l0"] = gates(bias[:4 * hidden]), gates(bias[4 * hidden:])
+    erd = ControlERD(dim, control, hidden, layers)
+    erd.load_state_dict({k: torch.from_numpy(np.ascontiguousarray(v, np.float32)) for k, v in sd.items()})
+    return erd.eval()
 
 
 def check_parity(erd: ControlERD, path: Path, steps: int = 20) -> float:
@@ -137,12 +185,29 @@ def write_reference_fixture(erd_path: Path, decoder_path: Path, info: dict, norm
     print(f"wrote {FIXTURE}")
 
 
+def _publish(info: dict, out: Path, norm: Normalisation) -> None:
+    """latent-erd.json beside the graph; into MODELS_DIR also the parity fixture and the manifest entry."""
+    path = out / info["file"]
+    info["bytes"] = path.stat().st_size
+    (out / "latent-erd.json").write_text(json.dumps(info) + "\n")
+    if out == MODELS_DIR:
+        write_reference_fixture(path, out / "manifold-decoder.onnx", info, norm)
+        register_model({"id": "latent-erd", "kind": "latent-erd", "skeleton": "cmu-canonical", "fps": info["fps"],
+                        "bytes": info["bytes"], "file": path.name})
+
+
+def _write_step(erd: ControlERD, path: Path, weights: str) -> dict:
+    """Writes and parity-checks the step graph; returns the JSON's parity and weight fields."""
+    parity = check_parity(export_step(erd, path, weights), path)
+    return {"parity_max_abs": parity, "parity_reference": f"torch with the weights as stored ({weights})",
+            "weights": weight_format(onnx.load(str(path)))}
+
+
 def export_latent_erd(erd: ControlERD, meta: dict, autoencoder: MotionAutoencoder, corpus: WindowCorpus,
-                      report: dict, out: Path = MODELS_DIR) -> dict:
+                      report: dict, out: Path = MODELS_DIR, weights: str = "float32") -> dict:
     out.mkdir(parents=True, exist_ok=True)
     path = out / "latent-erd.onnx"
-    export_step(erd, path)
-    parity = check_parity(erd, path)
+    stored = _write_step(erd, path, weights)
     norm = Normalisation.from_meta(meta)
     control_sigma = float(meta.get("control_sigma", 0.0))
     info = {"id": "latent-erd", "kind": "latent-erd", "file": path.name, "manifold": "manifold.json", "fps": meta["fps"],
@@ -151,30 +216,47 @@ def export_latent_erd(erd: ControlERD, meta: dict, autoencoder: MotionAutoencode
             "inputs": INPUTS, "outputs": OUTPUTS,
             "latent_normalisation": {"mean": np.round(norm.latent_mean, 6).tolist(), "std": np.round(norm.latent_std, 6).tolist()},
             "control_range": control_range(corpus), "seeds": pick_seeds(corpus, autoencoder, norm, control_sigma),
-            "control_smoothing_frames": control_sigma,
-            "parity_max_abs": parity, "report": report, "bytes": path.stat().st_size}
-    (out / "latent-erd.json").write_text(json.dumps(info) + "\n")
-    if out == MODELS_DIR:
-        write_reference_fixture(path, out / "manifold-decoder.onnx", info, norm)
-        register_model({"id": "latent-erd", "kind": "latent-erd", "skeleton": "cmu-canonical", "fps": meta["fps"],
-                        "bytes": info["bytes"], "file": path.name})
-    print(f"wrote {path} ({info['bytes'] / 1e6:.1f} MB), parity {parity:.1e}")
+            "control_smoothing_frames": control_sigma, **stored, "report": report}
+    _publish(info, out, norm)
+    print(f"wrote {path} ({info['bytes'] / 1e6:.2f} MB, {weights}), parity {info['parity_max_abs']:.1e}")
     return info
 
 
-def reseed(out: Path, autoencoder: MotionAutoencoder, corpus: WindowCorpus) -> dict:
-    """Rewrite the seeds of an exported latent-erd.json (pick_seeds) for its latent-erd.onnx as it is, without the
-    network's checkpoint, and for public/models the parity fixture: for a change in how streams are seeded. The
-    normalisations are the JSON's (6 decimals), as the page reads them."""
-    path = out / "latent-erd.json"
-    info = json.loads(path.read_text())
+def _json_normalisation(out: Path, info: dict) -> Normalisation:
+    """The normalisations as the page reads them: latent-erd.json's and its manifold.json's (6 decimals)."""
     manifold = json.loads((out / info["manifold"]).read_text())
-    norm = Normalisation(*(np.asarray(v, np.float64) for v in (
+    return Normalisation(*(np.asarray(v, np.float64) for v in (
         info["latent_normalisation"]["mean"], info["latent_normalisation"]["std"],
         manifold["normalisation"]["mean"], manifold["normalisation"]["std"])))
-    info["seeds"] = pick_seeds(corpus, autoencoder, norm, float(info.get("control_smoothing_frames", 0.0)))
+
+
+def reseed(out: Path, corpus: WindowCorpus) -> dict:
+    """Rewrite the seeds of an exported latent-erd.json (pick_seeds, through the autoencoder of out/manifold.json as
+    exported) for its latent-erd.onnx as it is, without a checkpoint, and for public/models the parity fixture: for a
+    change in how streams are seeded."""
+    path = out / "latent-erd.json"
+    info = json.loads(path.read_text())
+    norm = _json_normalisation(out, info)
+    info["seeds"] = pick_seeds(corpus, shipped_autoencoder(out / info["manifold"]), norm, float(info.get("control_smoothing_frames", 0.0)))
     path.write_text(json.dumps(info) + "\n")
     if out == MODELS_DIR:
         write_reference_fixture(out / info["file"], out / "manifold-decoder.onnx", info, norm)
     print(f"wrote {path}: {len(info['seeds'])} seeds of {SEED_STEPS} latent steps")
+    return info
+
+
+def rewrite_latent_erd(source: Path, out: Path, corpus: WindowCorpus, weights: str) -> dict:
+    """The exported latent ERD `source`/latent-erd.{json,onnx} written again into `out` with its weights stored as
+    `weights`, without the checkpoint: the network is read back from the ONNX file (erd_from_onnx), the seeds picked
+    again through the autoencoder exported into `out` (export it first: the seeds are what its encoder gives), and
+    for public/models the fixture made from the files as written. The rest of the JSON is kept."""
+    info = json.loads((source / "latent-erd.json").read_text())
+    erd = erd_from_onnx(source / info["file"], info["latent"], info["control_dim"], info["hidden"], info["layers"])
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / "latent-erd.onnx"
+    info.update(_write_step(erd, path, weights), file=path.name)
+    norm = _json_normalisation(out, info)
+    info["seeds"] = pick_seeds(corpus, shipped_autoencoder(out / info["manifold"]), norm, float(info.get("control_smoothing_frames", 0.0)))
+    _publish(info, out, norm)
+    print(f"wrote {path} ({info['bytes'] / 1e6:.2f} MB, {weights}), parity {info['parity_max_abs']:.1e}")
     return info

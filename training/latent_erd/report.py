@@ -8,12 +8,14 @@ import json
 from pathlib import Path
 
 import numpy as np
+import onnx
 import torch
 
 from .. import metrics
 from ..data.locomotion import load_clips
 from ..data.windows import WindowCorpus
 from ..generator.shipped import ShippedGenerator
+from ..onnx.compact import weight_format
 from ..paths import MODELS_DIR, REPO_ROOT, REPORTS_DIR
 from . import measures as m
 from .training import load_erd
@@ -100,9 +102,9 @@ def evaluate(mocap: str | None, frames: int, n_seeds: int, pose_checkpoint: Path
         report["browser"] = json.loads(BROWSER_JSON.read_text())
     if (REPORTS_DIR / "control.json").exists():
         report["generator_browser"] = json.loads((REPORTS_DIR / "control.json").read_text())
-    report["sizes_bytes"] = {"latent-erd.onnx": (models_dir / "latent-erd.onnx").stat().st_size,
-                             "manifold-encoder.onnx": (models_dir / "manifold-encoder.onnx").stat().st_size,
-                             "manifold-decoder.onnx": (models_dir / "manifold-decoder.onnx").stat().st_size}
+    files = ("latent-erd.onnx", "manifold-encoder.onnx", "manifold-decoder.onnx")
+    report["sizes_bytes"] = {f: (models_dir / f).stat().st_size for f in files}
+    report["weights"] = {f: weight_format(onnx.load(str(models_dir / f))) for f in files}
     # Runs whose run folder is not in this clone keep the summary the last report had.
     report["training"] = dict(previous.get("training", {}))
     for name in TRAINING_RUNS:
@@ -205,6 +207,19 @@ def summary_lines(r: dict) -> list[str]:
     return out + [""]
 
 
+def files_lines(r: dict) -> list[str]:
+    """The shipped files' sizes and how they store their weights."""
+    sizes, formats = r.get("sizes_bytes", {}), r.get("weights", {})
+    if not sizes:
+        return []
+    listed = ", ".join(f"`{f}` {sizes[f] / 1e6:.2f} MB" + (f" ({formats[f]})" if f in formats else "") for f in sizes)
+    stored = "/".join(sorted(set(formats.values()) - {"float32"}))
+    how = (f" Their large weights are stored as {stored}{' with one float32 scale per output channel' if stored == 'int8' else ''} "
+           "and made float32 again inside the graph when the session is created (`training/onnx/compact.py`), so the "
+           "arithmetic is float32; everything below is measured on the files as stored.") if stored else ""
+    return [f"Files: {listed}, {sum(sizes.values()) / 1e6:.2f} MB together.{how}", ""]
+
+
 def write_markdown(r: dict, path: Path) -> None:
     man, pred, longr, seams = r["manifold"], r["prediction"], r["long_runs"], r["seams"]
     sr, sh, sl = r["sliding_real"], r["sliding_held_out_control"], r["sliding_random_control"]
@@ -216,6 +231,7 @@ def write_markdown(r: dict, path: Path) -> None:
         "signal (forward, sideways and turning speed of the root, `training/control.py`, the same rules in "
         "`web/motion/control.ts`, checked by `tests/fixtures/control_signal.json`).",
         "",
+    ] + files_lines(r) + [
         "## Data",
         "",
         "CMU walking and running on the canonical skeleton at 30 fps, split by clip as for the generator (every 8th clip "
@@ -252,7 +268,7 @@ def write_markdown(r: dict, path: Path) -> None:
         "",
         "ELU encoder (256 latent + 12 control: the next step's 4 frames) → 3 × LSTM(224) with skip connections (every "
         "layer also sees the encoder's output; the decoder sees all three) → dropout 0.2 → linear decoder of the change to "
-        "the next latent. 224 units rather than the thesis's 256 so the file stays under 8 MB. The pose-space ERD baseline "
+        "the next latent. 224 units rather than the thesis's 256 so the file stayed under 8 MB as float32. The pose-space ERD baseline "
         "is the same network on the 80-value rows, one frame per step, with Fragkiadaki-style input noise growing to 0.3.",
         "",
         "The decoder needs latents 9 steps (1.2 s) on both sides of a frame. Waiting for them would add 1.2 s of lag, so "
