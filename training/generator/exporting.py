@@ -6,18 +6,21 @@ import json
 from pathlib import Path
 
 import numpy as np
+import onnx
 import torch
 
 from ..data.features import FIXED_JOINTS, FeatureCodec, feature_names
 from ..data.locomotion import LocomotionClip, load_clips
-from ..mocap.rotations import matrix_to_quat
+from ..mocap.rotations import matrix_to_quat, quat_to_matrix
 from ..mocap.skeleton import canonical_skeleton
 from ..models.generator import MixtureLSTM, mixture_nll
+from ..onnx.compact import weight_format
 from ..onnx.graph import OPSET
 from ..onnx.manifest import register_model
 from ..onnx.sessions import cpu_session
 from ..paths import MODELS_DIR, REPO_ROOT
 from .graph import INPUTS, OUTPUTS, check_parity, export_onnx
+from .recovery import model_from_onnx
 from .shipped import seed_batch
 from .training import load_generator
 
@@ -97,16 +100,44 @@ def write_reference_fixture(onnx_path: Path, info: dict, codec: FeatureCodec) ->
     print(f"wrote {FIXTURE}")
 
 
-def export_generator(checkpoint: Path, out: Path, mocap: str | None) -> Path:
+def _write_graph(model: MixtureLSTM, onnx_path: Path, weights: str) -> dict:
+    """Writes the step graph with its weights stored as `weights` and checks it against torch holding the weights
+    as stored (read back from the file); returns the JSON's parity field."""
+    export_onnx(model, onnx_path, weights)
+    stored = model_from_onnx(onnx_path, model.dim, model.hidden, model.mixtures)
+    parity = {**check_parity(stored, onnx_path), "reference": f"torch with the weights as stored ({weights})"}
+    print(f"parity ok: max |torch - onnxruntime| = {parity['max_abs_diff']:.2e}")
+    return parity
+
+
+def rewrite_generator(source: Path, out: Path, weights: str) -> Path:
+    """The export in `source` (generator.onnx and .json) written again with its weights stored as `weights`,
+    without the checkpoint: the network is read back from the file; seeds and the rest of the JSON are kept."""
+    info = json.loads((source / "generator.json").read_text())
+    o = info["onnx"]
+    model = model_from_onnx(source / info["file"], o["dim"], o["hidden"], o["mixtures"])
+    out.mkdir(parents=True, exist_ok=True)
+    onnx_path = out / "generator.onnx"
+    info["parity"] = _write_graph(model, onnx_path, weights)
+    info["bytes"] = onnx_path.stat().st_size
+    info["weights"] = weight_format(onnx.load(str(onnx_path)))
+    (out / "generator.json").write_text(json.dumps(info) + "\n")
+    if out == MODELS_DIR:
+        codec = FeatureCodec(canonical_skeleton(), quat_to_matrix(np.array(info["features"]["references"], np.float64)))
+        write_reference_fixture(onnx_path, info, codec)
+        register_model({"id": "generator", "kind": info["kind"], "skeleton": "cmu-canonical", "fps": info["fps"],
+                        "bytes": info["bytes"], "file": info["file"]})
+    return onnx_path
+
+
+def export_generator(checkpoint: Path, out: Path, mocap: str | None, weights: str = "int8") -> Path:
     """Writes out/generator.onnx and out/generator.json (skeleton, feature layout, normalisation, rotation
     references, seed states, training and parity numbers); into MODELS_DIR also the fixture and the manifest
     entry. Returns the ONNX path."""
     model, meta, state = load_generator(checkpoint)
     out.mkdir(parents=True, exist_ok=True)
     onnx_path = out / "generator.onnx"
-    export_onnx(model, onnx_path)
-    parity = check_parity(model, onnx_path)
-    print(f"parity ok: max |torch - onnxruntime| = {parity['max_abs_diff']:.2e}")
+    parity = _write_graph(model, onnx_path, weights)
 
     skel = canonical_skeleton()
     codec = FeatureCodec(skel, np.array(meta["references"]))
@@ -136,6 +167,7 @@ def export_generator(checkpoint: Path, out: Path, mocap: str | None) -> Path:
                      "valid_files": meta["valid_files"], "train_frames": meta["train_frames"],
                      "args": meta["args"]},
         "parity": parity,
+        "weights": weight_format(onnx.load(str(onnx_path))),
     }
     (out / "generator.json").write_text(json.dumps(info) + "\n")
     if out == MODELS_DIR:  # a candidate exported elsewhere must not replace the shipped model's fixture
