@@ -4,7 +4,8 @@ frame with the output and the state fed back, as the page generates.
 
 - acLSTM: the reference code's synthesis loop (papagina/Auto_Conditioned_RNN_motion): three LSTMCells and a
   Linear, the output fed back as the next input; the shipped sizes (aclstm.json: 3 x LSTM(256) over 171 features
-  and the 3-way style).
+  and the 3-way style). Native onnxruntime runs the shipped Loop graph as the page does, 32 steps per call (and,
+  for comparison, one step per call).
 - generator: the shipped MixtureLSTM (FC, FC, 2 x LSTM(192), the mixture head) with one mixture draw per frame
   (component by its weight, then a Gaussian sample), fed back.
 
@@ -23,6 +24,9 @@ from torch import nn
 
 from ..models.generator import MixtureLSTM
 from ..onnx.sessions import cpu_session
+
+
+STEPS_PER_CALL = 32  # the page's calls (web/runtime/danceCore.ts STEPS_PER_CALL, as training/aclstm/shipped.py)
 
 
 def _rate(step, frames: int, warmup: int) -> float:
@@ -67,13 +71,20 @@ def aclstm_peers(models_dir: Path, frames: int, warmup: int) -> dict:
 
     session = cpu_session(models_dir / info["file"], threads=1)
     feed = {"x": np.zeros((1, dim), np.float32), "style": style.numpy(), "h": np.zeros((layers, 1, hidden), np.float32),
-            "c": np.zeros((layers, 1, hidden), np.float32), "steps": np.array([1], np.int64)}
+            "c": np.zeros((layers, 1, hidden), np.float32)}
 
-    def ort_step():
-        ys, feed["h"], feed["c"] = session.run(["ys", "h_out", "c_out"], feed)
-        feed["x"] = ys[-1]
+    def ort_calls(steps: int):
+        """One call of `steps` steps of the shipped Loop graph, the last output fed to the next call."""
+        def call():
+            ys, feed["h"], feed["c"] = session.run(["ys", "h_out", "c_out"], {**feed, "steps": np.array([steps], np.int64)})
+            feed["x"] = ys[-1]
+        return call
 
-    return {"torch_frames_per_s": _rate(torch_step, frames, warmup), "ort_frames_per_s": _rate(ort_step, frames, warmup),
+    per_call = STEPS_PER_CALL
+    return {"torch_frames_per_s": _rate(torch_step, frames, warmup),
+            "ort_frames_per_s": per_call * _rate(ort_calls(per_call), frames // per_call, warmup // per_call + 1),
+            "ort_single_step_frames_per_s": _rate(ort_calls(1), frames, warmup),
+            "ort": f"the shipped Loop graph, {per_call} steps per call as the page calls it (and one step per call)",
             "torch": "3 x nn.LSTMCell(256) + Linear, the reference code's loop", "sizes": {"dim": dim, "hidden": hidden, "layers": layers}}
 
 
