@@ -74,7 +74,7 @@ def evaluate_generator(frames: int, n_seeds: int, temperature: float, mocap: str
     gen_speed = np.concatenate([metrics.root_speed(f, fps) for f in feats])
     gen_turn = np.concatenate([metrics.turning_rate(f, fps) for f in feats])
     report = {
-        "model": "generator", "file": gen.info["file"], "bytes": gen.info["bytes"], "fps": fps,
+        "model": "generator", "file": gen.info["file"], "bytes": gen.info["bytes"], "weights": gen.info.get("weights", "float32"), "fps": fps,
         "temperature": temperature, "frames_per_seed": frames, "sampling_seconds": sample_seconds,
         "real": {"clips": len(real), "frames": int(sum(len(f) for f in real_feats)), "foot_skating": real_skate,
                  "low_foot_sliding": real_low_foot,
@@ -188,7 +188,10 @@ def write_markdown(report: dict) -> None:
     lines += [
         "## Model", "",
         f"FC {m['dim']}→{m['hidden']} → FC → 2 × LSTM({m['hidden']}) → FC to a {m['mixtures']}-component diagonal mixture "
-        f"over {m['dim']} features; {m['parameters']:,} parameters, {report['bytes'] / 1e6:.2f} MB as float32 ONNX. "
+        f"over {m['dim']} features; {m['parameters']:,} parameters, {report['bytes'] / 1e6:.2f} MB of ONNX "
+        f"(weights stored as {report.get('weights', 'float32')}: int8 with the mixture head float16, computed in float32; "
+        "a float32 file was 3.11 MB and its report numbers differ from these by no more than float16 storage's do, "
+        "see [weights.md](weights.md)). "
         "The ONNX step is written by `training/generator/graph.py` directly as a gate-level graph (Gemm products and "
         "the gate maths, no ONNX LSTM op); its parity with torch is in generator.json. "
         f"The width was chosen for the browser budget: in onnxruntime (1 thread) a step costs about 0.3 ms at batch 1 "
