@@ -132,6 +132,7 @@ export class MotionPlaygroundElement extends HTMLElement {
     for (const m of ['clip', 'walk', 'dance', 'path', 'steer']) this.shadow.getElementById(`mode-${m}`)?.addEventListener('click', () => this.linkSoon());
     this.installShare();
     this.markStarted();
+    this.preloadFirstModel(app);
     void this.api.ready.then(async () => {
       const fromLink = this.hasAttribute('link') ? this.linkView() : null;
       const attrs = this.attributeView();
@@ -144,6 +145,20 @@ export class MotionPlaygroundElement extends HTMLElement {
       if (this.hasAttribute('src')) await this.loadSource();
       this.fire('load');
     });
+  }
+
+  /**
+   * Starts loading the generator (its worker, the onnxruntime wasm, the model) right away when the view about to
+   * be shown is Random walk, beside the models list rather than after `ready`: the first generated frame comes
+   * sooner (npm run bench -- first-frame). Only a guess from the attributes and link, read silently (applyView
+   * reports their errors later); a failed load is retried when the mode asks for the model.
+   */
+  private preloadFirstModel(app: App): void {
+    if (this.hasAttribute('src')) return;
+    const quiet = (get: (k: ViewKey) => string | null) => parseView(get).view.mode;
+    const params = new URLSearchParams(location.search || location.hash.replace(/^#/, ''));
+    const mode = (this.hasAttribute('link') ? quiet((k) => params.get(k)) : undefined) ?? quiet((k) => this.getAttribute(k)) ?? FIRST_VIEW.mode;
+    if (mode === 'walk') app.generator.load().catch(() => undefined);
   }
 
   // ---------- views: attributes, links, the UI ----------
