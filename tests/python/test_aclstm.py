@@ -135,6 +135,25 @@ def test_shipped_dance_model(model_id):
     assert np.abs(other[0] - feats[0]).max() > 1e-3
 
 
+def test_shipped_dance_gives_the_same_frames_in_many_step_calls_as_in_one_step_calls():
+    """ShippedDance.generate runs STEPS_PER_CALL steps per ONNX call (the Loop feeds each frame back inside the
+    graph); one call per step, the output fed back by hand, must give the same frames bit for bit."""
+    model = ShippedDance(MODELS_DIR, "aclstm")
+    seed = np.array([model.seeds_of("indian")[0]["frames"]], np.float32)
+    frames = 2 * model.STEPS_PER_CALL + 7
+    many = model.generate(seed, ["indian"], frames)
+    style = np.eye(len(model.styles), dtype=np.float32)[[model.styles.index("indian")]]
+    h = np.zeros((model.layers, 1, model.hidden), np.float32)
+    c = np.zeros_like(h)
+    for t in range(seed.shape[1]):
+        ys, h, c = model.run_steps(((seed[:, t] - model.mean) / model.std).astype(np.float32), style, h, c, 1)
+    one = []
+    for _ in range(frames):
+        one.append(ys[-1])
+        ys, h, c = model.run_steps(ys[-1], style, h, c, 1)
+    assert np.array_equal(many, np.stack(one, axis=1) * model.std + model.mean)
+
+
 def test_freeze_rule_judges_against_the_real_clips():
     """The fairer freeze rule (issue 18): (a) low share at most twice the real one, (b) no 5 s low stretch,
     (c) a median of at least half the real one; a low-energy collapse fails (c) though it never stops."""

@@ -24,7 +24,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--id", default=None, help="model id and file name (default: the run name)")
     parser.add_argument("--out", type=Path, default=MODELS_DIR)
     parser.add_argument("--mocap", default=None)
-    parser.add_argument("--weights", choices=FORMATS, default="float16", help="how the file stores its large weights")
+    parser.add_argument("--weights", choices=FORMATS, default="int8", help="how the file stores its large weights (int8 with a scale per output channel)")
     parser.add_argument("--from-shipped", type=Path, nargs="?", const=MODELS_DIR, default=None, metavar="DIR",
                         help="no checkpoint: read the network back from DIR/<id>.onnx (default the shipped one) and keep its JSON")
     args = parser.parse_args(argv)

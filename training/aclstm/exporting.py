@@ -1,7 +1,7 @@
 """Exporting the dance models (acLSTM and its vanilla baseline): ONNX step plus JSON, parity checked.
 
 public/models/<id>.onnx runs K steps in one call: x, style, h, c, steps -> ys (steps frames), h_out, c_out (the batch
-dimension is dynamic; training/aclstm/graph.py); its large weights are stored as float16 or int8 (training/onnx/compact.py).
+dimension is dynamic; training/aclstm/graph.py); its large weights are stored as int8 by default (or float16/float32: --weights; training/onnx/compact.py).
 <id>.json holds the skeleton, feature layout, normalisation, per-style seed motions (10 real frames each,
 from held-out clips), the real per-second pose change per style, training and parity numbers.
 """
@@ -120,7 +120,7 @@ def _publish(info: dict, onnx_path: Path, model_id: str, out: Path) -> None:
                         "styles": info["styles"], "bytes": info["bytes"], "file": info["file"]})
 
 
-def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | None, weights: str = "float16") -> Path:
+def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | None, weights: str = "int8") -> Path:
     """Writes out/<model_id>.onnx (parity checked) and out/<model_id>.json (see _publish). Returns the ONNX path."""
     model, meta, state = load_dance_model(checkpoint)
     out.mkdir(parents=True, exist_ok=True)

@@ -16,23 +16,16 @@ from pathlib import Path
 import numpy as np
 import onnx
 import torch
-from onnx import TensorProto, helper, numpy_helper
+from onnx import TensorProto, helper
 
 from ..models.aclstm import DanceLSTM, DanceStep
-from ..onnx.compact import stored_float_weights
+from ..onnx.compact import float_initializers
 from ..onnx.graph import OPSET, GraphBuilder
+from ..onnx.lstm import lstm_node_weights, onnx_gates_to_torch, torch_gates_to_onnx
 from ..onnx.sessions import cpu_session
 
 INPUTS, OUTPUTS = ["x", "style", "h", "c", "steps"], ["ys", "h_out", "c_out"]
 PARITY_TOLERANCE = 1e-4
-# ONNX LSTM and this graph keep the gate blocks in the order (i, o, f, g); PyTorch's order is (i, f, g, o).
-TORCH_TO_GRAPH = [0, 3, 1, 2]
-
-
-def _gates(w: np.ndarray, hidden: int, order: list[int]) -> np.ndarray:
-    return w.reshape(4, hidden, *w.shape[1:])[order].reshape(4 * hidden, *w.shape[1:])
-
-
 def dance_graph(model: DanceLSTM) -> onnx.ModelProto:
     """The Loop graph of the module docstring for a trained DanceLSTM. Initialisers are named
     `lstm{l}.w_ih_t` (the first layer's: `lstm0.w_x_t` and `lstm0.w_style_t`), `lstm{l}.w_hh_t`, `lstm{l}.bias`
@@ -41,7 +34,7 @@ def dance_graph(model: DanceLSTM) -> onnx.ModelProto:
     H, D, S, L = model.hidden, model.dim, model.styles, model.layers
     outer = GraphBuilder()
     const, node = outer.const, outer.node
-    gates = lambda w: _gates(w, H, TORCH_TO_GRAPH)
+    gates = lambda w: torch_gates_to_onnx(w, H)  # this graph keeps ONNX LSTM's gate order (i, o, f, g)
     w_ih = [gates(sd[f"lstm.weight_ih_l{l}"]) for l in range(L)]
     bias = [gates(sd[f"lstm.bias_ih_l{l}"] + sd[f"lstm.bias_hh_l{l}"]) for l in range(L)]
     w_in = [const("lstm0.w_x_t", w_ih[0][:, :D].T)] + [const(f"lstm{l}.w_ih_t", w_ih[l].T) for l in range(1, L)]
@@ -98,26 +91,18 @@ def dance_graph(model: DanceLSTM) -> onnx.ModelProto:
     return onnx_model
 
 
-def _weights(path: Path) -> tuple[onnx.ModelProto, dict[str, np.ndarray]]:
-    model = onnx.load(str(path))
-    return model, {t.name: numpy_helper.to_array(t).astype(np.float32) for t in model.graph.initializer}
-
-
 def dance_model_from_onnx(path: Path, dim: int, styles: int, hidden: int, layers: int) -> DanceLSTM:
     """The DanceLSTM an exported file holds: this module's Loop graph, or the earlier torch export (LSTM nodes).
     Weights stored in lower precision come back as the float32 values the graph computes with."""
-    graph_model, w = _weights(path)
-    w = {**w, **stored_float_weights(graph_model)}
+    graph_model = onnx.load(str(path))
+    w = float_initializers(graph_model)
     model = DanceLSTM(dim, styles, hidden, layers)
-    to_torch = lambda a: _gates(a, hidden, [TORCH_TO_GRAPH.index(k) for k in range(4)])
+    to_torch = lambda a: onnx_gates_to_torch(a, hidden)
     sd: dict[str, np.ndarray] = {}
     lstm_nodes = [n for n in graph_model.graph.node if n.op_type == "LSTM"]
-    if lstm_nodes:  # the earlier export: W (1, 4H, in), R (1, 4H, H), B (1, 8H) per layer, gates (i, o, f, c)
+    if lstm_nodes:  # the earlier torch export: one ONNX LSTM node per layer
         for l, n in enumerate(lstm_nodes):
-            bias = w[n.input[3]][0]
-            sd[f"lstm.weight_ih_l{l}"] = to_torch(w[n.input[1]][0])
-            sd[f"lstm.weight_hh_l{l}"] = to_torch(w[n.input[2]][0])
-            sd[f"lstm.bias_ih_l{l}"], sd[f"lstm.bias_hh_l{l}"] = to_torch(bias[:4 * hidden]), to_torch(bias[4 * hidden:])
+            sd.update({f"lstm.{k}_l{l}": v for k, v in lstm_node_weights(n, w, hidden).items()})
         matmul = next(n for n in graph_model.graph.node if n.op_type == "MatMul")
         sd["decoder.weight"] = w[matmul.input[1]].T
         sd["decoder.bias"] = w["model.decoder.bias"]

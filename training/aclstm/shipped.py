@@ -36,14 +36,14 @@ class ShippedDance:
         c = np.zeros_like(h)
         warm = ((np.asarray(seed_frames) - self.mean) / self.std).astype(np.float32)
         for t in range(warm.shape[1]):
-            y, h, c = self._steps(warm[:, t], style, h, c, 1)
+            y, h, c = self.run_steps(warm[:, t], style, h, c, 1)
         y = y[-1]
         out = np.zeros((b, frames, len(self.mean)), np.float32)
         if not feedback_noise:  # the page's way: many steps per call, each output fed back inside the graph
             for t in tqdm(range(0, frames, self.STEPS_PER_CALL), desc="dance", unit="call", disable=not progress):
                 n = min(self.STEPS_PER_CALL, frames - t)
                 out[:, t] = y
-                ys, h, c = self._steps(y, style, h, c, n)
+                ys, h, c = self.run_steps(y, style, h, c, n)
                 out[:, t + 1:t + n] = np.swapaxes(ys[:n - 1], 0, 1)
                 y = ys[-1]
             return out * self.std + self.mean
@@ -58,10 +58,10 @@ class ShippedDance:
             if feedback_noise:
                 noise = rho * noise + np.sqrt(1 - rho * rho) * feedback_noise * rng.standard_normal(y.shape).astype(np.float32)
                 x = (y + noise * mask).astype(np.float32)
-            ys, h, c = self._steps(x, style, h, c, 1)
+            ys, h, c = self.run_steps(x, style, h, c, 1)
             y = ys[-1]
         return out * self.std + self.mean
 
-    def _steps(self, x, style, h, c, steps: int):
+    def run_steps(self, x, style, h, c, steps: int):
         """One session call: `steps` steps from x; returns ys (steps, batch, dim), h, c."""
         return self.session.run(None, {"x": x, "style": style, "h": h, "c": c, "steps": np.array([steps], np.int64)})

@@ -27,16 +27,8 @@ import torch
 from ..mocap.rotations import quat_to_matrix
 from ..models.generator import MixtureLSTM
 from ..onnx.compact import float_initializers
+from ..onnx.lstm import lstm_node_weights
 from .graph import GATE_ORDER, parity_error
-
-ONNX_TO_TORCH_GATES = [0, 2, 3, 1]  # torch (i, f, g, o) from ONNX LSTM blocks (i, o, f, c)
-
-
-def _reorder_gates(w: np.ndarray, hidden: int) -> np.ndarray:
-    """Rows (4H, ...) in ONNX gate order -> PyTorch gate order."""
-    blocks = w.reshape(4, hidden, *w.shape[1:])
-    return np.concatenate([blocks[k] for k in ONNX_TO_TORCH_GATES], axis=0)
-
 
 def _consumers(graph: onnx.GraphProto) -> dict[str, list[onnx.NodeProto]]:
     out: dict[str, list[onnx.NodeProto]] = {}
@@ -53,14 +45,7 @@ def _lstm_node_weights(graph: onnx.GraphProto, inits: dict[str, np.ndarray], hid
     if len(lstms) != 2:
         raise ValueError(f"expected 2 LSTM nodes, found {len(lstms)}")
     for layer, node in enumerate(lstms):
-        attrs = {a.name: onnx.helper.get_attribute_value(a) for a in node.attribute}
-        if attrs.get("hidden_size") != hidden or attrs.get("direction", b"forward") not in (b"forward", "forward"):
-            raise ValueError(f"LSTM node {node.name}: unexpected attributes {attrs}")
-        w, r, b = (inits[name] for name in node.input[1:4])
-        state[f"lstm.weight_ih_l{layer}"] = _reorder_gates(w[0], hidden)
-        state[f"lstm.weight_hh_l{layer}"] = _reorder_gates(r[0], hidden)
-        state[f"lstm.bias_ih_l{layer}"] = _reorder_gates(b[0, :4 * hidden], hidden)
-        state[f"lstm.bias_hh_l{layer}"] = _reorder_gates(b[0, 4 * hidden:], hidden)
+        state.update({f"lstm.{k}_l{layer}": v for k, v in lstm_node_weights(node, inits, hidden).items()})
     # fc1, fc2, fc3 are the MatMul nodes with a weight initializer, in graph order, each followed by an Add
     # of its bias (the legacy exporter's Linear); Gemm is accepted too.
     consumers = _consumers(graph)

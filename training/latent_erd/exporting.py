@@ -24,6 +24,7 @@ from ..data.windows import CONTROL_SLICE, WindowCorpus
 from ..models.autoencoder import POOLING, MotionAutoencoder
 from ..models.erd import ControlERD
 from ..onnx.compact import compact_weights, float_initializers, weight_format
+from ..onnx.lstm import lstm_node_weights
 from ..onnx.manifest import register_model
 from ..onnx.sessions import cpu_session
 from ..paths import MODELS_DIR, REPO_ROOT
@@ -38,9 +39,6 @@ PARITY_TOLERANCE = 1e-4
 # follow better (the report's prediction tables keep their own 16-frame seeds).
 SEED_STEPS = 8
 FIXTURE = REPO_ROOT / "tests" / "fixtures" / "latent_erd_reference.json"
-# ONNX LSTM nodes keep the gate blocks in the order (i, o, f, c); PyTorch's is (i, f, g, o): torch block k is ONNX
-# block ONNX_TO_TORCH[k].
-ONNX_TO_TORCH = [0, 2, 3, 1]
 
 
 class ERDStep(nn.Module):
@@ -87,14 +85,11 @@ def erd_from_onnx(path: Path, dim: int, control: int, hidden: int, layers: int) 
     def clamp(op: str) -> np.ndarray:
         return w[next(i for n in nodes if n.op_type == op for i in n.input if i in w)]
 
-    gates = lambda a: a.reshape(4, hidden, *a.shape[1:])[ONNX_TO_TORCH].reshape(4 * hidden, *a.shape[1:])
     sd = {"encoder.0.weight": w[matmuls[0].input[1]].T, "encoder.0.bias": bias_of(matmuls[0]),
           "decoder.weight": w[matmuls[1].input[1]].T, "decoder.bias": bias_of(matmuls[1]),
           "low": clamp("Max"), "high": clamp("Min")}
     for l, n in enumerate(lstms):
-        bias = w[n.input[3]][0]
-        sd[f"lstms.{l}.weight_ih_l0"], sd[f"lstms.{l}.weight_hh_l0"] = gates(w[n.input[1]][0]), gates(w[n.input[2]][0])
-        sd[f"lstms.{l}.bias_ih_l0"], sd[f"lstms.{l}.bias_hh_l0"] = gates(bias[:4 * hidden]), gates(bias[4 * hidden:])
+        sd.update({f"lstms.{l}.{k}_l0": v for k, v in lstm_node_weights(n, w, hidden).items()})
     erd = ControlERD(dim, control, hidden, layers)
     erd.load_state_dict({k: torch.from_numpy(np.ascontiguousarray(v, np.float32)) for k, v in sd.items()})
     return erd.eval()

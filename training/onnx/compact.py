@@ -127,6 +127,11 @@ def compact_file(path: Path, fmt: str) -> tuple[int, int]:
     return before, path.stat().st_size
 
 
+def files_weight_format(paths: list[Path]) -> str:
+    """How a model's files store their weights together: one weight_format, or e.g. 'float32/int8' when they differ."""
+    return "/".join(sorted({weight_format(onnx.load(str(p), load_external_data=False)) for p in paths}))
+
+
 def model_files(info: dict) -> list[str]:
     """The ONNX files of a model JSON or manifest entry: `files` (several graphs) or `file`."""
     return sorted(set(info["files"].values())) if "files" in info else [info["file"]]
@@ -140,9 +145,8 @@ def refresh_bytes(models_dir: Path) -> None:
     for entry in manifest["models"]:
         info_path = models_dir / f"{entry['id']}.json"
         info = json.loads(info_path.read_text())
-        files = model_files(info)
-        entry["bytes"] = info["bytes"] = sum((models_dir / f).stat().st_size for f in files)
-        formats = {weight_format(onnx.load(str(models_dir / f), load_external_data=False)) for f in files}
-        info["weights"] = "/".join(sorted(formats))
+        files = [models_dir / f for f in model_files(info)]
+        entry["bytes"] = info["bytes"] = sum(f.stat().st_size for f in files)
+        info["weights"] = files_weight_format(files)
         info_path.write_text(json.dumps(info) + "\n")
     manifest_path.write_text(json.dumps(manifest, indent=1) + "\n")

@@ -31,7 +31,7 @@ from torch import nn
 from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, JOINTS, POSITION_DIM
 from ..mocap.skeleton import canonical_skeleton
 from ..models.vae_lstm import KERNEL, POOLING, VaeLstm
-from ..onnx.compact import compact_weights, weight_format
+from ..onnx.compact import compact_weights, files_weight_format
 from ..onnx.manifest import register_model
 from ..onnx.sessions import cpu_session
 from ..paths import MODELS_DIR, REPO_ROOT
@@ -204,7 +204,7 @@ def write_fixture(model: VaeLstm, info: dict, path: Path = FIXTURE) -> None:
 
 def files_format(out: Path) -> str:
     """How the four files store their large weights ("int8", or e.g. "float32/int8" when they differ)."""
-    return "/".join(sorted({weight_format(onnx.load(str(out / f), load_external_data=False)) for f in FILES.values()}))
+    return files_weight_format([out / f for f in FILES.values()])
 
 
 def _write_checked(model: VaeLstm, out: Path, weights: str) -> tuple[VaeLstm, dict]:

@@ -38,7 +38,8 @@ export const DANCE_TOE_GROUND_HEIGHT = 0.012;
 
 /**
  * Most steps one session call runs. A call's fixed cost (feeds, copies into wasm, scheduling) is paid once per
- * call instead of once per frame; 16-64 measured alike, 32 keeps a cancellable call near 5 ms (docs/bench.md).
+ * call instead of once per frame; 16-64 measured alike, and a 32-step call (about 10 ms in Chromium on the 2-core
+ * test machine) keeps cancellation prompt (docs/bench.md).
  */
 export const STEPS_PER_CALL = 32;
 
