@@ -22,19 +22,21 @@ from .report import BONE_ERROR_LIMIT, HEIGHT_BAND, per_second
 
 def rollout(model, meta: dict, seed_frames: np.ndarray, styles: list[str], frames: int, feedback_noise: float = 0.0) -> np.ndarray:
     """Warm up on the seeds (batch, seed, dim; physical units), then feed outputs back (plus white noise of
-    `feedback_noise`, normalised units, seeded): (batch, frames, dim)."""
+    `feedback_noise`, normalised units, seeded): (batch, frames, dim). A Gaussian head's outputs are draws
+    (seeded), fed back and returned."""
     mean, std = np.array(meta["mean"], np.float32), np.array(meta["std"], np.float32)
     style = torch.eye(len(meta["styles"]))[[meta["styles"].index(s) for s in styles]]
     x = torch.from_numpy(((seed_frames - mean) / std).astype(np.float32))
     out = np.zeros((len(x), frames, x.shape[-1]), np.float32)
     with torch.no_grad():
-        y, state = model(x, style)
-        y = y[:, -1:]
         noise = torch.Generator().manual_seed(0)
+        draws = torch.Generator().manual_seed(1)
+        y, state = model(x, style, sample=True, generator=draws)
+        y = y[:, -1:]
         for t in range(frames):
             out[:, t] = y[:, 0].numpy()
             fed = y + feedback_noise * torch.randn(y.shape, generator=noise) if feedback_noise else y
-            y, state = model(fed, style, state)
+            y, state = model(fed, style, state, sample=True, generator=draws)
     return out * std + mean
 
 
@@ -89,6 +91,8 @@ def recipe(args: dict) -> str:
              f"u={args.get('ground_truth', 5)} v={args.get('condition', 5)}"
              + (f"->{args['condition_max']}" if args.get("condition_max") else ""),
              f"lr {args.get('lr', 1e-3):g} x{args.get('decay', 0.95):g}/epoch"]
+    if args.get("head", "mean") != "mean":
+        parts.append(f"{args['head']} head, draws fed back")
     if args.get("feedback_noise"):
         parts.append(f"feedback noise {args['feedback_noise']:g}")
     if args.get("energy"):
