@@ -49,9 +49,18 @@ async function readyClient(): Promise<{ client: GeneratorClient; worker: FakeWor
   return { client, worker };
 }
 
+/** URLs the page fetched (the prefetch of init): answered 404, except a refiner.json naming its file. */
+let fetched: string[] = [];
+
 beforeEach(() => {
   vi.stubGlobal('Worker', FakeWorker);
   vi.stubGlobal('document', { baseURI: 'http://localhost/app/' });
+  fetched = [];
+  vi.stubGlobal('fetch', (url: string) => {
+    fetched.push(String(url));
+    if (String(url).endsWith('/refiner.json')) return Promise.resolve(new Response(JSON.stringify({ file: 'r.onnx' }), { headers: { 'content-type': 'application/json' } }));
+    return Promise.resolve(new Response('', { status: 404 }));
+  });
 });
 
 afterEach(() => {
@@ -116,5 +125,21 @@ describe('GeneratorClient', () => {
     await expect(pending).rejects.toThrow(/disposed/);
     await expect(client.pull(1)).rejects.toThrow(/disposed/);
     expect(worker.terminated).toBe(true);
+  });
+});
+
+describe('GeneratorClient prefetch', () => {
+  it('starts fetching the onnxruntime wasm, the model and the refiner before the worker asks for them', async () => {
+    const client = new GeneratorClient({ modelUrl: 'models/g.onnx', infoUrl: 'models/g.json' });
+    const worker = FakeWorker.last;
+    const init = client.init();
+    expect(worker.sent.map((m) => m.type)).toEqual(['init']);
+    await vi.waitFor(() => expect(fetched).toContain('http://localhost/app/models/r.onnx'));
+    expect(fetched).toContain('http://localhost/app/models/g.onnx');
+    expect(fetched).toContain('http://localhost/app/models/refiner.json');
+    expect(fetched.some((u) => /ort-wasm-simd-threaded.*\.wasm$/.test(u))).toBe(true);
+    worker.reply({ id: worker.sent[0].id, ok: true, result: INIT });
+    await init;
+    client.dispose();
   });
 });

@@ -23,6 +23,7 @@ import type {
   StreamInfo,
   StreamParams,
 } from './protocol';
+import { sharedDownload } from './sharedDownloads';
 import { ModelClient, type ProgressOptions, type RequestOptions } from './workerClient';
 
 export type {
@@ -79,6 +80,18 @@ export class GeneratorClient extends ModelClient<StreamParams, InitResult, Gener
       modelUrl: options.modelUrl ?? 'models/generator.onnx',
       infoUrl: options.infoUrl ?? 'models/generator.json',
     });
+  }
+
+  /** Also the refiner's ONNX file (named in refiner.json beside the generator's JSON), for the first refined stream. */
+  protected override prefetch(): void {
+    super.prefetch();
+    const refinerInfo = new URL('refiner.json', this.urls.infoUrl).href;
+    fetch(refinerInfo)
+      .then((r) => (r.ok ? (r.json() as Promise<{ file?: unknown }>) : null))
+      .then((info) => {
+        if (typeof info?.file === 'string') sharedDownload(new URL(info.file, refinerInfo).href).catch(() => undefined);
+      })
+      .catch(() => undefined);
   }
 
   /**

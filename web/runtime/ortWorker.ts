@@ -4,11 +4,7 @@
 // by the request loop (requestLoop.ts: one request at a time, in order, each answered by exactly one
 // reply carrying its id, cancellable).
 import * as ort from 'onnxruntime-web/wasm';
-// The runtime's files, handed to onnxruntime explicitly so Vite serves them in dev and emits them in a
-// build. The .mjs stays a file of its own (not bundled into the worker) because the threaded runtime
-// starts its helper workers from the .mjs's own URL.
-import ortWasmUrl from 'onnxruntime-web/ort-wasm-simd-threaded.wasm?url';
-import ortGlueUrl from 'onnxruntime-web/ort-wasm-simd-threaded.mjs?url';
+import { ortGlueHref, ortWasmHref } from './ortFiles';
 import { WORKER_ERROR_ID, type ModelRequest } from './protocol';
 import type { DownloadReply, DownloadRequest } from './sharedDownloads';
 import { describe, serveRequests, type Progress } from './requestLoop';
@@ -37,8 +33,8 @@ async function configureRuntime(requestedThreads?: number): Promise<void> {
   ort.env.wasm.simd = true;
   ort.env.wasm.proxy = false; // already off the main thread
   // The wasm (the largest download) comes through the page too, shared by every worker.
-  ort.env.wasm.wasmBinary = await fetchBytes(ortWasmUrl, 'onnxruntime wasm');
-  ort.env.wasm.wasmPaths = { mjs: absolute(ortGlueUrl) };
+  ort.env.wasm.wasmBinary = await fetchBytes(ortWasmHref(), 'onnxruntime wasm');
+  ort.env.wasm.wasmPaths = { mjs: ortGlueHref() };
 }
 
 /** Downloads asked of the page and not yet answered (sharedDownloads.ts). */

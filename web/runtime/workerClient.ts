@@ -7,7 +7,8 @@ import type { Motion } from '../motion/types';
 import { CANCELLED_ERROR_NAME, CancelledError } from './cancellation';
 import { WORKER_ERROR_ID, type BenchmarkResult, type CancelMessage, type WorkerMessage } from './protocol';
 import { assetUrl } from './assetBase';
-import { answerDownload, type DownloadRequest } from './sharedDownloads';
+import { answerDownload, sharedDownload, type DownloadRequest } from './sharedDownloads';
+import { ortWasmHref } from './ortFiles';
 
 /** Options of any request: `signal` cancels it (cancellation.ts). */
 export interface RequestOptions {
@@ -145,7 +146,7 @@ export interface ModelClientOptions {
 export abstract class ModelClient<P extends object, Init extends ModelSkeleton, Chunk extends { frames: number; positions: Float32Array }, Info, Parity, Inputs, M> extends WorkerClient {
   /** The `init` result, once loaded. */
   protected loaded: Init | undefined;
-  private readonly urls: { modelUrl: string; infoUrl: string };
+  protected readonly urls: { modelUrl: string; infoUrl: string };
   private readonly initTimeoutMs: number;
   private readonly threads: number | undefined;
 
@@ -158,8 +159,18 @@ export abstract class ModelClient<P extends object, Init extends ModelSkeleton, 
 
   /** Loads the model; resolves with what the worker reports about it. Call before anything else. */
   async init(): Promise<Init> {
+    this.prefetch();
     this.loaded = await this.request<Init>('init', { ...this.urls, threads: this.threads }, { timeoutMs: this.initTimeoutMs });
     return this.loaded;
+  }
+
+  /**
+   * Starts fetching what the worker will ask the page for as it loads (ortWorker.ts: the onnxruntime wasm and
+   * the model), so the files are on their way while the worker script itself loads and starts. A failed fetch
+   * is forgotten (sharedDownloads.ts): the worker's own ask tries again and reports the error.
+   */
+  protected prefetch(): void {
+    for (const url of [ortWasmHref(), this.urls.modelUrl]) sharedDownload(url).catch(() => undefined);
   }
 
   /** `frames` new frames; the same parameters always give bit-identical output. Cancelled with `signal` (it stops between model steps). */

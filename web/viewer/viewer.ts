@@ -112,6 +112,22 @@ export class Viewer {
     new ResizeObserver(() => this.resize()).observe(container);
     this.resize();
     this.setRunning(true);
+    // Compile the figure's shader while the page waits for its first motion (models loading), not in the
+    // frame that first draws one: under software GL that compile costs tens of milliseconds.
+    const idle = (globalThis.requestIdleCallback as ((cb: () => void, o?: { timeout: number }) => number) | undefined) ?? ((cb: () => void) => setTimeout(cb, 50));
+    idle(() => this.compileFigureShader(), { timeout: 500 });
+  }
+
+  /**
+   * Compiles the figure's program on a hidden stand-in figure that stays in the scene (three.js frees a program
+   * once no material uses it; every Figure's material shares this one's program).
+   */
+  private compileFigureShader(): void {
+    if (this.figure) return;
+    const standIn = new Figure({ fps: 30, frames: 1, joints: ['Hips', 'Head'], parents: [-1, 0], positions: new Float32Array([0, 1, 0, 0, 1.5, 0]) });
+    this.scene.add(standIn.mesh);
+    this.renderer.compile(this.scene, this.camera);
+    standIn.mesh.visible = false;
   }
 
   /** Starts or stops the frame loop (an element taken off the page draws nothing and costs nothing). */
