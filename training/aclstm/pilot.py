@@ -38,10 +38,13 @@ def main(argv: list[str] | None = None) -> None:
     if "pilots" not in saved:  # the first format: the pilot rows alone
         saved = {"pilots": saved, "feedback_noise": {}}
     table, sweeps = saved["pilots"], saved["feedback_noise"]
+    mine, mine_sweeps = set(), set()  # what this call measured
     for sigma in args.feedback_noise:
         frames = args.frames or 20000
         w = feedback_noise_runs(MODELS_DIR, args.model, frames, sigma, args.rho, args.pose_only, mocap=args.mocap)
-        sweeps[f"{args.model} sigma {sigma:g} rho {args.rho:g} {'pose' if args.pose_only else 'all'} {frames}"] = w
+        key = f"{args.model} sigma {sigma:g} rho {args.rho:g} {'pose' if args.pose_only else 'all'} {frames}"
+        sweeps[key] = w
+        mine_sweeps.add(key)
         print(f"{args.model} feedback noise {sigma:g} (rho {args.rho:g}, {'pose' if args.pose_only else 'all'}): "
               f"{w['passes']}/{len(w['runs'])} pass, {w['diverged']} diverged")
     for name in args.runs:
@@ -51,7 +54,13 @@ def main(argv: list[str] | None = None) -> None:
         m.pop("details")
         key = f"{name}:{args.which}" + (f" +noise {args.rollout_noise:g}" if args.rollout_noise else "")
         table[key] = {**m, "summary": summary}
+        mine.add(key)
         print(summary_line(key, m))
+    # Another measurement may have written meanwhile (pilots run two at a time): merge into the file as it is now.
+    latest = json.loads(PILOTS.read_text()) if PILOTS.exists() else {}
+    if "pilots" in latest:
+        table = {**latest["pilots"], **{k: table[k] for k in mine}}
+        sweeps = {**latest["feedback_noise"], **{k: sweeps[k] for k in mine_sweeps}}
     PILOTS.write_text(json.dumps({"pilots": table, "feedback_noise": sweeps}, indent=1, default=str))
     PILOTS.with_suffix(".md").write_text(pilot_markdown(table, sweeps))
     print(f"wrote {PILOTS} and {PILOTS.with_suffix('.md')}")
