@@ -111,18 +111,22 @@ export interface LowpassOptions {
  * Motion (same joints, parents, fps, frames; contacts copied); the input is untouched.
  */
 export function lowpassMotion(motion: Motion, { cutoffHz = 6, order = 2 }: LowpassOptions = {}): Motion {
-  const sections = butterworthLowpass(cutoffHz, motion.fps, order);
-  const { frames: F, positions: P } = motion;
-  const J = motion.joints.length;
-  const out = new Float32Array(P.length);
-  const channel = new Float64Array(F);
-  for (let c = 0; c < J * 3; c++) {
-    // Channel c (joint c/3, axis c%3) sits at stride J·3 through the frames.
-    for (let f = 0; f < F; f++) channel[f] = P[f * J * 3 + c];
-    const filtered = filtfilt(channel, sections);
-    for (let f = 0; f < F; f++) out[f * J * 3 + c] = filtered[f];
-  }
-  const result: Motion = { fps: motion.fps, frames: F, joints: [...motion.joints], parents: [...motion.parents], positions: out };
+  const out = lowpassRows(motion.positions, motion.joints.length * 3, motion.fps, { cutoffHz, order });
+  const result: Motion = { fps: motion.fps, frames: motion.frames, joints: [...motion.joints], parents: [...motion.parents], positions: out };
   if (motion.contacts) result.contacts = motion.contacts.slice();
   return result;
+}
+
+/** Each of the `width` columns of frames × width `values` (at `fps`) filtered over time, zero-phase; a new array. */
+export function lowpassRows(values: ArrayLike<number>, width: number, fps: number, { cutoffHz = 6, order = 2 }: LowpassOptions = {}): Float32Array {
+  const sections = butterworthLowpass(cutoffHz, fps, order);
+  const F = values.length / width;
+  const out = new Float32Array(values.length);
+  const channel = new Float64Array(F);
+  for (let c = 0; c < width; c++) {
+    for (let f = 0; f < F; f++) channel[f] = values[f * width + c];
+    const filtered = filtfilt(channel, sections);
+    for (let f = 0; f < F; f++) out[f * width + c] = filtered[f];
+  }
+  return out;
 }

@@ -14,7 +14,7 @@ import type { GeneratorInfo } from '../model/generatorInfo';
 import { detectContacts } from '../motion/contacts';
 import { labelContacts } from '../motion/contactLabels';
 import { pinFeet } from '../motion/footPin';
-import { butterworthLowpass, filtfilt, lowpassMotion } from '../motion/lowpass';
+import { butterworthLowpass, filtfilt, lowpassMotion, lowpassRows } from '../motion/lowpass';
 import { resampleRobust, resampledFrames, resampleLinear, resampleNearest, resampleQuaternions } from '../motion/resample';
 import { CANONICAL_JOINTS, fromCanonical, mapSkeleton, medianBoneLengths, toCanonical } from '../motion/skeletonMap';
 import type { Motion } from '../motion/types';
@@ -134,6 +134,10 @@ export interface CanonicalInput {
   fps: number;
   /** The jitter of these points (m): measured at the motion's own frame rate (jitterSigma, median over the points), less the averaging down to the model's rate. */
   jitter: number;
+  /** The same points' slow part: low-passed at SLOW_BAND_HZ at the motion's own rate (every captured sample), then brought to the model's. */
+  slow: Float32Array;
+  /** The points low-passed at STEADY_BAND_HZ at the motion's own rate, brought to the model's, and their remaining jitter (m): for bone lengths. */
+  steady: { points: Float32Array; jitter: number };
 }
 export interface CanonicalCleaned {
   positions: Float32Array;
@@ -154,7 +158,7 @@ export function mapCleaner(args: { step: StepFn; info: GeneratorInfo; mean: Arra
     const frames = input.points.length / (K * 3);
     const encoded = encodeFeatures(info, input.points, input.rotations);
     const jitter = Math.max(SIGMA_FLOOR, input.jitter);
-    const offsets = segmentOffsets(info, input.points, input.jitter);
+    const offsets = segmentOffsets(info, input.steady.points, input.steady.jitter);
     const sigma = Array.from({ length: K }, (_, k) => {
       if (k === 0) return options.sigmaRoot ?? jitter;
       if (options.sigmaAngle === undefined) return jitter;
@@ -169,11 +173,34 @@ export function mapCleaner(args: { step: StepFn; info: GeneratorInfo; mean: Arra
     // Decoded on the clip's own segment lengths, so the cleaned points keep its proportions.
     const decoded = decodeFeatures(info, r.features, start, offsets);
     return {
-      positions: decoded.positions,
+      positions: withSlowPart(decoded.positions, input.slow, input.fps),
       bits: decoded.contacts,
       stats: { sigmaRoot: sigma[0], ...(options.sigmaAngle === undefined ? { jitter } : { sigmaAngle: options.sigmaAngle }), outlierShare: r.outlierShare },
     };
   };
+}
+
+/**
+ * Below SLOW_BAND_HZ the capture itself is the better estimate: averaged over every sample at the motion's own
+ * rate, its noise there is small, while the smoother's prior (a generator that predicts held-out capture less
+ * well than a constant-velocity guess) biases slow motion by centimetres (docs/models/cleanup.md). So `map` keeps
+ * its own motion above the band and the data's below it: cleaned − slow(cleaned) + slow(data), a complementary
+ * filter. Feet are pinned after this, on the sum.
+ */
+export const SLOW_BAND_HZ = 2;
+
+/**
+ * Bone lengths (and the offsets of joints riding on a canonical segment) are measured on the capture low-passed at
+ * this cut-off: averaging every sample leaves about a third of the jitter (noise bandwidth ≈ 2.05 × cut-off of the
+ * zero-phase filter), where correcting the raw lengths for jitter alone shortened the short spine bones by up to half
+ * at 5 cm jitter, which bent the whole upper body (the head 10–15 cm off).
+ */
+const STEADY_BAND_HZ = 6;
+
+function withSlowPart(cleaned: Float32Array, slowData: Float32Array, fps: number): Float32Array {
+  const width = CANONICAL_JOINTS.length * 3;
+  const slowCleaned = lowpassRows(cleaned, width, fps, { cutoffHz: SLOW_BAND_HZ });
+  return cleaned.map((v, i) => v - slowCleaned[i] + slowData[i]);
 }
 
 /** The `manifold` cleaner: the canonical points projected through the denoising autoencoder (manifoldProjection.ts). */
@@ -212,7 +239,14 @@ export async function cleanUpOnCanonical(
   const jitter = medianJitter(beforePoints);
   const rotations = canonicalRotations(info, points);
   const beforeRotations = resampleQuaternions(rotations, K, fps, motion.fps, motion.frames);
-  const cleaned = await clean({ points, rotations, fps, jitter: jitter / Math.sqrt(window >= 5 ? window - 1 : (2 * window) / Math.PI) });
+  const slow = resampleLinear(lowpassRows(beforePoints, K * 3, motion.fps, { cutoffHz: SLOW_BAND_HZ }), K * 3, motion.fps, fps, frames);
+  for (let i = 1; i < slow.length; i += 3) slow[i] -= floor;
+  const steadyHz = Math.min(STEADY_BAND_HZ, motion.fps * 0.45);
+  const steadyMotion = lowpassMotion(motion, { cutoffHz: steadyHz });
+  const steadyJitter = jitter * Math.sqrt(Math.min(1, (2.05 * steadyHz) / motion.fps));
+  const steadyBefore = toCanonical(steadyMotion, mapping);
+  const steady = { points: resampleLinear(steadyBefore, K * 3, motion.fps, fps, frames), jitter: steadyJitter };
+  const cleaned = await clean({ points, rotations, fps, jitter: jitter / Math.sqrt(window >= 5 ? window - 1 : (2 * window) / Math.PI), slow, steady });
   const { skeleton } = info;
   // Contacts labelled on the cleaned motion (the model's bits with the feet's heights and speeds), planted feet pinned.
   const contacts30 = labelContacts(cleaned.positions, cleaned.bits, skeleton.joints, fps);
@@ -222,7 +256,7 @@ export async function cleanUpOnCanonical(
   // After: back at the imported motion's frame times.
   const afterPoints = resampleLinear(planted.positions, K * 3, fps, motion.fps, motion.frames);
   const after = { points: afterPoints, rotations: resampleQuaternions(afterRotations, K, fps, motion.fps, motion.frames) };
-  const moved = fromCanonical(motion, mapping, { points: beforePoints, rotations: beforeRotations }, after, jitter / mapping.scale);
+  const moved = fromCanonical(steadyMotion, mapping, { points: steadyBefore, rotations: beforeRotations }, after, steadyJitter / mapping.scale);
   const contacts = resampleNearest(planted.contacts, 2, fps, motion.fps, motion.frames);
   return {
     motion: { ...moved, contacts },
