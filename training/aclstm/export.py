@@ -25,6 +25,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--out", type=Path, default=MODELS_DIR)
     parser.add_argument("--mocap", default=None)
     parser.add_argument("--weights", choices=FORMATS, default="int8", help="how the file stores its large weights (int8 with a scale per output channel)")
+    parser.add_argument("--temperature", type=float, default=0.2, help="a Gaussian head's sampling temperature (kept in the JSON)")
     parser.add_argument("--from-shipped", type=Path, nargs="?", const=MODELS_DIR, default=None, metavar="DIR",
                         help="no checkpoint: read the network back from DIR/<id>.onnx (default the shipped one) and keep its JSON")
     args = parser.parse_args(argv)
@@ -36,7 +37,7 @@ def main(argv: list[str] | None = None) -> None:
     checkpoint = RUNS_DIR / args.run / args.checkpoint
     if not checkpoint.exists():
         raise SystemExit(f"error: no checkpoint at {checkpoint}; train first with python -m training.aclstm.train")
-    onnx_path = export_dance_model(checkpoint, model_id, args.out, args.mocap, args.weights)
+    onnx_path = export_dance_model(checkpoint, model_id, args.out, args.mocap, args.weights, args.temperature)
     print(f"wrote {onnx_path} ({onnx_path.stat().st_size / 1e6:.2f} MB) and {model_id}.json")
 
 

@@ -20,7 +20,7 @@ from ..onnx.compact import compact_weights, weight_format
 from ..onnx.manifest import register_model
 from ..onnx.sessions import cpu_session
 from ..paths import MODELS_DIR, REPO_ROOT
-from .graph import INPUTS, OUTPUTS, check_parity, dance_graph, dance_model_from_onnx
+from .graph import OUTPUTS, check_parity, dance_graph, dance_model_from_onnx, graph_inputs
 
 SEED_FRAMES = 10  # the paper's seed length (about 170 ms at 60 fps)
 SEEDS_PER_STYLE = 8
@@ -74,10 +74,15 @@ def write_reference_fixture(onnx_path: Path, info: dict) -> None:
     shape = (info["onnx"]["layers"], 2, info["onnx"]["hidden"])
     h, c = (rng.normal(scale=0.3, size=shape).astype(np.float32) for _ in range(2))
     inputs = {"x": x.ravel().tolist(), "style": style.ravel().tolist(), "h": h.ravel().tolist(), "c": c.ravel().tolist(), "batch": 2}
+    gauss = "noise" in info["onnx"]["inputs"]
+    noise = rng.normal(size=(FIXTURE_STEPS, 2, x.shape[1])).astype(np.float32)
+    temperature = np.array([info.get("temperature", 1.0)], np.float32)
 
     def case(steps: int) -> dict:
-        outs = session.run(OUTPUTS, {"x": x, "style": style, "h": h, "c": c, "steps": np.array([steps], np.int64)})
-        return {"inputs": {**inputs, "steps": steps}, "outputs": {n: np.asarray(o).ravel().tolist() for n, o in zip(OUTPUTS, outs)}}
+        drawn = {"noise": noise[:steps], "temperature": temperature} if gauss else {}
+        outs = session.run(OUTPUTS, {"x": x, "style": style, "h": h, "c": c, "steps": np.array([steps], np.int64), **drawn})
+        listed = {"noise": noise[:steps].ravel().tolist(), "temperature": float(temperature[0])} if gauss else {}
+        return {"inputs": {**inputs, "steps": steps, **listed}, "outputs": {n: np.asarray(o).ravel().tolist() for n, o in zip(OUTPUTS, outs)}}
 
     feats = np.array(seeds[0]["frames"])
     decoded = {"features": feats.ravel().tolist(), "frames": len(feats), "positions": decode(feats).ravel().tolist()}
@@ -100,11 +105,15 @@ def _write_graph(model: DanceLSTM, onnx_path: Path, weights: str) -> tuple[dict,
     stored = export_onnx(model, onnx_path, weights)
     parity = {**check_parity(stored, onnx_path), "reference": f"torch with the weights as stored ({weights})"}
     print(f"parity ok: max |torch - onnxruntime| = {parity['max_abs_diff']:.2e}")
-    fields = {"inputs": INPUTS, "outputs": OUTPUTS, "opset": 17, "layers": model.layers, "hidden": model.hidden,
-              "dim": model.dim, "styles": model.styles, "weights": weight_format(onnx.load(str(onnx_path))),
+    fields = {"inputs": graph_inputs(model), "outputs": OUTPUTS, "opset": 17, "layers": model.layers, "hidden": model.hidden,
+              "dim": model.dim, "styles": model.styles, "head": model.head, "weights": weight_format(onnx.load(str(onnx_path))),
               "style_input": "one-hot over `styles`; x and ys are normalised features",
               "steps_input": "int64 (1,): steps run in the call, each output frame fed back as the next input; "
                              "ys is (steps, batch, dim)"}
+    if model.head == "gauss":
+        fields["noise_input"] = ("float32 (>= steps, batch, dim) standard normals, one row per step: each frame is "
+                                 "mu + temperature * sigma * noise[step], the network's Gaussian draw")
+        fields["temperature_input"] = "float32 (1,): scales sigma (0: the mean)"
     return fields, parity
 
 
@@ -120,8 +129,10 @@ def _publish(info: dict, onnx_path: Path, model_id: str, out: Path) -> None:
                         "styles": info["styles"], "bytes": info["bytes"], "file": info["file"]})
 
 
-def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | None, weights: str = "int8") -> Path:
-    """Writes out/<model_id>.onnx (parity checked) and out/<model_id>.json (see _publish). Returns the ONNX path."""
+def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | None, weights: str = "int8",
+                       temperature: float = 0.2) -> Path:
+    """Writes out/<model_id>.onnx (parity checked) and out/<model_id>.json (see _publish). Returns the ONNX path.
+    `temperature`: a Gaussian head's sampling temperature, kept in the JSON for the page and the evaluation."""
     model, meta, state = load_dance_model(checkpoint)
     out.mkdir(parents=True, exist_ok=True)
     onnx_path = out / f"{model_id}.onnx"
@@ -131,8 +142,11 @@ def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | 
     info = {
         "id": model_id, "kind": "aclstm", "fps": meta["fps"], "file": onnx_path.name,
         "description": ("Vanilla 3-layer LSTM trained with teacher forcing only (the acLSTM paper's baseline)" if vanilla else
-                        "Auto-conditioned LSTM (Zhou et al.), u = v = 5") + ", one model for salsa, Indian and martial-arts dance.",
+                        "Auto-conditioned LSTM (Zhou et al.), u = v = 5")
+                       + (f", Gaussian output head drawn at temperature {temperature:g} and fed back" if model.head == "gauss" else "")
+                       + ", one model for salsa, Indian and martial-arts dance.",
         "training_scheme": "teacher-forced" if vanilla else "auto-conditioned",
+        **({"temperature": temperature} if model.head == "gauss" else {}),
         "styles": meta["styles"],
         "skeleton": meta["skeleton"],
         "features": {"dim": meta["dim"], "seed_frames": SEED_FRAMES,

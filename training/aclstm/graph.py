@@ -4,6 +4,9 @@
 
 An ONNX Loop runs `steps` steps; each step's output frame is the next step's input, as the page's dance loop
 feeds it back, so one call replaces `steps` calls (steps = 1 is the plain one-step call, used for the seed frames).
+A model with the Gaussian head (DanceLSTM head="gauss") takes two more inputs, noise (≥ steps, B, D) standard
+normals and temperature (1,), and each step's frame is its draw mu + temperature · sigma · noise[step]: the caller
+supplies the random numbers, so a seeded caller gets the same frames in any runtime.
 Each LSTM layer is written at gate level (two Gemms, one Sigmoid over i, o, f, one Tanh over g); the style's share
 of the first layer's input product and both biases are one Gemm before the loop, as the style is fixed for a call.
 The batch dimension is dynamic. `dance_model_from_onnx` reads the network back from this graph or from the
@@ -18,14 +21,22 @@ import onnx
 import torch
 from onnx import TensorProto, helper
 
-from ..models.aclstm import DanceLSTM, DanceStep
+from ..models.aclstm import LOG_SIGMA_RANGE, DanceLSTM
 from ..onnx.compact import float_initializers
 from ..onnx.graph import OPSET, GraphBuilder
 from ..onnx.lstm import lstm_node_weights, onnx_gates_to_torch, torch_gates_to_onnx
 from ..onnx.sessions import cpu_session
 
 INPUTS, OUTPUTS = ["x", "style", "h", "c", "steps"], ["ys", "h_out", "c_out"]
+GAUSS_INPUTS = INPUTS + ["noise", "temperature"]
 PARITY_TOLERANCE = 1e-4
+
+
+def graph_inputs(model: DanceLSTM) -> list[str]:
+    return GAUSS_INPUTS if model.head == "gauss" else INPUTS
+
+
+
 def dance_graph(model: DanceLSTM) -> onnx.ModelProto:
     """The Loop graph of the module docstring for a trained DanceLSTM. Initialisers are named
     `lstm{l}.w_ih_t` (the first layer's: `lstm0.w_x_t` and `lstm0.w_style_t`), `lstm{l}.w_hh_t`, `lstm{l}.bias`
@@ -57,7 +68,16 @@ def dance_graph(model: DanceLSTM) -> onnx.ModelProto:
         g = body.node("Tanh", [t_in], [f"g{l}"])
         c2 = body.node("Add", [body.node("Mul", [f, c_in[l]], [f"f_c{l}"]), body.node("Mul", [i, g], [f"i_g{l}"])], [f"c{l}_out"])
         inp = body.node("Mul", [o, body.node("Tanh", [c2], [f"tanh_c{l}"])], [f"h{l}_out"])
-    body.node("Gemm", [inp, w_out, b_out], ["x_out"])
+    if model.head == "gauss":
+        out = body.node("Gemm", [inp, w_out, b_out], ["mu_log_sigma"])
+        mu, log_sigma = body.node("Split", [out, const("mu_sigma_split", np.array([D, D], np.int64))], ["mu", "log_sigma_raw"], axis=1)
+        lo, hi = (const(n, np.array(v, np.float32)) for n, v in (("log_sigma_min", LOG_SIGMA_RANGE[0]), ("log_sigma_max", LOG_SIGMA_RANGE[1])))
+        sigma = body.node("Exp", [body.node("Clip", [log_sigma, lo, hi], ["log_sigma"])], ["sigma"])
+        step_noise = body.node("Gather", ["noise", body.node("Squeeze", ["iteration"], ["step_index"])], ["step_noise"], axis=0)
+        spread = body.node("Mul", [body.node("Mul", [sigma, "temperature"], ["scaled_sigma"]), step_noise], ["spread"])
+        body.node("Add", [mu, spread], ["x_out"])
+    else:
+        body.node("Gemm", [inp, w_out, b_out], ["x_out"])
     body.node("Identity", ["x_out"], ["frame"])
     body.node("Identity", ["cond_in"], ["cond_out"])
     f32 = lambda n, shape: helper.make_tensor_value_info(n, TensorProto.FLOAT, shape)
@@ -83,6 +103,8 @@ def dance_graph(model: DanceLSTM) -> onnx.ModelProto:
 
     inputs = [f32("x", ["batch", D]), f32("style", ["batch", S]), f32("h", [L, "batch", H]), f32("c", [L, "batch", H]),
               helper.make_tensor_value_info("steps", TensorProto.INT64, [1])]
+    if model.head == "gauss":
+        inputs += [f32("noise", ["noise_steps", "batch", D]), f32("temperature", [1])]
     outputs = [f32("ys", ["steps", "batch", D]), f32("h_out", [L, "batch", H]), f32("c_out", [L, "batch", H])]
     graph = helper.make_graph(outer.nodes, "dance_steps", inputs, outputs, outer.inits)
     onnx_model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", OPSET)], producer_name="training.aclstm.export")
@@ -96,7 +118,8 @@ def dance_model_from_onnx(path: Path, dim: int, styles: int, hidden: int, layers
     Weights stored in lower precision come back as the float32 values the graph computes with."""
     graph_model = onnx.load(str(path))
     w = float_initializers(graph_model)
-    model = DanceLSTM(dim, styles, hidden, layers)
+    gauss = any(i.name == "noise" for i in graph_model.graph.input)
+    model = DanceLSTM(dim, styles, hidden, layers, "gauss" if gauss else "mean")
     to_torch = lambda a: onnx_gates_to_torch(a, hidden)
     sd: dict[str, np.ndarray] = {}
     lstm_nodes = [n for n in graph_model.graph.node if n.op_type == "LSTM"]
@@ -117,28 +140,32 @@ def dance_model_from_onnx(path: Path, dim: int, styles: int, hidden: int, layers
     return model.eval()
 
 
-def check_parity(model: DanceLSTM, path: Path, steps: int = 20) -> dict:
+def check_parity(model: DanceLSTM, path: Path, steps: int = 20, temperature: float = 0.5) -> dict:
     """torch (the one-step module, outputs fed back) against onnxruntime's Loop, at batch 1 and 5, in one call of
-    `steps` steps and in calls of 1 step."""
+    `steps` steps and in calls of 1 step; a Gaussian head with the same normals and `temperature` in both."""
     session = cpu_session(path)
-    step = DanceStep(model).eval()
     rng = np.random.default_rng(1)
     worst = 0.0
+    gauss = model.head == "gauss"
     for batch in (1, 5):
         x = rng.normal(size=(batch, model.dim)).astype(np.float32)
         style = np.eye(model.styles, dtype=np.float32)[rng.integers(0, model.styles, batch)]
         h, c = (rng.normal(scale=0.3, size=(model.layers, batch, model.hidden)).astype(np.float32) for _ in range(2))
+        noise = rng.normal(size=(steps, batch, model.dim)).astype(np.float32)
+        extra = lambda n: {"noise": noise[:n], "temperature": np.array([temperature], np.float32)} if gauss else {}
         ref, state = [], (h, c)
         xt = x
-        for _ in range(steps):
+        for t in range(steps):
             with torch.no_grad():
-                y, h2, c2 = (t.numpy() for t in step(*(torch.from_numpy(a) for a in (xt, style, *state))))
-            ref.append(y)
-            xt, state = y, (h2, c2)
-        ys, h_out, c_out = session.run(OUTPUTS, {"x": x, "style": style, "h": h, "c": c, "steps": np.array([steps], np.int64)})
+                mu, log_sigma, (h2, c2) = model.distribution(torch.from_numpy(xt)[:, None], torch.from_numpy(style),
+                                                             tuple(torch.from_numpy(a) for a in state))
+                y = mu[:, 0] if log_sigma is None else mu[:, 0] + temperature * torch.exp(log_sigma[:, 0]) * torch.from_numpy(noise[t])
+            ref.append(y.numpy())
+            xt, state = y.numpy(), (h2.numpy(), c2.numpy())
+        ys, h_out, c_out = session.run(OUTPUTS, {"x": x, "style": style, "h": h, "c": c, "steps": np.array([steps], np.int64), **extra(steps)})
         worst = max(worst, float(np.abs(np.stack(ref) - ys).max()), float(np.abs(state[0] - h_out).max()),
                     float(np.abs(state[1] - c_out).max()))
-        y1, _, _ = session.run(OUTPUTS, {"x": x, "style": style, "h": h, "c": c, "steps": np.array([1], np.int64)})
+        y1, _, _ = session.run(OUTPUTS, {"x": x, "style": style, "h": h, "c": c, "steps": np.array([1], np.int64), **extra(1)})
         worst = max(worst, float(np.abs(ref[0] - y1[0]).max()))
     if worst > PARITY_TOLERANCE:
         raise SystemExit(f"error: ONNX parity failed, max |torch - onnxruntime| = {worst:.2e} > {PARITY_TOLERANCE:.0e}")

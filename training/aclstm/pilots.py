@@ -20,10 +20,11 @@ from .freeze_rule import judge, real_reference
 from .report import BONE_ERROR_LIMIT, HEIGHT_BAND, per_second
 
 
-def rollout(model, meta: dict, seed_frames: np.ndarray, styles: list[str], frames: int, feedback_noise: float = 0.0) -> np.ndarray:
+def rollout(model, meta: dict, seed_frames: np.ndarray, styles: list[str], frames: int, feedback_noise: float = 0.0,
+            temperature: float = 1.0) -> np.ndarray:
     """Warm up on the seeds (batch, seed, dim; physical units), then feed outputs back (plus white noise of
     `feedback_noise`, normalised units, seeded): (batch, frames, dim). A Gaussian head's outputs are draws
-    (seeded), fed back and returned."""
+    (seeded, σ scaled by `temperature`), fed back and returned."""
     mean, std = np.array(meta["mean"], np.float32), np.array(meta["std"], np.float32)
     style = torch.eye(len(meta["styles"]))[[meta["styles"].index(s) for s in styles]]
     x = torch.from_numpy(((seed_frames - mean) / std).astype(np.float32))
@@ -31,24 +32,25 @@ def rollout(model, meta: dict, seed_frames: np.ndarray, styles: list[str], frame
     with torch.no_grad():
         noise = torch.Generator().manual_seed(0)
         draws = torch.Generator().manual_seed(1)
-        y, state = model(x, style, sample=True, generator=draws)
+        y, state = model(x, style, sample=True, generator=draws, temperature=temperature)
         y = y[:, -1:]
         for t in range(frames):
             out[:, t] = y[:, 0].numpy()
             fed = y + feedback_noise * torch.randn(y.shape, generator=noise) if feedback_noise else y
-            y, state = model(fed, style, state, sample=True, generator=draws)
+            y, state = model(fed, style, state, sample=True, generator=draws, temperature=temperature)
     return out * std + mean
 
 
 def measure_run(checkpoint: Path, frames: int = 3000, seeds_per_style: int = 3, mocap: str | None = None,
-                feedback_noise: float = 0.0) -> dict:
-    """The pilot measure of one checkpoint: per style and seed the freeze-rule numbers; validation from the run."""
+                feedback_noise: float = 0.0, temperature: float = 1.0) -> dict:
+    """The pilot measure of one checkpoint (a Gaussian head's draws with σ × `temperature`): per style and seed the freeze-rule numbers; validation from the run."""
     skel, clips = load_clips(mocap)
     model, meta, state = load_dance_model(checkpoint)
     ref = real_reference(clips)
+    real_jitter = real_jitter_cm(clips)
     chosen = [s for style in STYLES for s in [x for x in pick_seeds(clips) if x["style"] == style][:seeds_per_style]]
     feats = rollout(model, meta, np.array([s["frames"] for s in chosen], np.float32), [s["style"] for s in chosen], frames,
-                    feedback_noise)
+                    feedback_noise, temperature)
     runs = []
     for seed, f in zip(chosen, feats):
         finite = bool(np.isfinite(f).all())
@@ -58,7 +60,8 @@ def measure_run(checkpoint: Path, frames: int = 3000, seeds_per_style: int = 3, 
         height = pos[:, 0, 1]
         diverged = (not finite or float(limb.max()) > BONE_ERROR_LIMIT
                     or not (HEIGHT_BAND[0] <= height.min() and height.max() <= HEIGHT_BAND[1]))
-        runs.append({"style": seed["style"], "seed": seed["name"], "diverged": diverged, **judge(curve, ref[seed["style"]])})
+        runs.append({"style": seed["style"], "seed": seed["name"], "diverged": diverged,
+                     "jitter_vs_real": jitter_cm(pos) / real_jitter[seed["style"]], **judge(curve, ref[seed["style"]])})
     per_style = {}
     for style in STYLES:
         mine = [r for r in runs if r["style"] == style]
@@ -66,10 +69,11 @@ def measure_run(checkpoint: Path, frames: int = 3000, seeds_per_style: int = 3, 
                             "low_share_worst": max(r["low_share"] for r in mine),
                             "longest_low_s_worst": max(r["longest_low_s"] for r in mine),
                             "median_ratio_worst": min(r["median_ratio"] for r in mine),
+                            "jitter_vs_real": [min(r["jitter_vs_real"] for r in mine), max(r["jitter_vs_real"] for r in mine)],
                             "diverged": sum(r["diverged"] for r in mine)}
     valid = state.get("valid") or (state.get("history") or [{}])[-1].get("valid") or {}  # best.pt, else the last epoch
     return {"checkpoint": str(checkpoint), "iteration": state.get("iteration"), "frames": frames, "args": meta.get("args", {}),
-            "rollout_feedback_noise": feedback_noise,
+            "rollout_feedback_noise": feedback_noise, "rollout_temperature": temperature,
             "valid": {s: valid.get(s) for s in STYLES} if valid else None, "real": ref, "per_style": per_style,
             "passes": sum(p["passes"] for p in per_style.values()), "runs": len(runs), "details": runs}
 
@@ -115,7 +119,10 @@ def pilot_markdown(table: dict, sweeps: dict | None = None) -> str:
              "pose change; a run passes when (a) its share of low seconds is at most twice the real clips' share, (b) no low "
              "stretch lasts 5 s or more, and (c) its median is at least 50% of the real median. Each style's cell gives the "
              "passes and, over its seeds, the worst low share, the longest low stretch and the lowest median (share of real). "
-             "Rows marked *+noise σ* are rolled out with white noise σ (normalised units) on each fed-back frame.",
+             "Rows marked *+noise σ* are rolled out with white noise σ (normalised units) on each fed-back frame; rows "
+             "marked *temperature τ* draw a Gaussian head's frames with its σ × τ. *jitter* (where measured) is the mean "
+             "second difference of the joints relative to the root against the real clips' (a shaking dancer also passes "
+             "(a)–(c)).",
              "",
              "Real held-out clips, measured the same way (each clip alone): "
              + "; ".join(f"{s} median {r['median']:.3f} m/s, low share {r['low_share']:.1%}, longest low stretch "
@@ -127,13 +134,20 @@ def pilot_markdown(table: dict, sweeps: dict | None = None) -> str:
         for style in STYLES:
             p = m["per_style"][style]
             cells.append(f"{p['passes']}/{p['runs']}: {p['low_share_worst']:.0%} low, {p['longest_low_s_worst']} s, "
-                         f"median {p['median_ratio_worst']:.0%}" + (f", {p['diverged']} diverged" if p["diverged"] else ""))
+                         f"median {p['median_ratio_worst']:.0%}" + (f", {p['diverged']} diverged" if p["diverged"] else "")
+                         + (f", jitter {p['jitter_vs_real'][0]:.1f}–{p['jitter_vs_real'][1]:.1f}×" if "jitter_vs_real" in p else ""))
         valid = "/".join(f"{m['valid'][s]['auto_conditioned']:.3f}" for s in STYLES) if m.get("valid") else "—"
         minutes = m.get("summary", {}).get("minutes")
         lines.append(f"| {name} | {recipe(m.get('args', {}))} | {m['iteration']} | "
                      f"{'—' if minutes is None else f'{minutes:.0f}'} | " + " | ".join(cells) + f" | {valid} |")
     lines += feedback_markdown(sweeps or {})
     return "\n".join(lines) + "\n"
+
+
+def real_jitter_cm(clips) -> dict:
+    """Each style's mean jitter_cm over its held-out clips, each clip alone, at the model's rate."""
+    return {s: float(np.mean([jitter_cm(resample_positions(c.positions, c.fps, 0.0, int(c.seconds * MODEL_FPS) - 1))
+                              for c in clips if c.style == s and c.held_out])) for s in STYLES}
 
 
 def jitter_cm(pos: np.ndarray) -> float:
@@ -152,8 +166,7 @@ def feedback_noise_runs(models_dir: Path, model_id: str, frames: int, sigma: flo
 
     skel, clips = load_clips(mocap)
     ref = real_reference(clips)
-    real_jitter = {s: float(np.mean([jitter_cm(resample_positions(c.positions, c.fps, 0.0, int(c.seconds * MODEL_FPS) - 1))
-                                     for c in clips if c.style == s and c.held_out])) for s in STYLES}
+    real_jitter = real_jitter_cm(clips)
     model = ShippedDance(models_dir, model_id)
     chosen = [(style, seed) for style in STYLES for seed in model.seeds_of(style)[:seeds_per_style]]
     feats = model.generate(np.array([s["frames"] for _, s in chosen], np.float32), [style for style, _ in chosen], frames,

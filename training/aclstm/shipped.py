@@ -20,16 +20,25 @@ class ShippedDance:
         self.std = np.array(self.info["normalisation"]["std"], np.float32)
         self.styles = self.info["styles"]
         self.layers, self.hidden = self.info["onnx"]["layers"], self.info["onnx"]["hidden"]
+        # A Gaussian head draws each frame from normals the caller passes (graph.py); its default temperature is the JSON's.
+        self.gauss = "noise" in self.info["onnx"]["inputs"]
+        self.temperature = float(self.info.get("temperature", 0.0))
+        self.draws, self.temperature_now = np.random.default_rng(0), self.temperature
 
     def seeds_of(self, style: str) -> list[dict]:
         return [s for s in self.info["seeds"] if s["style"] == style]
 
     def generate(self, seed_frames: np.ndarray, styles: list[str], frames: int, progress: bool = False,
-                 feedback_noise: float = 0.0, rho: float = 0.0, pose_only: bool = False, seed: int = 0) -> np.ndarray:
+                 feedback_noise: float = 0.0, rho: float = 0.0, pose_only: bool = False, seed: int = 0,
+                 temperature: float | None = None) -> np.ndarray:
         """Warm up on seed_frames (batch, seed, dim; physical units), then feed outputs back for `frames` steps.
         Returns the generated features (batch, frames, dim) in physical units. `feedback_noise`: Gaussian noise
         (normalised units, AR(1) with coefficient `rho`, seeded by `seed`) added to what the network reads back,
-        on every channel or, with `pose_only`, not the root's three; the outputs stay its own predictions."""
+        on every channel or, with `pose_only`, not the root's three; the outputs stay its own predictions.
+        A Gaussian head draws its frames at `temperature` (default the JSON's; 0 gives the mean), from normals
+        seeded by `seed`."""
+        self.draws = np.random.default_rng(seed)
+        self.temperature_now = self.temperature if temperature is None else temperature
         b = len(seed_frames)
         style = np.eye(len(self.styles), dtype=np.float32)[[self.styles.index(s) for s in styles]]
         h = np.zeros((self.layers, b, self.hidden), np.float32)
@@ -64,4 +73,8 @@ class ShippedDance:
 
     def run_steps(self, x, style, h, c, steps: int):
         """One session call: `steps` steps from x; returns ys (steps, batch, dim), h, c."""
-        return self.session.run(None, {"x": x, "style": style, "h": h, "c": c, "steps": np.array([steps], np.int64)})
+        feeds = {"x": x, "style": style, "h": h, "c": c, "steps": np.array([steps], np.int64)}
+        if self.gauss:
+            feeds["noise"] = self.draws.standard_normal((steps, *x.shape)).astype(np.float32)
+            feeds["temperature"] = np.array([self.temperature_now], np.float32)
+        return self.session.run(None, feeds)

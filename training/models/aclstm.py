@@ -40,12 +40,13 @@ class DanceLSTM(nn.Module):
         return mu, log_sigma.clamp(*LOG_SIGMA_RANGE), state
 
     def forward(self, x: torch.Tensor, style: torch.Tensor, state=None, sample: bool = False,
-                generator: torch.Generator | None = None):
+                generator: torch.Generator | None = None, temperature: float = 1.0):
         """x (batch, time, dim), style (batch, styles) -> next frames (batch, time, dim), (h, c): the mean, or
-        with `sample` a draw from the Gaussian head (the mean head has nothing to draw)."""
+        with `sample` a draw from the Gaussian head with its σ scaled by `temperature` (the mean head has
+        nothing to draw)."""
         mu, log_sigma, state = self.distribution(x, style, state)
         if sample and log_sigma is not None:
-            mu = mu + torch.exp(log_sigma) * torch.randn(mu.shape, generator=generator)
+            mu = mu + temperature * torch.exp(log_sigma) * torch.randn(mu.shape, generator=generator)
         return mu, state
 
     def auto_conditioned(self, x: torch.Tensor, style: torch.Tensor, ground_truth: int, condition: int,
