@@ -71,6 +71,28 @@ def test_dance_graph_parity_and_read_back(tmp_path, fmt):
     assert (a - b).abs().max() < {"float32": 1e-6, "float16": 1e-2, "int8": 5e-2}[fmt]
 
 
+def test_gaussian_head_dance_graph_draws_from_the_given_normals(tmp_path):
+    """The Gaussian head's Loop graph: parity with torch on the same normals, read back with its head, and a draw at
+    temperature 0 is the mean while the normals move a draw at temperature 1."""
+    torch.manual_seed(4)
+    model = DanceLSTM(9, 3, hidden=32, layers=2, head="gauss").eval()
+    path = tmp_path / "gauss.onnx"
+    stored = export_onnx(model, path, "float32")
+    assert check_parity(stored, path)["max_abs_diff"] < 1e-4
+    assert dance_model_from_onnx(path, 9, 3, 32, 2).head == "gauss"
+    session = cpu_session(path)
+    x, style = np.zeros((1, 9), np.float32), np.eye(3, dtype=np.float32)[:1]
+    h = np.zeros((2, 1, 32), np.float32)
+    run = lambda noise, t: session.run(["ys"], {"x": x, "style": style, "h": h, "c": h, "steps": np.array([1], np.int64),
+                                                "noise": noise, "temperature": np.array([t], np.float32)})[0][0]
+    zeros, ones = np.zeros((1, 1, 9), np.float32), np.ones((1, 1, 9), np.float32)
+    with torch.no_grad():
+        mean = model.distribution(torch.from_numpy(x)[:, None], torch.from_numpy(style))[0][:, 0].numpy()
+    assert np.abs(run(ones, 0.0) - mean).max() < 1e-5
+    assert np.abs(run(zeros, 1.0) - mean).max() < 1e-5
+    assert (run(ones, 1.0) > mean).all()
+
+
 def test_dance_model_reads_back_from_the_earlier_one_step_export(tmp_path):
     """The torch export with ONNX LSTM nodes (the files shipped before the Loop graph) reads back exactly."""
     torch.manual_seed(3)
