@@ -125,16 +125,33 @@ def vae_prediction(vae: ShippedVae, corpus: WindowCorpus, w: Window, prior: tupl
     return positions[INITIAL_FRAMES:]
 
 
+def still_mean_pose(vae: ShippedVae, corpus: WindowCorpus, w: Window) -> np.ndarray:
+    """World positions of the window's predicted frames for the training clips' mean pose held still, its root moved
+    by the window's control like the VAE-LSTM's: the long-horizon baseline of motion prediction (once the stride's
+    phase is lost, an average error scores a body that barely moves well)."""
+    c = corpus.valid_clips[w.clip]
+    begin = w.start + SEED_FRAMES - INITIAL_FRAMES
+    frames = INITIAL_FRAMES + PREDICT_FRAMES
+    rows = np.tile(corpus.mean, (frames, 1))
+    rows[:, CONTROL_SLICE] = c.rows[begin:begin + frames, CONTROL_SLICE]
+    xz, heading = ground_frame(c.positions)
+    return rows_to_world(rows, vae.fps, xz[begin], float(heading[begin]))[INITIAL_FRAMES:]
+
+
 def prediction_rows(vae: ShippedVae, corpus: WindowCorpus, windows: list[Window], samplings: dict[str, dict]) -> dict:
-    """Rows of the tables: from 4 initial frames (Algorithm 1 from the posterior's z1), and from prior samples
-    drawn each way in `samplings` (name: sampling)."""
+    """Rows of the tables: from 4 initial frames (Algorithm 1 from the posterior's z1), from prior samples drawn
+    each way in `samplings` (name: sampling), and the still mean pose."""
     real = [corpus.valid_clips[w.clip].positions[w.start + SEED_FRAMES: w.start + SEED_FRAMES + PREDICT_FRAMES] for w in windows]
     frames = INITIAL_FRAMES + PREDICT_FRAMES
     out = {"VAE-LSTM, 4 initial frames": prediction_errors([vae_prediction(vae, corpus, w, None) for w in windows], real)}
     for name, sampling in samplings.items():
         made = [vae_prediction(vae, corpus, w, vae.prior(i, frames, sampling)) for i, w in enumerate(windows)]
         out[f"VAE-LSTM, prior sample ({name})"] = prediction_errors(made, real)
+    out[STILL_MEAN_POSE] = prediction_errors([still_mean_pose(vae, corpus, w) for w in windows], real)
     return out
+
+
+STILL_MEAN_POSE = "mean pose held still (root moved by the control)"
 
 
 # ---- long runs and seams --------------------------------------------------------------------------

@@ -11,7 +11,7 @@ import numpy as np
 
 from .. import metrics
 from ..data.locomotion import load_clips
-from ..data.windows import WindowCorpus
+from ..data.windows import CONTROL_SLICE, WindowCorpus
 from ..latent_erd import measures as erd_measures
 from ..paths import MODELS_DIR, REPO_ROOT, REPORTS_DIR
 from . import measures as m
@@ -98,7 +98,7 @@ def prediction_table(pred: dict, kind: str) -> list[str]:
     horizons = m.HORIZONS
     out = [_row(["model", "initial frames", "control signal", *[f"frame {h}" for h in horizons]]), _row(["---"] * (3 + len(horizons)))]
     seeds = {"VAE-LSTM, 4 initial frames": "4", "latent ERD": "16", "pose-space ERD": "16", "generator (free-running)": "16",
-             "generator + MAP optimiser, true root path": "its seed states"}
+             "generator + MAP optimiser, true root path": "its seed states", m.STILL_MEAN_POSE: "0"}
     for name, row in pred["rows"].items():
         control = "no" if name.startswith("generator (") else "the root path" if "MAP" in name else "yes"
         out.append(_row([name, seeds.get(name, "0" if "prior" in name else "?"), control, *[row[kind].get(h, row[kind].get(str(h))) for h in horizons]]))
@@ -152,7 +152,7 @@ def write_markdown(r: dict, notes: dict, path: Path) -> None:
               _row(["---"] * 7)]
     for w in d["windows"]:
         lines.append(_row([w["clip"], w["start"], w["forward"], w["turn"], w["prior_samples_cm"], w["real_similar_cm"], w["real_similar_windows"]]))
-    lines += [""] + notes.get("diversity", [])
+    lines += ["", f"![prior samples beside the real window]({VARIATIONS_PNG})", ""] + notes.get("diversity", [])
     lines += ["", "### Ways of drawing a prior sample", "",
               "The same measures for each way of drawing a prior sample (generation.py): one z1 and the cell on its own state "
               "(Algorithm 1), or a latent per step in teacher mode (the paper's other way), independent (rho 0) or correlated "
@@ -197,6 +197,41 @@ def write_markdown(r: dict, notes: dict, path: Path) -> None:
     path.write_text("\n".join(lines) + "\n")
 
 
+VARIATIONS_PNG = "vae-lstm-variations.png"
+VARIATION_JOINTS = ("RightHand", "RightToeBase")
+
+
+def variations_figure(models_dir: Path, mocap: str | None, path: Path, samples: int = 4) -> None:
+    """Prior samples for one held-out window's control beside the real window: the right hand's and right toe's
+    height and forward offset from the hips (facing frame) over the 4 s, so the variations are seen, not only counted."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from ..data.windows import JOINTS
+
+    corpus = WindowCorpus(load_clips(mocap))
+    vae = m.ShippedVae.load(models_dir)
+    window = vae.info["window"]
+    clip = corpus.valid_clips[0]
+    real = clip.rows[:window]
+    control = real[:, CONTROL_SLICE]
+    motions = [m.local_positions(vae.rows(control, *vae.prior(1000 + k, window))) for k in range(samples)]
+    t = np.arange(window) / vae.fps
+    fig, axes = plt.subplots(1, 2 * len(VARIATION_JOINTS), figsize=(16, 3.4))
+    for col, (name, axis, label) in enumerate((n, a, lab) for n in VARIATION_JOINTS for a, lab in ((1, "height"), (2, "forward"))):
+        j = JOINTS.index(name)
+        ax = axes[col]
+        for k, mo in enumerate(motions):
+            ax.plot(t, mo[:, j, axis], lw=1, color=f"C{k}", label=f"prior sample {k + 1}")
+        ax.plot(t, m.local_positions(real)[:, j, axis], lw=2, color="k", ls="--", label="real window")
+        ax.set(title=f"{name}: {label} from the hips (m)", xlabel="s")
+    axes[0].legend(fontsize=7)
+    fig.suptitle(f"VAE-LSTM prior samples (one z1 each) for the control of {Path(clip.file).name}, first 4 s", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+
+
 def write_report(mocap: str | None, models_dir: Path = MODELS_DIR, out_dir: Path = REPORTS_DIR) -> dict:
     """Measures the export in `models_dir` and writes vae-lstm.{md,json} into `out_dir` (the training rows kept from
     the JSON already there, else from docs/models/vae-lstm.json)."""
@@ -206,5 +241,6 @@ def write_report(mocap: str | None, models_dir: Path = MODELS_DIR, out_dir: Path
     report = evaluate(mocap, previous, models_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / REPORT_JSON.name).write_text(json.dumps(report, indent=1) + "\n")
+    variations_figure(models_dir, mocap, out_dir / VARIATIONS_PNG)
     write_markdown(report, notes, out_dir / "vae-lstm.md")
     return report
