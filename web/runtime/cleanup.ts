@@ -187,7 +187,7 @@ export function mapCleaner(args: { step: StepFn; info: GeneratorInfo; mean: Arra
  * its own motion above the band and the data's below it: cleaned − slow(cleaned) + slow(data), a complementary
  * filter. Feet are pinned after this, on the sum.
  */
-export const SLOW_BAND_HZ = 2;
+export const SLOW_BAND_HZ = 4;
 
 /**
  * Bone lengths (and the offsets of joints riding on a canonical segment) are measured on the capture low-passed at
