@@ -6,12 +6,13 @@ is below 20% of the real median for the style. A run passes when
   (b) no stretch of 5 s or more is low, and
   (c) its median per-second pose change is at least 50% of the real median (a low-energy collapse fails).
 Real dancers pause too, so the real clips' own share and longest low stretch are given beside every verdict.
+A dancer that shakes also passes, so the reports give each run's jitter against the real clips' beside the verdict.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ..data.dance import STYLES, DanceClip, held_out_pose_change
+from ..data.dance import MODEL_FPS, STYLES, DanceClip, held_out_pose_change, resample_positions
 
 LOW_FRACTION = 0.2      # of the real median: a "low" second
 SHARE_FACTOR = 2.0      # (a) at most this many times the real share of low seconds
@@ -48,3 +49,15 @@ def judge(curve: np.ndarray, ref: dict) -> dict:
     verdict = {"a": share <= SHARE_FACTOR * ref["low_share"], "b": longest < LONGEST_LOW_S, "c": ratio >= MEDIAN_FRACTION}
     return {"low_share": share, "longest_low_s": longest, "median_ratio": ratio, **{f"pass_{k}": v for k, v in verdict.items()},
             "passes": all(verdict.values())}
+
+
+def real_jitter_cm(clips) -> dict:
+    """Each style's mean jitter_cm over its held-out clips, each clip alone, at the model's rate."""
+    return {s: float(np.mean([jitter_cm(resample_positions(c.positions, c.fps, 0.0, int(c.seconds * MODEL_FPS) - 1))
+                              for c in clips if c.style == s and c.held_out])) for s in STYLES}
+
+
+def jitter_cm(pos: np.ndarray) -> float:
+    """Mean |second difference| of the joints relative to the root (cm per frame²): frame-to-frame shake."""
+    local = pos - pos[:, :1]
+    return float(np.linalg.norm(np.diff(local, 2, axis=0), axis=-1).mean() * 100)

@@ -14,9 +14,9 @@ import numpy as np
 import torch
 
 from .. import metrics
-from ..data.dance import LIMB_MIN_LENGTH, MODEL_FPS, STYLES, bone_length_error, decode, load_clips, resample_positions
+from ..data.dance import LIMB_MIN_LENGTH, MODEL_FPS, STYLES, bone_length_error, decode, load_clips
 from .exporting import load_dance_model, pick_seeds
-from .freeze_rule import judge, real_reference
+from .freeze_rule import jitter_cm, judge, real_jitter_cm, real_reference
 from .report import BONE_ERROR_LIMIT, HEIGHT_BAND, per_second
 
 
@@ -142,18 +142,6 @@ def pilot_markdown(table: dict, sweeps: dict | None = None) -> str:
                      f"{'—' if minutes is None else f'{minutes:.0f}'} | " + " | ".join(cells) + f" | {valid} |")
     lines += feedback_markdown(sweeps or {})
     return "\n".join(lines) + "\n"
-
-
-def real_jitter_cm(clips) -> dict:
-    """Each style's mean jitter_cm over its held-out clips, each clip alone, at the model's rate."""
-    return {s: float(np.mean([jitter_cm(resample_positions(c.positions, c.fps, 0.0, int(c.seconds * MODEL_FPS) - 1))
-                              for c in clips if c.style == s and c.held_out])) for s in STYLES}
-
-
-def jitter_cm(pos: np.ndarray) -> float:
-    """Mean |second difference| of the joints relative to the root (cm per frame²): frame-to-frame shake."""
-    local = pos - pos[:, :1]
-    return float(np.linalg.norm(np.diff(local, 2, axis=0), axis=-1).mean() * 100)
 
 
 def feedback_noise_runs(models_dir: Path, model_id: str, frames: int, sigma: float, rho: float = 0.0,

@@ -22,7 +22,7 @@ from .. import metrics
 from ..data.dance import (LIMB_MIN_LENGTH, MODEL_FPS, STYLES, DanceClip, bone_length_error, decode, encode, load_clips,
                           real_pose_change, resample_positions)
 from ..paths import REPORTS_DIR
-from .freeze_rule import LONGEST_LOW_S, MEDIAN_FRACTION, SHARE_FACTOR, judge, real_reference
+from .freeze_rule import LONGEST_LOW_S, MEDIAN_FRACTION, SHARE_FACTOR, jitter_cm, judge, real_jitter_cm, real_reference
 from .shipped import ShippedDance
 
 FREEZE_FRACTION = 0.2
@@ -48,7 +48,8 @@ def per_second(values: np.ndarray, fps: float) -> np.ndarray:
     return values[: len(values) // step * step].reshape(-1, step).mean(axis=1)
 
 
-def long_runs(model: ShippedDance, skel, frames: int, n_seeds: int, real_change: dict, real_ref: dict) -> list[dict]:
+def long_runs(model: ShippedDance, skel, frames: int, n_seeds: int, real_change: dict, real_ref: dict,
+              real_jitter: dict) -> list[dict]:
     chosen = [(style, s) for style in STYLES for s in model.seeds_of(style)[:n_seeds]]
     seeds = np.array([s["frames"] for _, s in chosen], np.float32)
     feats = model.generate(seeds, [style for style, _ in chosen], frames, progress=True)
@@ -69,6 +70,7 @@ def long_runs(model: ShippedDance, skel, frames: int, n_seeds: int, real_change:
                "bone_error_max_second": float(bone.max()), "bone_error_mean": float(bone.mean()),
                "all_bones_error_mean": float(all_bones.mean()),
                "root_height_min": float(height.min()), "root_height_max": float(height.max()),
+               "jitter_vs_real": jitter_cm(pos) / real_jitter[style],
                "pose_change_curve": change.round(4).tolist()}
         run["rule"] = judge(change, real_ref[style])  # the fairer freeze rule (freeze_rule.py)
         run["frozen"] = run["frozen_seconds"] > 0
@@ -116,7 +118,8 @@ def evaluate_dance(models_dir: Path, frames: int, n_seeds: int, mocap: str | Non
     skel, clips = load_clips(mocap)
     real_change = real_pose_change(clips)
     real_ref = real_reference(clips)
-    report = {"real_reference": real_ref, "frames_per_seed": frames, "fps": MODEL_FPS, "seeds_per_style": n_seeds, "freeze_fraction": FREEZE_FRACTION,
+    real_jitter = real_jitter_cm(clips)
+    report = {"real_reference": real_ref, "real_jitter_cm": real_jitter, "frames_per_seed": frames, "fps": MODEL_FPS, "seeds_per_style": n_seeds, "freeze_fraction": FREEZE_FRACTION,
               "bone_error_limit": BONE_ERROR_LIMIT, "height_band": HEIGHT_BAND, "real_median_pose_change": real_change,
               "models": {}}
     candidates = [(label, models_dir / f"{model_id}.json") for label, model_id in MODELS.items()] + list(extra)
@@ -126,18 +129,21 @@ def evaluate_dance(models_dir: Path, frames: int, n_seeds: int, mocap: str | Non
             continue
         model_id = json_path.stem
         model = ShippedDance(json_path.parent, model_id)
-        runs = long_runs(model, skel, frames, n_seeds, real_change, real_ref)
+        runs = long_runs(model, skel, frames, n_seeds, real_change, real_ref, real_jitter)
         report["models"][label] = {
             "id": model_id, "file": model.info["file"], "bytes": model.info["bytes"], "fps": model.info["fps"],
             "shipped": json_path.parent.resolve() == models_dir.resolve(),
             "training": {k: model.info["training"][k] for k in ("iterations", "valid")},
             "scheme": model.info["training"]["args"],
-            "minutes": model.info["training"].get("minutes"),
+            "minutes": model.info["training"].get("minutes"), "temperature": model.info.get("temperature"),
             "runs": runs, "all_stable": all(r["stable"] for r in runs),
             "all_pass_rule": all(r["rule"]["passes"] and not r["diverged"] for r in runs),
             "prediction_error_cm": prediction_errors(model, clips),
         }
     return report
+
+
+NOTES = REPORTS_DIR / "aclstm-notes.json"
 
 
 def plot(report: dict) -> None:
@@ -172,8 +178,8 @@ def fair_rule_section(report: dict) -> list[str]:
              "the real median (a low-energy collapse fails), with no divergence. The real clips, each measured alone: "
              + "; ".join(f"{s}: low share {r['low_share']:.1%}, longest low stretch {r['longest_low_s']} s, over "
                          f"{r['seconds']} s" for s, r in ref.items()) + ".", "",
-             "| model | style | passes | low share per seed | longest low stretch (s) | median / real median |",
-             "|---|---|---|---|---|---|"]
+             "| model | style | passes | low share per seed | longest low stretch (s) | median / real median | jitter / real |",
+             "|---|---|---|---|---|---|---|"]
     for label, m in report["models"].items():
         for style in STYLES:
             rs = [r for r in m["runs"] if r["style"] == style]
@@ -181,7 +187,8 @@ def fair_rule_section(report: dict) -> list[str]:
             lines.append(f"| {label} | {style} | {passes}/{len(rs)} | "
                          + ", ".join(f"{r['rule']['low_share']:.1%}" for r in rs) + " | "
                          + ", ".join(str(r["rule"]["longest_low_s"]) for r in rs) + " | "
-                         + ", ".join(f"{r['rule']['median_ratio']:.0%}" for r in rs) + " |")
+                         + ", ".join(f"{r['rule']['median_ratio']:.0%}" for r in rs) + " | "
+                         + ", ".join(f"{r['jitter_vs_real']:.1f}×" for r in rs) + " |")
     if any("before int8" in label for label in report["models"]):
         lines += ["", "**Weights stored as int8** (issue 19, [weights.md](weights.md)): the shipped files store the weights as int8 "
                   "with a scale per output channel, computed in float32. The rows marked *float32 (before int8)* are the same "
@@ -282,6 +289,8 @@ def write_markdown(report: dict) -> None:
         v = m["training"]["valid"] or {}
         a = m["scheme"]
         scheme = f"u = {a['ground_truth']}, v = {a['condition']}" if a["condition"] else "teacher forcing"
+        if a.get("head") == "gauss":
+            scheme += f", Gaussian output head drawn at temperature {m.get('temperature')} and fed back"
         where = "shipped" if m["shipped"] else "not shipped"
         took = f" in {m['minutes']} minutes" if m["minutes"] else ""
         lines.append(f"- **{label}** (`{m['file']}`, {m['bytes'] / 1e6:.2f} MB, {where}): {scheme}, "
@@ -289,6 +298,10 @@ def write_markdown(report: dict) -> None:
                      "held-out loss (normalised units) teacher-forced / auto-conditioned: "
                      + ", ".join(f"{s} {v[s]['teacher_forced']:.3f} / {v[s]['auto_conditioned']:.3f}" for s in STYLES if s in v) + ".")
     lines.append("")
+    # Hand-written findings kept beside the measured sections (issue 18's ranking of what was tried).
+    if NOTES.exists():
+        for title, body in json.loads(NOTES.read_text()).items():
+            lines += [f"## {title}", "", *body, ""]
     (REPORTS_DIR / "aclstm.md").write_text("\n".join(lines))
 
 
