@@ -32,6 +32,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--model", default="aclstm", help="exported model id for --feedback-noise")
     parser.add_argument("--rollout-noise", type=float, default=0.0, help="white noise on each fed-back frame of a RUN's rollouts")
     parser.add_argument("--temperature", type=float, default=1.0, help="a Gaussian head's draws in the rollouts: its σ times this")
+    parser.add_argument("--draw-rho", type=float, default=0.0, help="a Gaussian head's draws from AR(1) normals with this coefficient (0: white)")
     args = parser.parse_args(argv)
     if not args.runs and not args.feedback_noise:
         parser.error("give RUN names or --feedback-noise")
@@ -50,11 +51,12 @@ def main(argv: list[str] | None = None) -> None:
               f"{w['passes']}/{len(w['runs'])} pass, {w['diverged']} diverged")
     for name in args.runs:
         run_dir = RUNS_DIR / name
-        m = measure_run(run_dir / f"{args.which}.pt", args.frames or 3000, args.seeds, args.mocap, args.rollout_noise, args.temperature)
+        m = measure_run(run_dir / f"{args.which}.pt", args.frames or 3000, args.seeds, args.mocap, args.rollout_noise, args.temperature, args.draw_rho)
         summary = json.loads((run_dir / "summary.json").read_text()) if (run_dir / "summary.json").exists() else {}
         m.pop("details")
         key = (f"{name}:{args.which}" + (f" +noise {args.rollout_noise:g}" if args.rollout_noise else "")
-               + (f" temperature {args.temperature:g}" if args.temperature != 1 else ""))
+               + (f" temperature {args.temperature:g}" if args.temperature != 1 else "")
+               + (f" draw rho {args.draw_rho:g}" if args.draw_rho else ""))
         table[key] = {**m, "summary": summary}
         mine.add(key)
         print(summary_line(key, m))

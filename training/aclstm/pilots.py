@@ -21,10 +21,11 @@ from .report import BONE_ERROR_LIMIT, HEIGHT_BAND, per_second
 
 
 def rollout(model, meta: dict, seed_frames: np.ndarray, styles: list[str], frames: int, feedback_noise: float = 0.0,
-            temperature: float = 1.0) -> np.ndarray:
+            temperature: float = 1.0, draw_rho: float = 0.0) -> np.ndarray:
     """Warm up on the seeds (batch, seed, dim; physical units), then feed outputs back (plus white noise of
     `feedback_noise`, normalised units, seeded): (batch, frames, dim). A Gaussian head's outputs are draws
-    (seeded, σ scaled by `temperature`), fed back and returned."""
+    (seeded, σ scaled by `temperature`), fed back and returned; with `draw_rho` their normals are AR(1) over the
+    frames (each still N(0, 1)), so the draws wander smoothly instead of shaking."""
     mean, std = np.array(meta["mean"], np.float32), np.array(meta["std"], np.float32)
     style = torch.eye(len(meta["styles"]))[[meta["styles"].index(s) for s in styles]]
     x = torch.from_numpy(((seed_frames - mean) / std).astype(np.float32))
@@ -34,15 +35,21 @@ def rollout(model, meta: dict, seed_frames: np.ndarray, styles: list[str], frame
         draws = torch.Generator().manual_seed(1)
         y, state = model(x, style, sample=True, generator=draws, temperature=temperature)
         y = y[:, -1:]
+        wander = torch.randn(y.shape, generator=draws)
         for t in range(frames):
             out[:, t] = y[:, 0].numpy()
             fed = y + feedback_noise * torch.randn(y.shape, generator=noise) if feedback_noise else y
-            y, state = model(fed, style, state, sample=True, generator=draws, temperature=temperature)
+            if draw_rho and model.head == "gauss":
+                wander = draw_rho * wander + np.sqrt(1 - draw_rho ** 2) * torch.randn(y.shape, generator=draws)
+                mu, log_sigma, state = model.distribution(fed, style, state)
+                y = mu + temperature * torch.exp(log_sigma) * wander
+            else:
+                y, state = model(fed, style, state, sample=True, generator=draws, temperature=temperature)
     return out * std + mean
 
 
 def measure_run(checkpoint: Path, frames: int = 3000, seeds_per_style: int = 3, mocap: str | None = None,
-                feedback_noise: float = 0.0, temperature: float = 1.0) -> dict:
+                feedback_noise: float = 0.0, temperature: float = 1.0, draw_rho: float = 0.0) -> dict:
     """The pilot measure of one checkpoint (a Gaussian head's draws with σ × `temperature`): per style and seed the freeze-rule numbers; validation from the run."""
     skel, clips = load_clips(mocap)
     model, meta, state = load_dance_model(checkpoint)
@@ -50,7 +57,7 @@ def measure_run(checkpoint: Path, frames: int = 3000, seeds_per_style: int = 3, 
     real_jitter = real_jitter_cm(clips)
     chosen = [s for style in STYLES for s in [x for x in pick_seeds(clips) if x["style"] == style][:seeds_per_style]]
     feats = rollout(model, meta, np.array([s["frames"] for s in chosen], np.float32), [s["style"] for s in chosen], frames,
-                    feedback_noise, temperature)
+                    feedback_noise, temperature, draw_rho)
     runs = []
     for seed, f in zip(chosen, feats):
         finite = bool(np.isfinite(f).all())
@@ -73,7 +80,7 @@ def measure_run(checkpoint: Path, frames: int = 3000, seeds_per_style: int = 3, 
                             "diverged": sum(r["diverged"] for r in mine)}
     valid = state.get("valid") or (state.get("history") or [{}])[-1].get("valid") or {}  # best.pt, else the last epoch
     return {"checkpoint": str(checkpoint), "iteration": state.get("iteration"), "frames": frames, "args": meta.get("args", {}),
-            "rollout_feedback_noise": feedback_noise, "rollout_temperature": temperature,
+            "rollout_feedback_noise": feedback_noise, "rollout_temperature": temperature, "rollout_draw_rho": draw_rho,
             "valid": {s: valid.get(s) for s in STYLES} if valid else None, "real": ref, "per_style": per_style,
             "passes": sum(p["passes"] for p in per_style.values()), "runs": len(runs), "details": runs}
 
