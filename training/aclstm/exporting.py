@@ -90,14 +90,19 @@ def write_reference_fixture(onnx_path: Path, info: dict) -> None:
     print(f"wrote {FIXTURE}")
 
 
-def training_minutes(checkpoint: Path, iteration: int | None) -> float | None:
-    """Training time (minutes) up to `iteration`, from the run's latest checkpoint history."""
+def training_history(checkpoint: Path, iteration: int | None) -> dict:
+    """The run's last history entry up to `iteration` (its minutes and validation), from its latest checkpoint."""
     latest = checkpoint.parent / "checkpoint.pt"
     if not latest.exists() or iteration is None:
-        return None
-    history = torch.load(latest, weights_only=False).get("history", [])
-    upto = [h["minutes"] for h in history if h["iteration"] <= iteration]
-    return round(upto[-1], 1) if upto else None
+        return {}
+    upto = [h for h in torch.load(latest, weights_only=False).get("history", []) if h["iteration"] <= iteration]
+    return upto[-1] if upto else {}
+
+
+def training_minutes(checkpoint: Path, iteration: int | None) -> float | None:
+    """Training time (minutes) up to `iteration`, from the run's latest checkpoint history."""
+    minutes = training_history(checkpoint, iteration).get("minutes")
+    return None if minutes is None else round(minutes, 1)
 
 
 def _write_graph(model: DanceLSTM, onnx_path: Path, weights: str) -> tuple[dict, dict]:
@@ -157,7 +162,9 @@ def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | 
         "real_pose_change": real_pose_change(clips),
         "seeds": pick_seeds(clips),
         "training": {"iterations": state.get("iteration"), "minutes": training_minutes(checkpoint, state.get("iteration")),
-                     "valid": state.get("valid"), "valid_files": meta["valid_files"], "args": meta["args"]},
+                     # last.pt keeps no validation: the last one measured before it (up to 250 iterations earlier)
+                     "valid": state.get("valid") or training_history(checkpoint, state.get("iteration")).get("valid"),
+                     "valid_files": meta["valid_files"], "args": meta["args"]},
         "parity": parity,
     }
     _publish(info, onnx_path, model_id, out)
