@@ -55,6 +55,18 @@ describe('clean-up', () => {
     expect(Math.hypot(motion.positions[last] - clip.positions[last], motion.positions[last + 2] - clip.positions[last + 2])).toBeLessThan(0.3);
   });
 
+  it('map cleans a capture at a low frame rate (its filters stay under the clip Nyquist frequency)', async () => {
+    const J = noisy.joints.length, every = 20; // 120 → 6 fps: a 4 Hz band would be above its Nyquist 3 Hz
+    const frames = Math.floor(noisy.frames / every);
+    const positions = new Float32Array(frames * J * 3);
+    for (let f = 0; f < frames; f++) positions.set(noisy.positions.subarray(f * every * J * 3, (f * every + 1) * J * 3), f * J * 3);
+    const sparse: Motion = { ...noisy, fps: 6, frames, positions };
+    const cleaner = mapCleaner({ step: (b, x, h, c) => core.step(b, x, h, c), info, mean: core.mean, std: core.std, options: { method: 'map' } });
+    const { motion } = await cleanUpOnCanonical(info, sparse, 'map', cleaner);
+    expect([motion.fps, motion.frames]).toEqual([6, frames]);
+    expect(motion.positions.every(Number.isFinite)).toBe(true);
+  });
+
   it('refuses a skeleton it cannot map before running any model, naming what is missing', async () => {
     const knees = new Set(['lfemur', 'rfemur']);
     const renamed = { ...clip, joints: clip.joints.map((n) => (knees.has(n) ? `${n}_x` : n)) };

@@ -89,7 +89,7 @@ export function smoothRootTrack(features: Float32Array, start: RootStart, D: num
     integrateRoot(walker, features[f * D], features[f * D + 1], features[f * D + 2]);
     [xs[f], zs[f], hs[f]] = [walker.x, walker.z, walker.heading];
   }
-  const sections = butterworthLowpass(Math.min(ROOT_CUTOFF_HZ, fps * 0.45), fps);
+  const sections = butterworthLowpass(belowNyquist(ROOT_CUTOFF_HZ, fps), fps);
   const smooth = (v: Float64Array) => (frames > 6 ? filtfilt(runningMedian(v, 2), sections) : v);
   const [x, z, h] = [smooth(xs), smooth(zs), smooth(hs)];
   const rootTrack = Array.from({ length: frames }, (_, f) => ({ x: x[f], z: z[f], heading: h[f] }));
@@ -134,8 +134,8 @@ export interface CanonicalInput {
   fps: number;
   /** The jitter of these points (m): measured at the motion's own frame rate (jitterSigma, median over the points), less the averaging down to the model's rate. */
   jitter: number;
-  /** The same points' slow part: low-passed at SLOW_BAND_HZ at the motion's own rate (every captured sample), then brought to the model's. */
-  slow: Float32Array;
+  /** The same points' slow part: low-passed below `hz` (SLOW_BAND_HZ, or less for a capture under 9 fps) at the motion's own rate (every captured sample), then brought to the model's. */
+  slow: { points: Float32Array; hz: number };
   /** The points low-passed at STEADY_BAND_HZ at the motion's own rate, brought to the model's, and their remaining jitter (m): for bone lengths. */
   steady: { points: Float32Array; jitter: number };
 }
@@ -197,10 +197,15 @@ export const SLOW_BAND_HZ = 4;
  */
 const STEADY_BAND_HZ = 6;
 
-function withSlowPart(cleaned: Float32Array, slowData: Float32Array, fps: number): Float32Array {
+function withSlowPart(cleaned: Float32Array, slowData: { points: Float32Array; hz: number }, fps: number): Float32Array {
   const width = CANONICAL_JOINTS.length * 3;
-  const slowCleaned = lowpassRows(cleaned, width, fps, { cutoffHz: SLOW_BAND_HZ });
-  return cleaned.map((v, i) => v - slowCleaned[i] + slowData[i]);
+  const slowCleaned = lowpassRows(cleaned, width, fps, { cutoffHz: belowNyquist(slowData.hz, fps) });
+  return cleaned.map((v, i) => v - slowCleaned[i] + slowData.points[i]);
+}
+
+/** A filter's cut-off at `fps`: `hz`, or under the Nyquist frequency for a capture of few frames per second. */
+function belowNyquist(hz: number, fps: number): number {
+  return Math.min(hz, fps * 0.45);
 }
 
 /** The `manifold` cleaner: the canonical points projected through the denoising autoencoder (manifoldProjection.ts). */
@@ -239,9 +244,10 @@ export async function cleanUpOnCanonical(
   const jitter = medianJitter(beforePoints);
   const rotations = canonicalRotations(info, points);
   const beforeRotations = resampleQuaternions(rotations, K, fps, motion.fps, motion.frames);
-  const slow = resampleLinear(lowpassRows(beforePoints, K * 3, motion.fps, { cutoffHz: SLOW_BAND_HZ }), K * 3, motion.fps, fps, frames);
-  for (let i = 1; i < slow.length; i += 3) slow[i] -= floor;
-  const steadyHz = Math.min(STEADY_BAND_HZ, motion.fps * 0.45);
+  const slowHz = belowNyquist(SLOW_BAND_HZ, motion.fps);
+  const slow = { points: resampleLinear(lowpassRows(beforePoints, K * 3, motion.fps, { cutoffHz: slowHz }), K * 3, motion.fps, fps, frames), hz: slowHz };
+  for (let i = 1; i < slow.points.length; i += 3) slow.points[i] -= floor;
+  const steadyHz = belowNyquist(STEADY_BAND_HZ, motion.fps);
   const steadyMotion = lowpassMotion(motion, { cutoffHz: steadyHz });
   const steadyJitter = jitter * Math.sqrt(Math.min(1, (2.05 * steadyHz) / motion.fps));
   const steadyBefore = toCanonical(steadyMotion, mapping);
@@ -267,7 +273,7 @@ export async function cleanUpOnCanonical(
 /** The baseline: a zero-phase Butterworth low-pass on the imported joint positions; contacts by height and speed. */
 export function lowpassCleanup(motion: Motion, options: CleanupOptions): CleanupResult {
   const began = performance.now();
-  const cutoffHz = Math.min(options.cutoffHz ?? 6, motion.fps * 0.45);
+  const cutoffHz = belowNyquist(options.cutoffHz ?? 6, motion.fps);
   const filtered = lowpassMotion(motion, { cutoffHz });
   const contacts = detectContacts(filtered) ?? new Uint8Array(motion.frames * 2);
   return { motion: { ...filtered, contacts }, stats: { method: 'lowpass', cutoffHz, computeMs: performance.now() - began } };
