@@ -21,7 +21,7 @@ import onnx
 import torch
 from onnx import TensorProto, helper
 
-from ..models.aclstm import LOG_SIGMA_RANGE, DanceLSTM
+from ..models.aclstm import LOG_SIGMA_RANGE, DanceLSTM, draw
 from ..onnx.compact import float_initializers
 from ..onnx.graph import OPSET, GraphBuilder
 from ..onnx.lstm import lstm_node_weights, onnx_gates_to_torch, torch_gates_to_onnx
@@ -159,7 +159,7 @@ def check_parity(model: DanceLSTM, path: Path, steps: int = 20, temperature: flo
             with torch.no_grad():
                 mu, log_sigma, (h2, c2) = model.distribution(torch.from_numpy(xt)[:, None], torch.from_numpy(style),
                                                              tuple(torch.from_numpy(a) for a in state))
-                y = mu[:, 0] if log_sigma is None else mu[:, 0] + temperature * torch.exp(log_sigma[:, 0]) * torch.from_numpy(noise[t])
+                y = mu[:, 0] if log_sigma is None else draw(mu[:, 0], log_sigma[:, 0], temperature, torch.from_numpy(noise[t]))
             ref.append(y.numpy())
             xt, state = y.numpy(), (h2.numpy(), c2.numpy())
         ys, h_out, c_out = session.run(OUTPUTS, {"x": x, "style": style, "h": h, "c": c, "steps": np.array([steps], np.int64), **extra(steps)})

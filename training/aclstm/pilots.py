@@ -15,6 +15,7 @@ import torch
 
 from .. import metrics
 from ..data.dance import LIMB_MIN_LENGTH, MODEL_FPS, STYLES, bone_length_error, decode, load_clips
+from ..models.aclstm import draw
 from .exporting import load_dance_model, pick_seeds
 from .freeze_rule import jitter_cm, judge, real_jitter_cm, real_reference
 from .report import BONE_ERROR_LIMIT, HEIGHT_BAND, per_second
@@ -42,7 +43,7 @@ def rollout(model, meta: dict, seed_frames: np.ndarray, styles: list[str], frame
             if draw_rho and model.head == "gauss":
                 wander = draw_rho * wander + np.sqrt(1 - draw_rho ** 2) * torch.randn(y.shape, generator=draws)
                 mu, log_sigma, state = model.distribution(fed, style, state)
-                y = mu + temperature * torch.exp(log_sigma) * wander
+                y = draw(mu, log_sigma, temperature, wander)
             else:
                 y, state = model(fed, style, state, sample=True, generator=draws, temperature=temperature)
     return out * std + mean

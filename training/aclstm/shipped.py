@@ -23,7 +23,6 @@ class ShippedDance:
         # A Gaussian head draws each frame from normals the caller passes (graph.py); its default temperature is the JSON's.
         self.gauss = "noise" in self.info["onnx"]["inputs"]
         self.temperature = float(self.info.get("temperature", 0.0))
-        self.draws, self.temperature_now = np.random.default_rng(0), self.temperature
 
     def seeds_of(self, style: str) -> list[dict]:
         return [s for s in self.info["seeds"] if s["style"] == style]
@@ -37,22 +36,21 @@ class ShippedDance:
         on every channel or, with `pose_only`, not the root's three; the outputs stay its own predictions.
         A Gaussian head draws its frames at `temperature` (default the JSON's; 0 gives the mean), from normals
         seeded by `seed`."""
-        self.draws = np.random.default_rng(seed)
-        self.temperature_now = self.temperature if temperature is None else temperature
+        sampling = {"draws": np.random.default_rng(seed), "temperature": self.temperature if temperature is None else temperature}
         b = len(seed_frames)
         style = np.eye(len(self.styles), dtype=np.float32)[[self.styles.index(s) for s in styles]]
         h = np.zeros((self.layers, b, self.hidden), np.float32)
         c = np.zeros_like(h)
         warm = ((np.asarray(seed_frames) - self.mean) / self.std).astype(np.float32)
         for t in range(warm.shape[1]):
-            y, h, c = self.run_steps(warm[:, t], style, h, c, 1)
+            y, h, c = self.run_steps(warm[:, t], style, h, c, 1, **sampling)
         y = y[-1]
         out = np.zeros((b, frames, len(self.mean)), np.float32)
         if not feedback_noise:  # the page's way: many steps per call, each output fed back inside the graph
             for t in tqdm(range(0, frames, self.STEPS_PER_CALL), desc="dance", unit="call", disable=not progress):
                 n = min(self.STEPS_PER_CALL, frames - t)
                 out[:, t] = y
-                ys, h, c = self.run_steps(y, style, h, c, n)
+                ys, h, c = self.run_steps(y, style, h, c, n, **sampling)
                 out[:, t + 1:t + n] = np.swapaxes(ys[:n - 1], 0, 1)
                 y = ys[-1]
             return out * self.std + self.mean
@@ -67,14 +65,18 @@ class ShippedDance:
             if feedback_noise:
                 noise = rho * noise + np.sqrt(1 - rho * rho) * feedback_noise * rng.standard_normal(y.shape).astype(np.float32)
                 x = (y + noise * mask).astype(np.float32)
-            ys, h, c = self.run_steps(x, style, h, c, 1)
+            ys, h, c = self.run_steps(x, style, h, c, 1, **sampling)
             y = ys[-1]
         return out * self.std + self.mean
 
-    def run_steps(self, x, style, h, c, steps: int):
-        """One session call: `steps` steps from x; returns ys (steps, batch, dim), h, c."""
+    def run_steps(self, x, style, h, c, steps: int, draws: np.random.Generator | None = None,
+                  temperature: float | None = None):
+        """One session call: `steps` steps from x; returns ys (steps, batch, dim), h, c. A Gaussian head takes its
+        normals from `draws` (required) at `temperature` (default the JSON's)."""
         feeds = {"x": x, "style": style, "h": h, "c": c, "steps": np.array([steps], np.int64)}
         if self.gauss:
-            feeds["noise"] = self.draws.standard_normal((steps, *x.shape)).astype(np.float32)
-            feeds["temperature"] = np.array([self.temperature_now], np.float32)
+            if draws is None:
+                raise ValueError("a model with a Gaussian head needs `draws` (a numpy Generator) for its normals")
+            feeds["noise"] = draws.standard_normal((steps, *x.shape)).astype(np.float32)
+            feeds["temperature"] = np.array([self.temperature if temperature is None else temperature], np.float32)
         return self.session.run(None, feeds)

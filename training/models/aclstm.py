@@ -15,6 +15,12 @@ from torch import nn
 LOG_SIGMA_RANGE = (-5.0, 1.0)  # the Gaussian head's log standard deviation, normalised units
 
 
+def draw(mu: torch.Tensor, log_sigma: torch.Tensor, temperature: float, normals: torch.Tensor) -> torch.Tensor:
+    """The Gaussian head's draw from given standard normals: mu + temperature · sigma · normals (the exported
+    graph computes the same, training/aclstm/graph.py)."""
+    return mu + temperature * torch.exp(log_sigma) * normals
+
+
 class DanceLSTM(nn.Module):
     def __init__(self, dim: int, styles: int, hidden: int = 256, layers: int = 3, head: str = "mean"):
         super().__init__()
@@ -46,7 +52,7 @@ class DanceLSTM(nn.Module):
         nothing to draw)."""
         mu, log_sigma, state = self.distribution(x, style, state)
         if sample and log_sigma is not None:
-            mu = mu + temperature * torch.exp(log_sigma) * torch.randn(mu.shape, generator=generator)
+            mu = draw(mu, log_sigma, temperature, torch.randn(mu.shape, generator=generator))
         return mu, state
 
     def auto_conditioned(self, x: torch.Tensor, style: torch.Tensor, ground_truth: int, condition: int,
@@ -70,7 +76,7 @@ class DanceLSTM(nn.Module):
             mu, log_sigma, state = self.distribution(inp, style, state)
             mus.append(mu)
             sigmas.append(log_sigma)
-            fed = mu[:, -1:] if log_sigma is None else mu[:, -1:] + torch.exp(log_sigma[:, -1:]) * torch.randn_like(mu[:, -1:])
+            fed = mu[:, -1:] if log_sigma is None else draw(mu[:, -1:], log_sigma[:, -1:], 1.0, torch.randn_like(mu[:, -1:]))
             return fed, state
 
         while t < total:
