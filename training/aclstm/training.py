@@ -99,8 +99,9 @@ def validation_losses(model: DanceLSTM, corpus: DanceCorpus, condition: int) -> 
             style = corpus.one_hot([s] * len(x))
             # Squared error of the mean, whatever the head (the Gaussian head's self-fed frames are draws).
             tf = ((model.auto_conditioned(x[:, :-1], style, 5, 0) - x[:, 1:]) ** 2).mean()
-            torch.manual_seed(0)
-            ac = ((model.auto_conditioned(x[:, :-1], style, 5, 5) - x[:, 1:]) ** 2).mean()
+            with torch.random.fork_rng():  # the same draws every validation, without resetting training's generator
+                torch.manual_seed(0)
+                ac = ((model.auto_conditioned(x[:, :-1], style, 5, 5) - x[:, 1:]) ** 2).mean()
             out[s] = {"teacher_forced": float(tf), "auto_conditioned": float(ac)}
     model.train()
     key = "auto_conditioned" if condition else "teacher_forced"
