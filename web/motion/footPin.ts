@@ -13,8 +13,12 @@ export const PIN_RAMP = 3;
 
 type V3 = [number, number, number];
 
-/** `positions` (frames × joints × 3) with each planted foot pinned (see the file comment); `contacts` frames × 2. */
-export function pinFeet(positions: Float32Array, contacts: ArrayLike<number>, joints: readonly string[]): Float32Array {
+/**
+ * `positions` (frames × joints × 3) with each planted foot pinned (see the file comment); `contacts` frames × 2.
+ * `tolerance` (m): a foot point within this horizontal distance of its anchor is left where it is, one further away
+ * is brought back to that distance (a captured foot's lowest point wanders a few millimetres as it rolls).
+ */
+export function pinFeet(positions: Float32Array, contacts: ArrayLike<number>, joints: readonly string[], tolerance = 0): Float32Array {
   const J = joints.length;
   const frames = positions.length / (J * 3);
   const out = Float32Array.from(positions);
@@ -47,7 +51,10 @@ export function pinFeet(positions: Float32Array, contacts: ArrayLike<number>, jo
         const low = lowest(g);
         const a = anchors.get(low)!;
         const w = Math.min(1, (g - start + 1) / (PIN_RAMP + 1), (end - g) / (PIN_RAMP + 1));
-        const dx = (a[0] - positions[(g * J + low) * 3]) * w, dz = (a[2] - positions[(g * J + low) * 3 + 2]) * w;
+        const ox = a[0] - positions[(g * J + low) * 3], oz = a[2] - positions[(g * J + low) * 3 + 2];
+        const off = Math.hypot(ox, oz);
+        const share = off > tolerance ? (off - tolerance) / off : 0;
+        const dx = ox * share * w, dz = oz * share * w;
         for (const j of points) {
           out[(g * J + j) * 3] += dx;
           out[(g * J + j) * 3 + 2] += dz;

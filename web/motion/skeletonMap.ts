@@ -8,7 +8,7 @@
 //
 // Canonical points that a scheme lacks but that lie between or beyond points it has (the spine and neck
 // segments, toe and hand tips) are placed along them at canonical proportions; the rest are required.
-import { quatRotate, type Quat } from './math';
+import { quatConjugate, quatMultiply, quatRotate, type Quat } from './math';
 import type { Motion } from './types';
 
 /** The canonical skeleton's points, in its order (parents: CANONICAL_PARENTS). */
@@ -282,9 +282,18 @@ export function boneOwners(parents: readonly number[], mapping: SkeletonMapping)
 }
 
 /**
+ * How far (m) a joint riding rigidly at its median offset lands from where it was captured, on clean capture
+ * (fingers and thumbs of held-out CMU walks: 3-6 mm; docs/models/cleanup.md). fromCanonical weighs it against the
+ * jitter left in the joint's own captured point.
+ */
+const RIDER_OFFSET_ERROR = 0.005;
+
+/**
  * `motion` (the imported skeleton) moved as the canonical motion changed from `before` to `after`. A bone that is a
  * whole canonical segment points from where its parent was placed at the cleaned canonical point (unscaled); any
- * other bone rides rigidly on its owning canonical segment (boneOwners) at its median offset in that segment's frame. Every bone gets the skeleton's length for it, the median over the
+ * other bone rides on its owning canonical segment (boneOwners) at its median offset in that segment's frame, fused
+ * with its own point in `motion` moved as the owner's end moved (weighted by RIDER_OFFSET_ERROR against `jitter`, the
+ * noise left in `motion`'s points). Every bone gets the skeleton's length for it, the median over the
  * frames (a file's skeleton has one length per bone; noisy positions give a different one each frame, and the
  * median ignores glitches). The root follows the canonical hips.
  *
@@ -330,6 +339,7 @@ export function fromCanonical(
   // aimed at where the rounds put it.
   const target = new Float64Array(J * 3);
   const placed = new Float64Array(J * 3);
+  const riderWeight = RIDER_OFFSET_ERROR ** 2 / (RIDER_OFFSET_ERROR ** 2 + 3 * jitter ** 2);
   const ROUNDS = 8;
   for (let f = 0; f < motion.frames; f++) {
     const rot = (src: Float32Array, k: number): Quat => {
@@ -379,6 +389,12 @@ export function fromCanonical(
         for (let a = 0; a < 3; a++) placed[j * 3 + a] = placed[parent * 3 + a] + dir[a] * lengths[j];
       } else {
         attach(j, placed, placed);
+        // Fused with the joint's own captured point, carried as its owner segment moved (its end's shift and turn):
+        // each estimate weighted by the inverse of its variance (RIDER_OFFSET_ERROR against the point's jitter).
+        const k = owner[j], o = (f * J + j) * 3;
+        const turn = quatMultiply(rot(after.rotations, k), quatConjugate(rot(before.rotations, k)));
+        const own = quatRotate(turn, [0, 1, 2].map((a) => p[o + a] - pt(before.points, k, a) * inv) as [number, number, number]);
+        for (let a = 0; a < 3; a++) placed[j * 3 + a] = riderWeight * (pt(after.points, k, a) * inv + own[a]) + (1 - riderWeight) * placed[j * 3 + a];
         // Rigid offsets keep their own median length; scale to the bone's median length like every bone.
         const d = [0, 1, 2].map((a) => placed[j * 3 + a] - placed[parent * 3 + a]);
         const n = Math.hypot(d[0], d[1], d[2]);

@@ -134,7 +134,7 @@ export interface CanonicalInput {
   fps: number;
   /** The jitter of these points (m): measured at the motion's own frame rate (jitterSigma, median over the points), less the averaging down to the model's rate. */
   jitter: number;
-  /** The same points' slow part: low-passed below `hz` (SLOW_BAND_HZ, or less for a capture under 9 fps) at the motion's own rate (every captured sample), then brought to the model's. */
+  /** The same points' slow part: low-passed below `hz` (slowBandHz of its jitter, or less for a capture of few frames per second) at the motion's own rate (every captured sample), then brought to the model's. */
   slow: { points: Float32Array; hz: number };
   /** The points low-passed at STEADY_BAND_HZ at the motion's own rate, brought to the model's, and their remaining jitter (m): for bone lengths. */
   steady: { points: Float32Array; jitter: number };
@@ -181,13 +181,22 @@ export function mapCleaner(args: { step: StepFn; info: GeneratorInfo; mean: Arra
 }
 
 /**
- * Below SLOW_BAND_HZ the capture itself is the better estimate: averaged over every sample at the motion's own
+ * Below the slow band the capture itself is the better estimate: averaged over every sample at the motion's own
  * rate, its noise there is small, while the smoother's prior (a generator that predicts held-out capture less
  * well than a constant-velocity guess) biases slow motion by centimetres (docs/models/cleanup.md). So `map` keeps
  * its own motion above the band and the data's below it: cleaned − slow(cleaned) + slow(data), a complementary
  * filter. Feet are pinned after this, on the sum.
+ *
+ * The crossover rises as the jitter falls: where the motion's spectrum meets the noise's. Motion whose acceleration
+ * is roughly white has a position spectrum falling as f⁻⁴ against white noise of variance σ², so the crossover goes
+ * as σ^(-1/2): 4 Hz at 3 cm (measured best there), about 7 Hz at 1 cm and 3 Hz at 5 cm, kept within 2-8 Hz.
  */
-export const SLOW_BAND_HZ = 4;
+export function slowBandHz(jitter: number): number {
+  return Math.min(8, Math.max(2, 4 * Math.sqrt(0.03 / Math.max(jitter, 1e-6))));
+}
+
+/** A planted foot point within this horizontal distance (m) of its anchor is left as captured (pinFeet). */
+const PIN_TOLERANCE = 0.005;
 
 /**
  * Bone lengths (and the offsets of joints riding on a canonical segment) are measured on the capture low-passed at
@@ -244,7 +253,7 @@ export async function cleanUpOnCanonical(
   const jitter = medianJitter(beforePoints);
   const rotations = canonicalRotations(info, points);
   const beforeRotations = resampleQuaternions(rotations, K, fps, motion.fps, motion.frames);
-  const slowHz = belowNyquist(SLOW_BAND_HZ, motion.fps);
+  const slowHz = belowNyquist(slowBandHz(jitter), motion.fps);
   const slow = { points: resampleLinear(lowpassRows(beforePoints, K * 3, motion.fps, { cutoffHz: slowHz }), K * 3, motion.fps, fps, frames), hz: slowHz };
   for (let i = 1; i < slow.points.length; i += 3) slow.points[i] -= floor;
   const steadyHz = belowNyquist(STEADY_BAND_HZ, motion.fps);
@@ -256,7 +265,7 @@ export async function cleanUpOnCanonical(
   const { skeleton } = info;
   // Contacts labelled on the cleaned motion (the model's bits with the feet's heights and speeds), planted feet pinned.
   const contacts30 = labelContacts(cleaned.positions, cleaned.bits, skeleton.joints, fps);
-  const planted = { positions: pinFeet(cleaned.positions, contacts30, skeleton.joints), contacts: contacts30 };
+  const planted = { positions: pinFeet(cleaned.positions, contacts30, skeleton.joints, PIN_TOLERANCE), contacts: contacts30 };
   for (let i = 1; i < planted.positions.length; i += 3) planted.positions[i] += floor;
   const afterRotations = canonicalRotations(info, planted.positions);
   // After: back at the imported motion's frame times.
