@@ -14,7 +14,7 @@ from training.control import Rng
 from training.data.windows import ROW_DIM
 from training.models.vae_lstm import POOLING, VaeLstm
 from training.vae_lstm.exporting import FILES, PRIOR_FIXTURE_SEED, check_parity, export_graphs, files_format, generate_rows
-from training.vae_lstm.generation import SEED_FRAMES, SEED_PAD, prior_latents, seed_window
+from training.vae_lstm.generation import SEED_FRAMES, SEED_PAD, free_latents, prior_latents, seed_window
 from training.vae_lstm.measures import ShippedVae
 from training.models.losses import energy_loss
 from training.vae_lstm.recovery import vae_lstm_from_onnx
@@ -54,6 +54,13 @@ def test_generation_in_chunks_equals_one_pass(model):
         whole = model.generate(torch.from_numpy(control[None]), torch.from_numpy(z1[None])).numpy()[0]
     assert chunked.shape == (frames, ROW_DIM)
     np.testing.assert_allclose(chunked, whole, atol=1e-5)
+    # With z1 also a share of every step's content (a model trained with --free-mix), as the page runs it.
+    zs, mix = free_latents(z1, frames // 4, {"mode": "z1", "mix": 0.3})
+    mixed = generate_rows(model, control, z1, zs, mix)
+    with torch.no_grad():
+        whole_mixed = model.generate(torch.from_numpy(control[None]), torch.from_numpy(z1[None]), 0.3).numpy()[0]
+    np.testing.assert_allclose(mixed, whole_mixed, atol=1e-5)
+    assert float(np.abs(mixed - chunked).max()) > 1e-3
 
 
 def test_the_posterior_seed_repeats_the_fourth_frame():
@@ -108,7 +115,8 @@ def test_the_shipped_graphs_reproduce_the_fixture_generation():
     vae = ShippedVae.load(REPO / "public" / "models")
     g = fixture["generate"]
     control = np.array(g["control"]).reshape(-1, 3)
-    rows = vae.rows(control, np.array(g["z1"], np.float32))
+    z1 = np.array(g["z1"], np.float32)
+    rows = vae.rows(control, z1, *free_latents(z1, -(-len(control) // 4), vae.info["sampling"]))
     normalised = (rows - vae.mean) / vae.std
     np.testing.assert_allclose(normalised.ravel(), g["rows"], atol=fixture["tolerance"])
     zs = np.array(fixture["generate_steps"]["zs"], np.float32).reshape(-1, len(g["z1"]))

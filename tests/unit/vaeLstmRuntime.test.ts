@@ -6,7 +6,7 @@
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { integrateControl, PolylinePath } from '../../web/motion/control';
 import { parseVaeLstmInfo, VAE_LSTM_GRAPHS, type VaeLstmGraph, type VaeLstmModel } from '../../web/model/vaeLstmInfo';
-import { priorLatents, VaeLstmCore } from '../../web/runtime/vaeLstmCore';
+import { freeLatents, priorLatents, VaeLstmCore } from '../../web/runtime/vaeLstmCore';
 import { controlForPath, followPathVae } from '../../web/runtime/vaeLstmRequests';
 import { readRepoFile } from './corpus';
 import { bytes, maxAbsDiff, ort, shippedSession } from './shippedModel';
@@ -70,6 +70,16 @@ describe('VAE-LSTM parity with the Python reference', () => {
 });
 
 describe('VAE-LSTM generation', () => {
+  it('a model trained with z1 in every free step reads it there: z1 repeated at its mix, none for Algorithm 1', () => {
+    const z1 = Float32Array.of(0.5, -1, 2);
+    expect(freeLatents(z1, 4, { mode: 'z1' })).toBeUndefined();
+    expect(freeLatents(z1, 4, { mode: 'z1', mix: 0 })).toBeUndefined();
+    expect(freeLatents(z1, 4, { mode: 'steps', rho: 0.9 })).toBeUndefined();
+    const free = freeLatents(z1, 4, { mode: 'z1', mix: 0.3 })!;
+    expect(free.mix).toBe(0.3);
+    expect(Array.from(free.zs)).toEqual([0, 1, 2, 3].flatMap(() => Array.from(z1)));
+  });
+
   it('a seed draws the same z1 and per-step latents as the Python side (generation.prior_latents)', () => {
     const p = fixture.prior;
     expect(maxAbsDiff(priorLatents(p.seed, info.latent).z1, p.z1)).toBeLessThan(1e-6);
@@ -161,6 +171,7 @@ describe('vae-lstm.json checks', () => {
     expect(() => parseVaeLstmInfo({ ...json, pooling: 2 })).toThrow(/pooling must be 4/);
     expect(() => parseVaeLstmInfo({ ...json, sampling: { mode: 'steps', rho: 1 } })).toThrow(/sampling\.rho must be in \[0, 1\)/);
     expect(() => parseVaeLstmInfo({ ...json, sampling: { mode: 'many' } })).toThrow(/sampling\.mode must be "z1" or "steps"/);
+    expect(() => parseVaeLstmInfo({ ...json, sampling: { mode: 'z1', mix: 1 } })).toThrow(/sampling\.mix must be in \[0, 1\)/);
     expect(() => parseVaeLstmInfo({ ...json, rows: { ...json.rows, control: [75, 77] } })).toThrow(/rows\.control is \[75, 77\]/);
   });
 });

@@ -67,13 +67,14 @@ class CanvasCell(nn.Module):
         i, f = torch.sigmoid(self.gates_state(previous) + self.gates_control(control)).chunk(2, dim=-1)
         return nn.functional.elu(f * self.content_state(content) + i * self.content_control(control))
 
-    def run(self, state: torch.Tensor, controls: torch.Tensor, latents: torch.Tensor | None = None) -> tuple[torch.Tensor, torch.Tensor]:
+    def run(self, state: torch.Tensor, controls: torch.Tensor, latents: torch.Tensor | None = None, mix: float = 1.0) -> tuple[torch.Tensor, torch.Tensor]:
         """The canvas (batch, steps, latent) over controls (batch, steps, control) from `state`, and the last
-        state. With `latents` (batch, steps, latent) the content of step t is z_t (teacher mode), else the
-        previous state (free mode)."""
+        state. With `latents` (batch, steps, latent) the content of step t is mix · z_t + (1 − mix) · the previous
+        state (mix 1: teacher mode), else the previous state (free mode)."""
         canvas = []
         for t in range(controls.shape[1]):
-            state = self(state, state if latents is None else latents[:, t], controls[:, t])
+            content = state if latents is None else (latents[:, t] if mix == 1.0 else mix * latents[:, t] + (1 - mix) * state)
+            state = self(state, content, controls[:, t])
             canvas.append(state)
         return torch.stack(canvas, dim=1), state
 
@@ -102,10 +103,12 @@ class VaeLstm(nn.Module):
         self.cell = CanvasCell(latent, control_features)
         self.decoder = CanvasDecoder(latent, dim, decoder_hidden)
 
-    def generate(self, control: torch.Tensor, z1: torch.Tensor) -> torch.Tensor:
+    def generate(self, control: torch.Tensor, z1: torch.Tensor, mix: float = 0.0) -> torch.Tensor:
         """Algorithm 1: frames (batch, frames, dim) for a control signal (batch, frames, control) from one
-        latent sample z1 (batch, latent), the cell running on its own state."""
-        canvas, _ = self.cell.run(z1, self.control_encoder(control))
+        latent sample z1 (batch, latent), the cell running on its own state (with `mix` > 0 z1 is also that share
+        of every step's content)."""
+        hc = self.control_encoder(control)
+        canvas, _ = self.cell.run(z1, hc, z1[:, None].expand(-1, hc.shape[1], -1), mix) if mix > 0 else self.cell.run(z1, hc)
         return self.decoder(canvas)
 
     def posterior_first(self, seed: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:

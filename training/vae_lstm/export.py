@@ -47,7 +47,9 @@ def main(argv: list[str] | None = None) -> None:
     model, meta = load_vae_lstm(checkpoint)
     if not 0 <= args.rho < 1:
         raise SystemExit(f"error: --rho must be in [0, 1), got {args.rho}")
-    sampling = {"mode": "z1"} if args.sampling == "z1" else {"mode": "steps", "rho": args.rho}
+    free_mix = float(meta["args"].get("free_mix", 0.0))
+    # A model trained with z1 in every step of its free mode (--free-mix) is run that way (generation.free_latents).
+    sampling = ({"mode": "z1", "mix": free_mix} if free_mix > 0 else {"mode": "z1"}) if args.sampling == "z1" else {"mode": "steps", "rho": args.rho}
     export_vae_lstm(model, meta, {}, sampling, Path(args.out), args.weights)
 
 

@@ -35,7 +35,7 @@ from ..onnx.compact import compact_weights, files_weight_format
 from ..onnx.manifest import register_model
 from ..onnx.sessions import cpu_session
 from ..paths import MODELS_DIR, REPO_ROOT
-from .generation import CHUNK_STEPS, SEED_FRAMES, SEED_PAD, prior_latents
+from .generation import CHUNK_STEPS, SEED_FRAMES, SEED_PAD, free_latents, prior_latents
 from .recovery import vae_lstm_from_onnx
 
 PARITY_TOLERANCE = 1e-4
@@ -105,7 +105,7 @@ def export_graphs(model: VaeLstm, out: Path, weights: str = "float32") -> VaeLst
 def random_inputs(model: VaeLstm, rng: np.random.Generator, batch: int, frames: int) -> dict[str, list[np.ndarray]]:
     hc_dim = model.cell.gates_control.in_features
     f32 = lambda *shape: rng.normal(size=shape).astype(np.float32)
-    mix = np.array([float(rng.integers(0, 2))], np.float32)
+    mix = np.array([rng.choice([0.0, 0.3, 1.0])], np.float32)
     return {"cell": [np.abs(f32(batch, CHUNK_STEPS, hc_dim)), f32(batch, model.latent), f32(batch, CHUNK_STEPS, model.latent), mix],
             "control": [f32(batch, frames, model.control)], "decoder": [f32(batch, frames // POOLING, model.latent)],
             "inference": [f32(batch, frames, model.dim)]}
@@ -151,10 +151,11 @@ def vae_lstm_info(meta: dict, model: VaeLstm, report: dict, sampling: dict) -> d
     }
 
 
-def generate_rows(model: VaeLstm, control: np.ndarray, z1: np.ndarray, zs: np.ndarray | None = None) -> np.ndarray:
+def generate_rows(model: VaeLstm, control: np.ndarray, z1: np.ndarray, zs: np.ndarray | None = None, mix: float | None = None) -> np.ndarray:
     """Normalised rows (frames, dim) for a normalised control (frames, 3), frames a multiple of 4, from z1
     (latent,), the cell run chunk by chunk as the page runs it (the last chunk padded with its last step); with
-    `zs` (steps, latent) in teacher mode on those latents."""
+    `zs` (steps, latent) each step's content is mix · z_t + (1 − mix) · the previous state (mix default 1: teacher
+    mode)."""
     with torch.no_grad():
         hc = model.control_encoder(torch.from_numpy(control[None].astype(np.float32)))
         steps = hc.shape[1]
@@ -162,7 +163,7 @@ def generate_rows(model: VaeLstm, control: np.ndarray, z1: np.ndarray, zs: np.nd
         pad = lambda x: torch.cat([x, x[:, -1:].expand(-1, chunks * CHUNK_STEPS - steps, -1)], dim=1)
         padded = pad(hc)
         z = pad(torch.from_numpy(zs[None].astype(np.float32))) if zs is not None else torch.zeros(1, chunks * CHUNK_STEPS, model.latent)
-        mix = torch.tensor([1.0 if zs is not None else 0.0])
+        mix = torch.tensor([(1.0 if zs is not None else 0.0) if mix is None else mix])
         state, canvas, chunk = torch.from_numpy(z1[None].astype(np.float32)), [], CellChunk(model)
         for k in range(chunks):
             part, state = chunk(padded[:, k * CHUNK_STEPS:(k + 1) * CHUNK_STEPS], state, z[:, k * CHUNK_STEPS:(k + 1) * CHUNK_STEPS], mix)
@@ -189,7 +190,8 @@ def write_fixture(model: VaeLstm, info: dict, path: Path = FIXTURE) -> None:
     physical = np.stack([1.2 + 0.2 * np.sin(t), np.zeros_like(t), 0.6 * np.sin(0.5 * t)], axis=1).round(6)
     mean, std = np.array(info["normalisation"]["mean"])[CONTROL_SLICE], np.array(info["normalisation"]["std"])[CONTROL_SLICE]
     z1 = rng.normal(size=model.latent).round(6).astype(np.float32)
-    rows = generate_rows(model, ((physical - mean) / std).astype(np.float32), z1)
+    # The free mode as the page runs it for this model (with z1 in every step when it was trained so).
+    rows = generate_rows(model, ((physical - mean) / std).astype(np.float32), z1, *free_latents(z1, frames // POOLING, info["sampling"]))
     prior, prior_steps = prior_latents(PRIOR_FIXTURE_SEED, model.latent, 5, PRIOR_FIXTURE_RHO)
     steps = frames // POOLING
     zs = rng.normal(size=(steps, model.latent)).round(6).astype(np.float32)

@@ -4,8 +4,12 @@
   cell run on its own state for every step, the canvas decoded in one pass.
 - Or (the paper's other way, §3.3: "we could also consider sampling a latent variable z_t for each frame"):
   a latent per step in teacher mode, drawn as an AR(1) sequence with N(0, I) marginals and lag-one
-  correlation rho (the posterior's own latents are correlated from step to step). Which of the two a shipped
-  model uses is in its JSON (`sampling`), chosen by measurement (docs/models/vae-lstm.md).
+  correlation rho (the posterior's own latents are correlated from step to step). Or between the two ("nudged",
+  measured in the report, not in the page): free mode whose content each step is mix · z_t + (1 − mix) · the
+  previous state. Which a shipped model uses is in its JSON (`sampling`), chosen by measurement
+  (docs/models/vae-lstm.md).
+- A model trained with --free-mix also reads z_1 in every step of its free mode (free_latents; its JSON's sampling
+  {"mode": "z1", "mix": …}), for prior samples and starts from 4 frames alike: the cell then cannot forget it.
 - From the posterior: z_1 is the mean of q(z_1 | 4 initial frames). The inference network is convolutional
   and reads about 1.2 s around the first step, so the 4 frames are padded to SEED_PAD frames by repeating the
   last (a held pose), the same in training (free mode) and at test time.
@@ -41,6 +45,14 @@ def pad_to_steps(control: torch.Tensor) -> tuple[torch.Tensor, int]:
     if extra:
         control = torch.cat([control, control[:, -1:].expand(-1, extra, -1)], dim=1)
     return control, n
+
+
+def free_latents(z1: np.ndarray, steps: int, sampling: dict) -> tuple[np.ndarray | None, float]:
+    """What the cell's free mode reads besides its state, for a model whose sampling (its JSON's) is "z1": the
+    per-step latents and mix of a model trained with z1 in every step's content (`mix`, the training's
+    --free-mix: mix · z1 + (1 − mix) · the previous state), else none (Algorithm 1)."""
+    mix = float(sampling.get("mix", 0.0)) if sampling["mode"] == "z1" else 0.0
+    return (np.repeat(np.asarray(z1, np.float32)[None], steps, 0), mix) if mix > 0 else (None, 0.0)
 
 
 def prior_latents(seed: int, latent: int, steps: int = 0, rho: float = 0.0) -> tuple[np.ndarray, np.ndarray | None]:

@@ -32,7 +32,7 @@ from ..latent_erd.measures import prediction_windows as erd_prediction_windows
 from ..latent_erd.measures import sliding
 from ..onnx.sessions import cpu_session
 from .generation import SEED_FRAMES as INITIAL_FRAMES
-from .generation import SEED_PAD, prior_latents
+from .generation import SEED_PAD, free_latents, prior_latents
 
 LONG_RUN_FRAMES = 3000
 DIVERSITY_SAMPLES = 10
@@ -63,9 +63,10 @@ class ShippedVae:
     def std(self) -> np.ndarray:
         return np.array(self.info["normalisation"]["std"])
 
-    def rows(self, control: np.ndarray, z1: np.ndarray, zs: np.ndarray | None = None) -> np.ndarray:
-        """Physical rows (frames, dim) for a physical control (frames, 3) from z1 (latent,), in teacher mode on
-        the per-step latents `zs` (steps, latent) when given."""
+    def rows(self, control: np.ndarray, z1: np.ndarray, zs: np.ndarray | None = None, mix: float | None = None) -> np.ndarray:
+        """Physical rows (frames, dim) for a physical control (frames, 3) from z1 (latent,), with the per-step
+        latents `zs` (steps, latent) when given: step t's content is mix · z_t + (1 − mix) · the previous state
+        (mix defaults to 1 with `zs`, teacher mode, and 0 without, Algorithm 1's free mode)."""
         frames = len(control)
         padded = np.concatenate([control, np.repeat(control[-1:], -frames % 4, 0)])
         c = ((padded - self.mean[CONTROL_SLICE]) / self.std[CONTROL_SLICE]).astype(np.float32)
@@ -78,7 +79,7 @@ class ShippedVae:
         if zs is not None:
             z[0, :steps] = zs[:steps]
             z[0, steps:] = zs[steps - 1]
-        mix = np.array([0.0 if zs is None else 1.0], np.float32)
+        mix = np.array([(0.0 if zs is None else 1.0) if mix is None else mix], np.float32)
         state, canvas = z1[None].astype(np.float32), []
         for k in range(n):
             part, state = self.sessions["cell"].run(["canvas", "state_out"], {"hc": hc[:, k * chunk:(k + 1) * chunk], "state": state,
@@ -93,18 +94,21 @@ class ShippedVae:
         x = np.concatenate([initial_rows, np.repeat(initial_rows[-1:], SEED_PAD - len(initial_rows), 0)]).astype(np.float32)
         return self.sessions["inference"].run(["mean"], {"rows": x[None]})[0][0, 0]
 
-    def prior(self, seed: int, frames: int, sampling: dict | None = None) -> tuple[np.ndarray, np.ndarray | None]:
-        """A seed's prior sample for `frames` frames, drawn as the page draws it: z1, and per-step latents when
-        the sampling (default the JSON's) is "steps"."""
+    def prior(self, seed: int, frames: int, sampling: dict | None = None) -> tuple[np.ndarray, np.ndarray | None, float]:
+        """A seed's prior sample for `frames` frames, drawn as the page draws it: z1, per-step latents unless the
+        sampling (default the JSON's) is "z1", and the share of each step's content they give (rows' `mix`):
+        1 for "steps" (teacher mode), the sampling's `mix` for "nudged" (free mode nudged by them)."""
         sampling = sampling or self.info["sampling"]
         if sampling["mode"] == "z1":
-            return prior_latents(seed, self.info["latent"])
-        return prior_latents(seed, self.info["latent"], -(-frames // 4), sampling["rho"])
+            z1, _ = prior_latents(seed, self.info["latent"])
+            return (z1, *free_latents(z1, -(-frames // 4), sampling))
+        z1, zs = prior_latents(seed, self.info["latent"], -(-frames // 4), sampling["rho"])
+        return z1, zs, 1.0 if sampling["mode"] == "steps" else float(sampling["mix"])
 
-    def world(self, control: np.ndarray, z1: np.ndarray, zs: np.ndarray | None = None, start_xz=(0.0, 0.0),
-              start_heading: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    def world(self, control: np.ndarray, z1: np.ndarray, zs: np.ndarray | None = None, mix: float | None = None,
+              start_xz=(0.0, 0.0), start_heading: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """World positions (frames, joints, 3) with the root moved by `control`, and the decoded contact bits."""
-        rows = self.rows(control, z1, zs)
+        rows = self.rows(control, z1, zs, mix)
         placed = rows.copy()
         placed[:, CONTROL_SLICE] = control
         return rows_to_world(placed, self.fps, start_xz, start_heading), (rows[:, CONTACT_SLICE] > 0.5).astype(np.uint8)
@@ -114,14 +118,17 @@ class ShippedVae:
 
 def vae_prediction(vae: ShippedVae, corpus: WindowCorpus, w: Window, prior: tuple | None, sampling: dict | None = None) -> np.ndarray:
     """World positions of the window's predicted frames (PREDICT_FRAMES): from 4 initial frames (prior None:
-    z1 the posterior mean, Algorithm 1) or from the given prior sample (z1, per-step latents or None)."""
+    z1 the posterior mean, Algorithm 1) or from the given prior sample (ShippedVae.prior)."""
     c = corpus.valid_clips[w.clip]
     begin = w.start + SEED_FRAMES - INITIAL_FRAMES
     frames = INITIAL_FRAMES + PREDICT_FRAMES
-    z1, zs = prior if prior is not None else (vae.posterior_mean(corpus.valid[w.clip][begin:begin + INITIAL_FRAMES]), None)
+    if prior is None:
+        z1 = vae.posterior_mean(corpus.valid[w.clip][begin:begin + INITIAL_FRAMES])
+        prior = (z1, *free_latents(z1, -(-frames // 4), vae.info["sampling"]))
+    z1, zs, mix = prior
     xz, heading = ground_frame(c.positions)
     control = c.rows[begin:begin + frames, CONTROL_SLICE]
-    positions, _ = vae.world(control, z1, zs, xz[begin], float(heading[begin]))
+    positions, _ = vae.world(control, z1, zs, mix, xz[begin], float(heading[begin]))
     return positions[INITIAL_FRAMES:]
 
 

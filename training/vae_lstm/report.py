@@ -24,7 +24,8 @@ TRAINING_RUNS = ("vae-lstm", "vae-lstm-e100")
 LONG_RUN_SEEDS = 5
 # The ways of drawing a prior sample compared (generation.py); the shipped one is vae-lstm.json's `sampling`.
 SAMPLINGS = {"one z1 (Algorithm 1)": {"mode": "z1"}, "a latent per step, rho 0": {"mode": "steps", "rho": 0.0},
-             "a latent per step, rho 0.9": {"mode": "steps", "rho": 0.9}}
+             "a latent per step, rho 0.9": {"mode": "steps", "rho": 0.9},
+             "one z1, nudged by latents (rho 0.9, mix 0.2)": {"mode": "nudged", "rho": 0.9, "mix": 0.2}}
 
 
 def evaluate(mocap: str | None, previous: dict, models_dir: Path = MODELS_DIR) -> dict:

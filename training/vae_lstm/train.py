@@ -23,6 +23,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--dropout", type=float, default=0.1, help="dropout on the positions and the control")
     parser.add_argument("--beta", type=float, default=0.02, help="KL weight against the mean squared error (2 sigma^2)")
     parser.add_argument("--free", type=float, default=1.0, help="weight of the free-mode reconstruction (0: the paper's recipe)")
+    parser.add_argument("--free-z1", choices=["seed", "window", "both"], default="seed",
+                        help="the free mode's z_1: from the first 4 frames held (seed), from the window's own first step (window), or half each")
+    parser.add_argument("--free-mix", type=float, default=0.0, help="free mode: z_1's share of every step's content (0: Algorithm 1, z_1 only the first state)")
     parser.add_argument("--energy", type=float, default=5.0, help="weight of the free mode's motion-energy term (models/losses.py energy_loss)")
     parser.add_argument("--l1", type=float, default=L1_PAPER, help="l1 on the weights, against the summed loss")
     parser.add_argument("--control-sigma", type=float, default=10.0, help="frames of smoothing on the control the cell reads")

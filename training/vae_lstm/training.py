@@ -11,8 +11,8 @@ before it is pulled to the prior.
 
 The paper trains the cell only in teacher mode (content z_t at every step) and generates in free mode (content
 the previous state) from one sample z_1. `free` adds the free mode to training: each window is also
-generated from z_1 alone, z_1 from the posterior of its first 4 frames (generation.py seed_window), and its
-reconstruction error (and that z_1's KL) counts `free` times. Pilots compare the two
+generated from z_1 alone, z_1 from the posterior of its first 4 frames (generation.py seed_window) or of the window
+itself (`free_z1`, losses), and its reconstruction error (and that z_1's KL) counts `free` times. Pilots compare the two
 (docs/models/vae-lstm.md).
 
 Motion energy (`energy`): a free-mode window that has lost the stride's phase costs least under the squared
@@ -97,8 +97,11 @@ def sample(mean: torch.Tensor, log_var: torch.Tensor) -> torch.Tensor:
     return mean + torch.randn_like(mean) * (0.5 * log_var).exp()
 
 
-def losses(model: VaeLstm, x: torch.Tensor, control: torch.Tensor) -> dict:
-    """The teacher-mode and free-mode terms for windows x (batch, frames, dim) and their control."""
+def losses(model: VaeLstm, x: torch.Tensor, control: torch.Tensor, free_z1: str = "seed", free_mix: float = 0.0) -> dict:
+    """The teacher-mode and free-mode terms for windows x (batch, frames, dim) and their control. The free mode's
+    z_1 comes from the posterior of the window's first 4 frames held (`free_z1` "seed", as a 4-frame start has
+    it), of the window itself at its first step (“window”: it reads about 1.3 s of the real motion, its stride's
+    phase and speed, as a prior sample is meant to stand for), or half the batch each ("both")."""
     hc = model.control_encoder(control)
     mean, log_var = model.inference(x)
     z = sample(mean, log_var)
@@ -106,14 +109,19 @@ def losses(model: VaeLstm, x: torch.Tensor, control: torch.Tensor) -> dict:
     teacher = ((model.decoder(canvas) - x) ** 2).mean()
     kl = kl_per_step(mean, log_var).mean()
     m1, v1 = model.posterior_first(seed_window(x[:, :SEED_FRAMES]))
-    free_canvas, _ = model.cell.run(sample(m1, v1), hc)
+    if free_z1 != "seed":
+        own = torch.ones(x.shape[0], 1, dtype=torch.bool) if free_z1 == "window" else (torch.arange(x.shape[0]) % 2 == 1)[:, None]
+        m1, v1 = torch.where(own, mean[:, 0], m1), torch.where(own, log_var[:, 0], v1)
+    z1 = sample(m1, v1)
+    # free_mix > 0: z_1 is also part of every step's content (mix · z_1 + (1 − mix) · the previous state).
+    free_canvas, _ = model.cell.run(z1, hc, z1[:, None].expand(-1, hc.shape[1], -1), free_mix) if free_mix > 0 else model.cell.run(z1, hc)
     free_rows = model.decoder(free_canvas)
     free = ((free_rows - x) ** 2).mean()
     return {"teacher": teacher, "kl": kl, "free": free, "kl_first": kl_per_step(m1, v1).mean(),
             "energy": energy_loss(free_rows[..., :POSITION_DIM], x[..., :POSITION_DIM])}
 
 
-def position_error_cm(model: VaeLstm, corpus: WindowCorpus, x: torch.Tensor, control: torch.Tensor, prior_seed: int | None) -> float:
+def position_error_cm(model: VaeLstm, corpus: WindowCorpus, x: torch.Tensor, control: torch.Tensor, prior_seed: int | None, mix: float = 0.0) -> float:
     """Mean joint position error (cm, in the root's facing frame) of windows generated in free mode from z_1:
     the posterior mean of the first 4 frames, or with `prior_seed` a sample of N(0, I)."""
     with torch.no_grad():
@@ -121,7 +129,7 @@ def position_error_cm(model: VaeLstm, corpus: WindowCorpus, x: torch.Tensor, con
             z1 = model.posterior_first(seed_window(x[:, :SEED_FRAMES]))[0]
         else:
             z1 = torch.randn(x.shape[0], model.latent, generator=torch.Generator().manual_seed(prior_seed))
-        y = model.generate(control, z1).numpy()
+        y = model.generate(control, z1, mix).numpy()
     std, mean = corpus.std[:POSITION_DIM], corpus.mean[:POSITION_DIM]
     real = (x.numpy()[..., :POSITION_DIM] * std + mean).reshape(*x.shape[:2], -1, 3)
     made = (y[..., :POSITION_DIM] * std + mean).reshape(*x.shape[:2], -1, 3)
@@ -165,7 +173,7 @@ def train_vae_lstm(args: argparse.Namespace) -> tuple[float, Path]:
     for it in range(start, args.iterations):
         x, c = train.batch(rng, args.batch)
         beta = args.beta * min(1.0, it / max(1, args.iterations * KL_RAMP))
-        terms = losses(model, x, c)
+        terms = losses(model, x, c, args.free_z1, args.free_mix)
         loss = (terms["teacher"] + beta * terms["kl"] / (4 * ROW_DIM)
                 + args.free * (terms["free"] + beta * terms["kl_first"] / (4 * ROW_DIM) + args.energy * terms["energy"])
                 + args.l1 * l1_penalty(model) / values)
@@ -180,8 +188,8 @@ def train_vae_lstm(args: argparse.Namespace) -> tuple[float, Path]:
         bar.set_postfix(teacher=f"{recent[0]:.3f}", free=f"{recent[1]:.3f}", kl=f"{recent[2]:.1f}")
         if (it + 1) % VALIDATE_EVERY == 0 or it + 1 == args.iterations:
             model.eval()
-            posterior = position_error_cm(model, corpus, vx, vc, None)
-            prior = position_error_cm(model, corpus, vx, vc, 0)
+            posterior = position_error_cm(model, corpus, vx, vc, None, args.free_mix)
+            prior = position_error_cm(model, corpus, vx, vc, 0, args.free_mix)
             model.train()
             if posterior < best:
                 best = posterior

@@ -36,9 +36,10 @@ export interface VaeLstmInfo {
   seed_pad: number;
   /**
    * How a seed's prior sample is drawn (training/vae_lstm/generation.py): "z1", one latent and the cell on its
-   * own state (Algorithm 1), or "steps", a latent per step in teacher mode, AR(1) with lag-one correlation rho.
+   * own state (Algorithm 1; with `mix`, a model trained so, z1 is also that share of every step's content, in
+   * starts from 4 frames too), or "steps", a latent per step in teacher mode, AR(1) with lag-one correlation rho.
    */
-  sampling: { mode: 'z1' } | { mode: 'steps'; rho: number };
+  sampling: { mode: 'z1'; mix?: number } | { mode: 'steps'; rho: number };
   onnx: Record<VaeLstmGraph, { inputs: string[]; outputs: string[] }>;
   skeleton: { joints: string[]; parents: number[]; offsets: number[] };
   rows: {
@@ -78,6 +79,10 @@ const format = modelInfoFormat<VaeLstmInfo>('VaeLstmInfoError', 'vae-lstm.json',
     const rho = check.num(sampling.rho, 'sampling.rho');
     if (!(rho >= 0 && rho < 1)) fail(`sampling.rho must be in [0, 1), got ${rho}`);
   } else if (sampling.mode !== 'z1') fail(`sampling.mode must be "z1" or "steps", got ${JSON.stringify(sampling.mode)}`);
+  else if (sampling.mix !== undefined) {
+    const mix = check.num(sampling.mix, 'sampling.mix');
+    if (!(mix >= 0 && mix < 1)) fail(`sampling.mix must be in [0, 1), got ${mix}`);
+  }
   check.skeleton(root.skeleton);
   check.normalisation(root.normalisation, checkRowLayout(check, root.rows, (root.skeleton as { joints: string[] }).joints));
 });

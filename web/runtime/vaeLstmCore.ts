@@ -36,6 +36,19 @@ class GraphSession extends SessionCore<GraphInfo> {
 }
 
 /**
+ * What the cell's free mode reads besides its state (training/vae_lstm/generation.py free_latents): for a model
+ * whose sampling is "z1" with a `mix` (trained with z1 in every step's content), z1 repeated over `steps` and that
+ * mix; else nothing (Algorithm 1).
+ */
+export function freeLatents(z1: Float32Array, steps: number, sampling: VaeLstmInfo['sampling']): { zs: Float32Array; mix: number } | undefined {
+  const mix = sampling.mode === 'z1' ? sampling.mix ?? 0 : 0;
+  if (!(mix > 0)) return undefined;
+  const zs = new Float32Array(steps * z1.length);
+  for (let t = 0; t < steps; t++) zs.set(z1, t * z1.length);
+  return { zs, mix };
+}
+
+/**
  * A seed's prior draws (training/vae_lstm/generation.py prior_latents, the same numbers): z1, `latent` draws
  * of N(0, 1) from the page's Rng, and with `steps` the per-step latents (steps × latent): z1 first, then
  * rho · previous + sqrt(1 − rho²) · a new draw, in the same stream.
@@ -141,14 +154,15 @@ export class VaeLstmCore {
 
   /**
    * The canvas (steps × latent) over control encodings (steps × control_features) from `state`, chunk by chunk:
-   * on its own state (Algorithm 1), or with `zs` (steps × latent) in teacher mode on those latents.
+   * on its own state (Algorithm 1), or with `zs` (steps × latent) each step's content mix · z_t + (1 − mix) · the
+   * previous state (mix default 1: teacher mode on those latents).
    */
-  async runCell(hc: Float32Array, state: Float32Array, zs?: Float32Array, signal?: AbortSignal): Promise<{ canvas: Float32Array; state: Float32Array; calls: number }> {
+  async runCell(hc: Float32Array, state: Float32Array, zs?: Float32Array, signal?: AbortSignal, share?: number): Promise<{ canvas: Float32Array; state: Float32Array; calls: number }> {
     const { chunk_steps: K, latent: Z, control_features: F } = this.info;
     const steps = hc.length / F;
     if (zs && zs.length < steps * Z) throw new Error(`zs has ${zs.length / Z} steps; the control needs ${steps}`);
     const canvas = new Float32Array(steps * Z);
-    const mix = Float32Array.of(zs ? 1 : 0);
+    const mix = Float32Array.of(zs ? (share ?? 1) : 0);
     let calls = 0;
     for (let at = 0; at < steps; at += K) {
       const part = new Float32Array(K * F);
@@ -176,7 +190,10 @@ export class VaeLstmCore {
     return read('rows', pooling * steps * rows.dim);
   }
 
-  /** Physical rows (frames × dim) for a physical control (frames × 3) from z1 (teacher mode on `zs` when given), and the cell calls made. */
+  /**
+   * Physical rows (frames × dim) for a physical control (frames × 3) from z1 (teacher mode on `zs` when given; else
+   * the free mode, with z1 in every step when the model's sampling has a `mix`), and the cell calls made.
+   */
   async rowsFor(control: ArrayLike<number>, z1: Float32Array, zs?: Float32Array, signal?: AbortSignal): Promise<{ rows: Float64Array; cellCalls: number }> {
     const { pooling, rows: layout, normalisation } = this.info;
     const frames = control.length / 3;
@@ -184,7 +201,8 @@ export class VaeLstmCore {
     padded.set(control);
     for (let f = frames; f < padded.length / 3; f++) padded.set(padded.subarray((frames - 1) * 3, frames * 3), f * 3);
     const hc = await this.encodeControl(padded, signal);
-    const { canvas, calls } = await this.runCell(hc, z1, zs, signal);
+    const free = zs ? undefined : freeLatents(z1, hc.length / this.info.control_features, this.info.sampling);
+    const { canvas, calls } = await this.runCell(hc, z1, zs ?? free?.zs, signal, free?.mix);
     const normalised = await this.decode(canvas, signal);
     const D = layout.dim;
     const rows = new Float64Array(frames * D);
