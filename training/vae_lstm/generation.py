@@ -4,10 +4,8 @@
   cell run on its own state for every step, the canvas decoded in one pass.
 - Or (the paper's other way, §3.3: "we could also consider sampling a latent variable z_t for each frame"):
   a latent per step in teacher mode, drawn as an AR(1) sequence with N(0, I) marginals and lag-one
-  correlation rho (the posterior's own latents are correlated from step to step). Or between the two ("nudged",
-  measured in the report, not in the page): free mode whose content each step is mix · z_t + (1 − mix) · the
-  previous state. Which a shipped model uses is in its JSON (`sampling`), chosen by measurement
-  (docs/models/vae-lstm.md).
+  correlation rho (the posterior's own latents are correlated from step to step). Which a shipped model uses is
+  in its JSON (`sampling`), chosen by measurement (docs/models/vae-lstm.md).
 - A model trained with --free-mix also reads z_1 in every step of its free mode (free_latents; its JSON's sampling
   {"mode": "z1", "mix": …}), for prior samples and starts from 4 frames alike: the cell then cannot forget it.
 - From the posterior: z_1 is the mean of q(z_1 | 4 initial frames). The inference network is convolutional

@@ -95,15 +95,15 @@ class ShippedVae:
         return self.sessions["inference"].run(["mean"], {"rows": x[None]})[0][0, 0]
 
     def prior(self, seed: int, frames: int, sampling: dict | None = None) -> tuple[np.ndarray, np.ndarray | None, float]:
-        """A seed's prior sample for `frames` frames, drawn as the page draws it: z1, per-step latents unless the
-        sampling (default the JSON's) is "z1", and the share of each step's content they give (rows' `mix`):
-        1 for "steps" (teacher mode), the sampling's `mix` for "nudged" (free mode nudged by them)."""
+        """A seed's prior sample for `frames` frames, drawn as the page draws it: z1, the per-step latents and the
+        share of each step's content they give (rows' `mix`): for "steps" a latent per step in teacher mode, for
+        "z1" what the model's free mode reads (generation.free_latents)."""
         sampling = sampling or self.info["sampling"]
         if sampling["mode"] == "z1":
             z1, _ = prior_latents(seed, self.info["latent"])
             return (z1, *free_latents(z1, -(-frames // 4), sampling))
         z1, zs = prior_latents(seed, self.info["latent"], -(-frames // 4), sampling["rho"])
-        return z1, zs, 1.0 if sampling["mode"] == "steps" else float(sampling["mix"])
+        return z1, zs, 1.0
 
     def world(self, control: np.ndarray, z1: np.ndarray, zs: np.ndarray | None = None, mix: float | None = None,
               start_xz=(0.0, 0.0), start_heading: float = 0.0) -> tuple[np.ndarray, np.ndarray]:

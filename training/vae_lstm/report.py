@@ -20,12 +20,20 @@ REPORT_JSON = REPORTS_DIR / "vae-lstm.json"
 BROWSER_JSON = REPORTS_DIR / "vae-lstm-browser.json"
 ERD_JSON = REPORTS_DIR / "latent-erd.json"
 NOTES_JSON = REPORTS_DIR / "vae-lstm-notes.json"
-TRAINING_RUNS = ("vae-lstm", "vae-lstm-e100")
+TRAINING_RUNS = ("vae-lstm", "vae-lstm-e100", "vae-lstm-mix")
 LONG_RUN_SEEDS = 5
-# The ways of drawing a prior sample compared (generation.py); the shipped one is vae-lstm.json's `sampling`.
-SAMPLINGS = {"one z1 (Algorithm 1)": {"mode": "z1"}, "a latent per step, rho 0": {"mode": "steps", "rho": 0.0},
-             "a latent per step, rho 0.9": {"mode": "steps", "rho": 0.9},
-             "one z1, nudged by latents (rho 0.9, mix 0.2)": {"mode": "nudged", "rho": 0.9, "mix": 0.2}}
+# The ways of drawing a prior sample compared (generation.py), beside the shipped one (vae-lstm.json's `sampling`).
+OTHER_SAMPLINGS = {"a latent per step, rho 0": {"mode": "steps", "rho": 0.0}, "a latent per step, rho 0.9": {"mode": "steps", "rho": 0.9}}
+
+
+def samplings(shipped: dict) -> dict[str, dict]:
+    """The shipped sampling first; for a model trained with z1 in every step (`mix`), also the paper's Algorithm 1
+    on it (z1 only the first state), then OTHER_SAMPLINGS."""
+    mix = shipped.get("mix", 0.0) if shipped["mode"] == "z1" else 0.0
+    if not mix:
+        return {"one z1 (Algorithm 1, shipped)": shipped, **OTHER_SAMPLINGS}
+    return {f"one z1, also {mix:.0%} of every step (shipped)": shipped, "one z1 as Algorithm 1 (only the first state)": {"mode": "z1"},
+            **OTHER_SAMPLINGS}
 
 
 def evaluate(mocap: str | None, previous: dict, models_dir: Path = MODELS_DIR) -> dict:
@@ -36,7 +44,7 @@ def evaluate(mocap: str | None, previous: dict, models_dir: Path = MODELS_DIR) -
 
     report["sampling"] = vae.info["sampling"]
     windows = erd_measures.prediction_windows(corpus)
-    rows = m.prediction_rows(vae, corpus, windows, SAMPLINGS)
+    rows = m.prediction_rows(vae, corpus, windows, samplings(vae.info["sampling"]))
     if ERD_JSON.exists():
         erd = json.loads(ERD_JSON.read_text()).get("prediction", {})
         if erd.get("windows") == len(windows):
@@ -62,7 +70,7 @@ def evaluate(mocap: str | None, previous: dict, models_dir: Path = MODELS_DIR) -
                            "real_frame_change_cm": erd_measures.real_frame_change(corpus)}
     report["diversity"] = m.diversity(vae, corpus)
     report["samplings"] = {}
-    for name, sampling in SAMPLINGS.items():
+    for name, sampling in samplings(vae.info["sampling"]).items():
         stats = [m.freeze_stats(m.long_run(vae, seed, sampling=sampling)["positions"], fps, median) for seed in range(LONG_RUN_SEEDS)]
         runs_s = m.held_out_control_runs(vae, corpus, sampling)
         report["samplings"][name] = {
@@ -156,7 +164,8 @@ def write_markdown(r: dict, notes: dict, path: Path) -> None:
     lines += ["", f"![prior samples beside the real window]({VARIATIONS_PNG})", ""] + notes.get("diversity", [])
     lines += ["", "### Ways of drawing a prior sample", "",
               "The same measures for each way of drawing a prior sample (generation.py): one z1 and the cell on its own state "
-              "(Algorithm 1), or a latent per step in teacher mode (the paper's other way), independent (rho 0) or correlated "
+              "(Algorithm 1; for a model trained with z1 in every step's content, `mix`, also that share of each step), or a latent "
+              "per step in teacher mode (the paper's other way), independent (rho 0) or correlated "
               f"from step to step (AR(1), rho 0.9). The page uses `{json.dumps(r['sampling'])}` (vae-lstm.json). Jitter: RMS second "
               f"difference of the joints relative to the hips, real held-out clips {r['jitter_real_cm']} cm per frame².", "",
               _row(["prior sample", "diversity (cm)", "long runs: lowest second / median", "mean median second / median", "seconds below 20%",
