@@ -107,9 +107,13 @@ class VaeLstm(nn.Module):
         """Algorithm 1: frames (batch, frames, dim) for a control signal (batch, frames, control) from one
         latent sample z1 (batch, latent), the cell running on its own state (with `mix` > 0 z1 is also that share
         of every step's content)."""
-        hc = self.control_encoder(control)
-        canvas, _ = self.cell.run(z1, hc, z1[:, None].expand(-1, hc.shape[1], -1), mix) if mix > 0 else self.cell.run(z1, hc)
-        return self.decoder(canvas)
+        return self.decoder(self.free_canvas(z1, self.control_encoder(control), mix))
+
+    def free_canvas(self, z1: torch.Tensor, hc: torch.Tensor, mix: float = 0.0) -> torch.Tensor:
+        """The free mode's canvas (batch, steps, latent) from z1 over control encodings `hc`: the cell on its own
+        state, z1 its first state and, with `mix` > 0, that share of every step's content."""
+        latents = z1[:, None].expand(-1, hc.shape[1], -1) if mix > 0 else None
+        return self.cell.run(z1, hc, latents, mix)[0]
 
     def posterior_first(self, seed: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         """q(z_1 | the first 4 frames): mean and log-variance (batch, latent) of the first step of `seed` (batch,

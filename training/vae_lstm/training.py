@@ -113,9 +113,7 @@ def losses(model: VaeLstm, x: torch.Tensor, control: torch.Tensor, free_z1: str 
         own = torch.ones(x.shape[0], 1, dtype=torch.bool) if free_z1 == "window" else (torch.arange(x.shape[0]) % 2 == 1)[:, None]
         m1, v1 = torch.where(own, mean[:, 0], m1), torch.where(own, log_var[:, 0], v1)
     z1 = sample(m1, v1)
-    # free_mix > 0: z_1 is also part of every step's content (mix · z_1 + (1 − mix) · the previous state).
-    free_canvas, _ = model.cell.run(z1, hc, z1[:, None].expand(-1, hc.shape[1], -1), free_mix) if free_mix > 0 else model.cell.run(z1, hc)
-    free_rows = model.decoder(free_canvas)
+    free_rows = model.decoder(model.free_canvas(z1, hc, free_mix))
     free = ((free_rows - x) ** 2).mean()
     return {"teacher": teacher, "kl": kl, "free": free, "kl_first": kl_per_step(m1, v1).mean(),
             "energy": energy_loss(free_rows[..., :POSITION_DIM], x[..., :POSITION_DIM])}

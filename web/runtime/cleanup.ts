@@ -191,7 +191,7 @@ export function mapCleaner(args: { step: StepFn; info: GeneratorInfo; mean: Arra
  * is roughly white has a position spectrum falling as f⁻⁴ against white noise of variance σ², so the crossover goes
  * as σ^(-1/2): 4 Hz at 3 cm (measured best there), about 7 Hz at 1 cm and 3 Hz at 5 cm, kept within 2-8 Hz.
  */
-export function slowBandHz(jitter: number): number {
+function slowBandHz(jitter: number): number {
   return Math.min(8, Math.max(2, 4 * Math.sqrt(0.03 / Math.max(jitter, 1e-6))));
 }
 

@@ -157,12 +157,12 @@ export class VaeLstmCore {
    * on its own state (Algorithm 1), or with `zs` (steps × latent) each step's content mix · z_t + (1 − mix) · the
    * previous state (mix default 1: teacher mode on those latents).
    */
-  async runCell(hc: Float32Array, state: Float32Array, zs?: Float32Array, signal?: AbortSignal, share?: number): Promise<{ canvas: Float32Array; state: Float32Array; calls: number }> {
+  async runCell(hc: Float32Array, state: Float32Array, zs?: Float32Array, signal?: AbortSignal, mix = 1): Promise<{ canvas: Float32Array; state: Float32Array; calls: number }> {
     const { chunk_steps: K, latent: Z, control_features: F } = this.info;
     const steps = hc.length / F;
     if (zs && zs.length < steps * Z) throw new Error(`zs has ${zs.length / Z} steps; the control needs ${steps}`);
     const canvas = new Float32Array(steps * Z);
-    const mix = Float32Array.of(zs ? (share ?? 1) : 0);
+    const share = Float32Array.of(zs ? mix : 0);
     let calls = 0;
     for (let at = 0; at < steps; at += K) {
       const part = new Float32Array(K * F);
@@ -172,7 +172,7 @@ export class VaeLstmCore {
         part.set(hc.subarray(src * F, (src + 1) * F), k * F);
         if (zs) z.set(zs.subarray(src * Z, (src + 1) * Z), k * Z);
       }
-      const read = await this.graph('cell').call({ hc: [part, [1, K, F]], state: [state, [1, Z]], z: [z, [1, K, Z]], mix: [mix, [1]] }, signal);
+      const read = await this.graph('cell').call({ hc: [part, [1, K, F]], state: [state, [1, Z]], z: [z, [1, K, Z]], mix: [share, [1]] }, signal);
       const out = read('canvas', K * Z);
       canvas.set(out.subarray(0, Math.min(K, steps - at) * Z), at * Z);
       // The state after the last real step (the padded steps only fill the chunk).
