@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from training.fixtures.mixture_parity import BOUNDARY_MARGIN, OUT, boundary_distance, build_from, float32_values, step_outputs
-from training.generator.sampling import choose_component, draw_mixture, sample_mixture, snap_contacts
+from training.generator.sampling import choose_component, draw_mixture, held_normals, sample_mixture, snap_contacts
 
 
 @pytest.fixture(scope="module")
@@ -75,3 +75,19 @@ def test_choose_component_follows_the_tempered_cumulative_weights():
     assert [choose_component(w, 1.0, u) for u in (0.0, 0.19, 0.21, 0.49, 0.51, 0.999)] == [0, 0, 1, 1, 2, 2]
     # τ = 0.5 squares the weights: 0.04, 0.09, 0.25 of 0.38.
     assert [choose_component(w, 0.5, u) for u in (0.10, 0.11, 0.33, 0.35)] == [0, 1, 1, 2]
+
+
+def test_held_normals_drift_but_stay_standard_normal():
+    rng = np.random.default_rng(0)
+    fresh = rng.standard_normal((200, 4000))
+    assert np.array_equal(held_normals(None, fresh[0], 0.9), fresh[0])  # a stream's first frame
+    assert np.array_equal(held_normals(fresh[0], fresh[1], 0.0), fresh[1])  # correlation 0: the old sampler
+    z, steps, values = None, [], []
+    for n in fresh:
+        new = held_normals(z, n, 0.9)
+        if z is not None:
+            steps.append(np.mean((new - z) ** 2))
+        z = new
+        values.append(z)
+    assert abs(np.mean(steps) - 2 * (1 - 0.9)) < 0.01  # E[(z_t - z_{t-1})^2] = 2(1 - rho)
+    assert abs(np.var(np.concatenate(values)) - 1) < 0.02

@@ -1,7 +1,7 @@
 // The mixture sampler: seeded determinism, τ = 0, draw statistics against the analytic moments of a
 // known mixture, temperature sharpening, and contact snapping.
 import { describe, expect, it } from 'vitest';
-import { chooseComponent, denormalise, Rng, sampleMixture, snapContacts, type MixtureBatch } from '../../web/model/sampler';
+import { chooseComponent, denormalise, Rng, sampleMixture, snapContacts, type HeldNoise, type MixtureBatch } from '../../web/model/sampler';
 
 // Batch of 2 rows, 3 components, 2 dimensions.
 const WEIGHTS = [0.2, 0.5, 0.3];
@@ -60,6 +60,31 @@ describe('sampleMixture', () => {
     const b = sampleMixture(m, 1, new Rng(5));
     expect(Array.from(b)).toEqual(Array.from(a));
     expect(Array.from(sampleMixture(m, 1, new Rng(6)))).not.toEqual(Array.from(a));
+  });
+
+  it('held normals: correlation 0 draws what fresh normals draw; a high correlation moves less from frame to frame but keeps the spread', () => {
+    // One component, so every change between frames comes from the normals.
+    const m: MixtureBatch = { batch: 2000, mixtures: 1, dim: 2, weights: new Float32Array(2000).fill(1), mu: new Float32Array(4000), sigma: new Float32Array(4000).fill(1) };
+    const frames = (held: HeldNoise | undefined, seed: number) => {
+      const rng = new Rng(seed);
+      return Array.from({ length: 20 }, () => sampleMixture(m, 1, rng, undefined, held));
+    };
+    const fresh = frames(undefined, 3);
+    const zero = frames({ correlation: 0 }, 3);
+    zero.forEach((x, t) => expect(Array.from(x)).toEqual(Array.from(fresh[t])));
+    const stats = (xs: Float32Array[]) => {
+      let step = 0, square = 0, n = 0;
+      for (let t = 1; t < xs.length; t++) for (let i = 0; i < xs[t].length; i++, n++) {
+        step += (xs[t][i] - xs[t - 1][i]) ** 2;
+        square += xs[t][i] ** 2;
+      }
+      return { step: step / n, variance: square / n };
+    };
+    const a = stats(fresh), b = stats(frames({ correlation: 0.9 }, 3));
+    // E[(z_t − z_{t−1})²] = 2(1 − ρ): 2 for fresh normals, 0.2 at ρ = 0.9; the variance stays 1.
+    expect(a.step).toBeGreaterThan(1.9);
+    expect(b.step).toBeLessThan(0.25);
+    expect(Math.abs(b.variance - 1)).toBeLessThan(0.05);
   });
 
   it('returns the heaviest component mean at τ = 0, per row', () => {

@@ -6,7 +6,7 @@
 // components and the float32 frames must be identical (no tolerance); the uniforms keep 1e-9 from any
 // component boundary, so rounding in exp/log cannot flip a choice.
 import { describe, expect, it } from 'vitest';
-import { chooseComponent, sampleMixture, snapContacts, type MixtureBatch, type RandomSource } from '../../web/model/sampler';
+import { chooseComponent, sampleMixture, snapContacts, type HeldNoise, type MixtureBatch, type RandomSource } from '../../web/model/sampler';
 import { readRepoFile } from './corpus';
 
 interface Case {
@@ -30,6 +30,8 @@ interface Fixture {
   mean: number[];
   std: number[];
   cases: Case[];
+  /** Draws in a row with held normals: per step the uniforms, the fresh normals, the held ones and the frame. */
+  held: { temperature: number; correlation: number; steps: { u: number[]; z: number[]; held: number[]; x: number[] }[] };
 }
 
 const fixture = JSON.parse(readRepoFile('tests/fixtures/mixture_parity.json')) as Fixture;
@@ -44,7 +46,7 @@ const mixture: MixtureBatch = {
 };
 
 /** Gives the fixture's numbers in the order sampleMixture asks for them: per row one uniform, then D normals. */
-function replay(c: Case): RandomSource & { left: () => number } {
+function replay(c: Pick<Case, 'u' | 'z'>): RandomSource & { left: () => number } {
   const values: number[] = [];
   for (let b = 0; b < B; b++) values.push(c.u[b], ...c.z.slice(b * D, (b + 1) * D));
   let i = 0;
@@ -88,4 +90,21 @@ describe('mixture sampling matches training/generator/sampling.py', () => {
       expect(contacts).toEqual(Array.from(Float32Array.from(c.snapped_contacts)));
     });
   }
+
+  it('normals held over frames (generator.json sampling): the same held normals and the same float32 frames, step after step', () => {
+    const { temperature, correlation, steps } = fixture.held;
+    expect(correlation).toBeGreaterThan(0);
+    expect(steps.length).toBeGreaterThan(1);
+    const held: HeldNoise = { correlation };
+    for (const step of steps) {
+      const rng = replay(step);
+      const x = sampleMixture(mixture, temperature, rng, undefined, held);
+      expect(rng.left()).toBe(0);
+      expect(Array.from(held.previous!)).toEqual(step.held);
+      expect(Array.from(x)).toEqual(Array.from(Float32Array.from(step.x)));
+    }
+    // The first step took its fresh normals as they are; the later ones did not.
+    expect(steps[0].held).toEqual(steps[0].z);
+    expect(steps[1].held).not.toEqual(steps[1].z);
+  });
 });

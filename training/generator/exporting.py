@@ -21,6 +21,7 @@ from ..onnx.sessions import cpu_session
 from ..paths import MODELS_DIR, REPO_ROOT
 from .graph import INPUTS, OUTPUTS, check_parity, export_onnx
 from .recovery import model_from_onnx
+from .sampling import NOISE_CORRELATION
 from .shipped import seed_batch
 from .training import load_generator
 
@@ -130,6 +131,14 @@ def rewrite_generator(source: Path, out: Path, weights: str) -> Path:
     return onnx_path
 
 
+def sampling_info() -> dict:
+    """generator.json's "sampling": how the page draws from the mixture (training/generator/sampling.py)."""
+    return {"noise_correlation": NOISE_CORRELATION,
+            "rule": "per frame and row: one uniform picks the component (weights^(1/temperature)), then dim fresh normals n; "
+                    "z = noise_correlation * z_previous + sqrt(1 - noise_correlation^2) * n (z = n on a stream's first frame); "
+                    "x = mu + sigma * temperature * z"}
+
+
 def export_generator(checkpoint: Path, out: Path, mocap: str | None, weights: str = "int8") -> Path:
     """Writes out/generator.onnx and out/generator.json (skeleton, feature layout, normalisation, rotation
     references, seed states, training and parity numbers); into MODELS_DIR also the fixture and the manifest
@@ -163,6 +172,7 @@ def export_generator(checkpoint: Path, out: Path, mocap: str | None, weights: st
         },
         "normalisation": {"mean": [round(float(v), 7) for v in mean], "std": [round(float(v), 7) for v in std]},
         "seeds": seeds,
+        "sampling": sampling_info(),
         "training": {"epochs": state.get("epoch"), "valid_nll_per_frame": state.get("valid_nll"),
                      "valid_files": meta["valid_files"], "train_frames": meta["train_frames"],
                      "args": meta["args"]},

@@ -8,6 +8,10 @@ from __future__ import annotations
 import numpy as np
 
 WEIGHT_FLOOR = 1e-12  # log(max(w, floor)): a zero weight stays finite under the temperature
+# How much of each frame's normals carries over to the next (generator.json "sampling"): drawn anew every frame the
+# per-frame noise made sampled walking shake at 3x real motion's jitter. Chosen by measurement in
+# docs/models/refiner.md ("Sampling noise held over frames").
+NOISE_CORRELATION = 0.8
 
 
 def tempered_weights(w: np.ndarray, temperature: float) -> np.ndarray:
@@ -41,6 +45,16 @@ def draw_mixture(w: np.ndarray, mu: np.ndarray, sigma: np.ndarray, temperature: 
     k = np.array([choose_component(w[b], temperature, u[b]) for b in rows])
     x = mu[rows, k].astype(np.float64) + sigma[rows, k].astype(np.float64) * temperature * np.asarray(z, np.float64)
     return x.astype(np.float32)
+
+
+def held_normals(previous: np.ndarray | None, fresh: np.ndarray, correlation: float) -> np.ndarray:
+    """Standard normals that drift instead of jumping: correlation·previous + sqrt(1 − correlation²)·fresh, an AR(1)
+    sequence whose every value is still N(0, 1). Without previous normals (a stream's first frame) the fresh ones.
+    Correlation 0 gives the fresh ones exactly. float64, as the page computes it (web/model/sampler.ts heldNormals)."""
+    fresh = np.asarray(fresh, np.float64)
+    if previous is None:
+        return fresh.copy()
+    return correlation * np.asarray(previous, np.float64) + np.sqrt(1.0 - correlation * correlation) * fresh
 
 
 def sample_mixture(w: np.ndarray, mu: np.ndarray, sigma: np.ndarray, temperature: float, rng: np.random.Generator) -> np.ndarray:

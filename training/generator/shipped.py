@@ -13,7 +13,7 @@ from ..data.locomotion import LocomotionClip
 from ..mocap.rotations import quat_to_matrix
 from ..mocap.skeleton import canonical_skeleton
 from ..onnx.sessions import cpu_session
-from .sampling import sample_mixture, snap_contacts
+from .sampling import draw_mixture, held_normals, snap_contacts
 
 
 @dataclass
@@ -55,17 +55,32 @@ class ShippedGenerator:
         """The step inputs (x, h, c) of a batch that starts from the seed states `indices` (seed_batch)."""
         return seed_batch(self.info, indices)
 
+    @property
+    def noise_correlation(self) -> float:
+        """generator.json's sampling.noise_correlation: how much of each frame's normals carries to the next (0 if absent)."""
+        return float(self.info.get("sampling", {}).get("noise_correlation", 0.0))
+
     def sample(self, seeds: list[int], frames: int, temperature: float = 1.0, rng: np.random.Generator | None = None,
-               progress: bool = False) -> np.ndarray:
-        """Features (len(seeds), frames, dim) in physical units, one stream per seed, batched in one session call per step."""
+               progress: bool = False, noise_correlation: float | None = None) -> np.ndarray:
+        """Features (len(seeds), frames, dim) in physical units, one stream per seed, batched in one session call per
+        step, drawn as the page draws them: per row one uniform, then dim fresh normals held over frames with
+        `noise_correlation` (default: generator.json's)."""
         rng = rng or np.random.default_rng(0)
+        corr = self.noise_correlation if noise_correlation is None else noise_correlation
         b = len(seeds)
         x, h, c = self.seed_batch(seeds)
         out = np.zeros((b, frames, len(self.mean)), np.float32)
+        z = None
         for t in tqdm(range(frames), desc="sampling", unit="frame", disable=not progress):
             w, mu, sigma, h, c = self.session.run(None, {"x": x, "h": h, "c": c})
+            if temperature <= 0:
+                x = draw_mixture(w, mu, sigma, temperature)
+            else:
+                u = rng.random(b)
+                z = held_normals(z, rng.standard_normal((b, mu.shape[-1])), corr)
+                x = draw_mixture(w, mu, sigma, temperature, u, z)
             # Contacts are bits: feed back a clean 0 or 1, as in the training data.
-            x = snap_contacts(sample_mixture(w, mu, sigma, temperature, rng), self.mean, self.std)
+            x = snap_contacts(x, self.mean, self.std)
             out[:, t] = x * self.std + self.mean
         return out
 

@@ -149,7 +149,7 @@ def evaluate_refiner(frames: int, n_seeds: int, mocap: str | None, models_dir: P
 
     real_m, real_speeds, real_planted = variant_measures(real, fps, skel, None)
     report = {"frames_per_seed": frames, "seeds": [gen.info["seeds"][s]["name"] for s in seeds], "temperature": TEMPERATURE,
-              "fps": fps, "real": dict(real_m, clips=len(real), frames=int(sum(len(r.positions) for r in real))),
+              "noise_correlation": gen.noise_correlation, "fps": fps, "real": dict(real_m, clips=len(real), frames=int(sum(len(r.positions) for r in real))),
               "variants": {}}
     speeds_all, planted_all = {"real": real_speeds}, {"real": real_planted}
     for v in VARIANTS:

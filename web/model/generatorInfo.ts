@@ -39,6 +39,8 @@ export interface GeneratorInfo {
   };
   normalisation: { mean: number[]; std: number[] };
   seeds: GeneratorSeed[];
+  /** How the page draws from the mixture; absent = fresh normals every frame. */
+  sampling?: { noise_correlation: number };
 }
 
 export interface GeneratorSeed {
@@ -119,6 +121,10 @@ const format = modelInfoFormat<GeneratorInfo>('GeneratorInfoError', 'generator.j
     numbers(seed.c, `seeds[${i}].c`, layers * hidden);
   });
 
+  if (root.sampling !== undefined) {
+    const c = obj(root.sampling, 'sampling').noise_correlation;
+    if (typeof c !== 'number' || !(c >= 0 && c < 1)) fail(`sampling.noise_correlation must be a number from 0 up to (not including) 1, got ${String(c)}`);
+  }
 });
 
 export const GeneratorInfoError = format.InfoError;

@@ -45,17 +45,35 @@ export function chooseComponent(weights: ArrayLike<number>, temperature: number,
 }
 
 /**
- * One draw per batch row: component k with probability ∝ w_k^(1/τ), then mu_k + sigma_k·τ·N(0, 1) per
- * dimension; a row takes one uniform, then D normals. τ ≤ 0 takes the heaviest component's mean and uses no
- * random numbers.
+ * Normals held over a stream's frames (generator.json "sampling"): each frame's normal is
+ * correlation·previous + sqrt(1 − correlation²)·fresh, so the noise drifts instead of jumping every frame and
+ * each value is still N(0, 1). Mirrors training/generator/sampling.py held_normals.
  */
-export function sampleMixture(m: MixtureBatch, temperature: number, rng: RandomSource, out = new Float32Array(m.batch * m.dim)): Float32Array {
+export interface HeldNoise {
+  correlation: number;
+  /** batch × dim normals of the last draw; undefined before a stream's first frame (which takes the fresh ones). */
+  previous?: Float64Array;
+}
+
+export function heldNormal(previous: number, fresh: number, correlation: number): number {
+  return correlation * previous + Math.sqrt(1 - correlation * correlation) * fresh;
+}
+
+/**
+ * One draw per batch row: component k with probability ∝ w_k^(1/τ), then mu_k + sigma_k·τ·z per dimension with
+ * z standard normals (fresh, or held over frames with `held`, which is updated); a row takes one uniform, then D
+ * fresh normals. τ ≤ 0 takes the heaviest component's mean and uses no random numbers.
+ */
+export function sampleMixture(m: MixtureBatch, temperature: number, rng: RandomSource, out = new Float32Array(m.batch * m.dim), held?: HeldNoise): Float32Array {
   const { batch, mixtures: M, dim: D } = m;
   if (m.weights.length !== batch * M || m.mu.length !== batch * M * D || m.sigma.length !== batch * M * D) {
     throw new Error(`sampleMixture: output sizes (${m.weights.length}, ${m.mu.length}, ${m.sigma.length}) do not fit batch ${batch}, ${M} mixtures, dim ${D}`);
   }
   if (out.length !== batch * D) throw new Error(`sampleMixture: out has ${out.length} values, expected ${batch * D}`);
   const scratch = new Float64Array(M);
+  const previous = held?.previous;
+  if (previous && previous.length !== batch * D) throw new Error(`sampleMixture: ${previous.length} held normals, expected ${batch * D}`);
+  const normals = held && temperature > 0 ? new Float64Array(batch * D) : undefined;
   for (let b = 0; b < batch; b++) {
     const w = m.weights.subarray(b * M, (b + 1) * M);
     let k = 0;
@@ -66,9 +84,17 @@ export function sampleMixture(m: MixtureBatch, temperature: number, rng: RandomS
     }
     const src = (b * M + k) * D;
     for (let d = 0; d < D; d++) {
-      out[b * D + d] = temperature <= 0 ? m.mu[src + d] : m.mu[src + d] + m.sigma[src + d] * temperature * rng.normal();
+      if (temperature <= 0) {
+        out[b * D + d] = m.mu[src + d];
+        continue;
+      }
+      const fresh = rng.normal();
+      const z = previous ? heldNormal(previous[b * D + d], fresh, held!.correlation) : fresh;
+      if (normals) normals[b * D + d] = z;
+      out[b * D + d] = m.mu[src + d] + m.sigma[src + d] * temperature * z;
     }
   }
+  if (held && normals) held.previous = normals;
   return out;
 }
 

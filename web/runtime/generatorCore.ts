@@ -7,7 +7,7 @@ import { setStateRow } from '../model/lstmState';
 import type { GeneratorInfo, StepInputs, StepOutputs } from '../model/generatorInfo';
 import type { BenchmarkResult, GeneratedChunk, GenerateParams, InitResult, ParityResult, StreamInfo, StreamParams } from './protocol';
 import type { RefinerCore, RefinerStream } from './refinerCore';
-import { denormalise, Rng, sampleMixture, snapContacts } from '../model/sampler';
+import { denormalise, Rng, sampleMixture, snapContacts, type HeldNoise } from '../model/sampler';
 import { checkFrameCount, SessionCore, timeSteps } from './session';
 
 /** One generation stream: the LSTM input and state, the PRNG and where the root stands. */
@@ -18,6 +18,8 @@ export interface GeneratorStream {
   h: Float32Array;
   c: Float32Array;
   rng: Rng;
+  /** The sampler's normals, held over frames (generator.json sampling.noise_correlation). */
+  noise: HeldNoise;
   root: RootStart;
   frame: number;
   /** With params.refine: the refiner's state behind this stream (made on the first advance). */
@@ -118,6 +120,7 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
       h: Float32Array.from(seed.h),
       c: Float32Array.from(seed.c),
       rng: new Rng(params.seed),
+      noise: { correlation: this.info.sampling?.noise_correlation ?? 0 },
       root: { x: 0, z: 0, heading: 0 },
       frame: 0,
     };
@@ -146,7 +149,7 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
     const fedBack = refiner ? new Float32Array(frames * D) : undefined;
     for (let t = 0; t < frames; t++) {
       const out = await this.step(1, stream.x, stream.h, stream.c, signal);
-      const x = sampleMixture({ weights: out.weights, mu: out.mu, sigma: out.sigma, batch: 1, mixtures: M, dim: D }, stream.params.temperature, stream.rng);
+      const x = sampleMixture({ weights: out.weights, mu: out.mu, sigma: out.sigma, batch: 1, mixtures: M, dim: D }, stream.params.temperature, stream.rng, undefined, stream.noise);
       snapContacts(x, D, this.mean, this.std);
       denormalise(x, this.mean, this.std, features.subarray(t * D, (t + 1) * D));
       fedBack?.set(x, t * D);
