@@ -8,7 +8,9 @@ contact bits too. FC2 starts at zero, so an untrained R is the identity.
 
 D (sees whole windows, bidirectional):
     d_input = [p_end(x), v_end(x), contacts(x)]                           (eq. 12 plus the contact bits, §4.3)
-    optionally + the rest of x (training.refiner.train --d-pose): D then judges the whole pose, not only the end effectors
+    optionally + the rest of x (training.refiner.train --d-input pose): D then judges the whole pose, not only the end effectors
+    or, with --d-input joints, [p_all, v_all, contacts(x)]: every joint's root-frame position and velocity, what the refiner
+    report's two-sample classifiers see (JointFeatures)
     D(x)    = FC2(BiLSTM(relu(FC1(d_input))))   -> one logit per frame
 
 End effectors (END_EFFECTORS: wrists, ankles, toes, top of the head) are expressed in the character's root
@@ -128,6 +130,22 @@ class FeatureGeometry(nn.Module):
         return torch.stack([torch.cumsum(dx, -1), f[..., 3], torch.cumsum(dz, -1)], dim=-1)
 
 
+class ConvDiscriminator(nn.Module):
+    """A window discriminator shaped like the refiner report's two-sample window classifier (three 1-D convolutions of
+    kernel 5, the last with stride 2, mean pooling, one logit per window), so D judges windows as the test does."""
+
+    def __init__(self, inputs: int, width: int = 64):
+        super().__init__()
+        self.net = nn.Sequential(nn.Conv1d(inputs, width, 5, padding=2), nn.LeakyReLU(0.2),
+                                 nn.Conv1d(width, width, 5, padding=2), nn.LeakyReLU(0.2),
+                                 nn.Conv1d(width, width, 5, padding=2, stride=2), nn.LeakyReLU(0.2))
+        self.out = nn.Linear(width, 1)
+
+    def forward(self, d: torch.Tensor) -> torch.Tensor:
+        """d (B, T, inputs) -> logits (B, 1) of 'real'."""
+        return self.out(self.net(d.transpose(1, 2)).mean(-1))
+
+
 def straight_through_bits(c: torch.Tensor) -> torch.Tensor:
     """Contact bits (> 0.5) in the forward pass, the identity's gradient in the backward pass: D sees clean
     0/1 bits for real and refined motion alike, and R still gets a gradient for its contact outputs."""
@@ -190,18 +208,50 @@ class Discriminator(nn.Module):
         return self.fc2(y).squeeze(-1)
 
 
-def discriminator_input(refiner: Refiner, x: torch.Tensor, x_prev: torch.Tensor, with_pose: bool = False) -> torch.Tensor:
-    """[p_end, v_end (normalised as R's input), contact bits] (B, T, 6E + 2) of normalised frames x after x_prev
-    (eq. 12 with the contacts of §4.3); with_pose appends the other features of x (root motion, tilt, joint
-    rotations; normalised), (B, T, 6E + 2 + D - 2)."""
-    e = refiner.end_features(x, x_prev)
+class JointFeatures(nn.Module):
+    """Every joint's root-frame position and its velocity (FeatureGeometry over all joints), normalised by statistics
+    of real windows: the per-frame view of the refiner report's two-sample classifiers
+    (training/refiner/measures.classifier_frames), so a discriminator on it judges what they judge."""
+
+    def __init__(self, references: np.ndarray, mean: np.ndarray, std: np.ndarray, fps: float = 30.0):
+        super().__init__()
+        self.geometry = FeatureGeometry(references, fps=fps, end_effectors=tuple(canonical_skeleton().joints))
+        self.register_buffer("mean", torch.tensor(np.asarray(mean), dtype=torch.float32))
+        self.register_buffer("std", torch.tensor(np.asarray(std), dtype=torch.float32))
+
+    def physical(self, f: torch.Tensor, f_prev: torch.Tensor) -> torch.Tensor:
+        """Physical frames f (B, T, D) after f_prev (B, D) -> [p_all, v_all] (B, T, 6J), metres and m/s: positions in
+        the frame's root frame, velocities turned from the previous frame's heading frame into this frame's, as
+        classifier_frames has them (tests/python/test_refiner.py checks the two agree)."""
+        p, v = self.geometry.end_effectors(f, f_prev)
+        v = (yaw_matrix(-f[..., 2]).unsqueeze(-3) @ v.unsqueeze(-1)).squeeze(-1)
+        return torch.cat([p.flatten(-2), v.flatten(-2)], dim=-1)
+
+    def forward(self, f: torch.Tensor, f_prev: torch.Tensor) -> torch.Tensor:
+        return (self.physical(f, f_prev) - self.mean) / self.std
+
+
+DISCRIMINATOR_INPUTS = ("ends", "pose", "joints")
+
+
+def discriminator_input(refiner: Refiner, x: torch.Tensor, x_prev: torch.Tensor, kind: str = "ends",
+                        joints: JointFeatures | None = None) -> torch.Tensor:
+    """D's input for normalised frames x after x_prev. kind "ends": [p_end, v_end (normalised as R's input), contact
+    bits] (B, T, 6E + 2), eq. 12 with the contacts of §4.3; "pose": that plus the other features of x (root motion,
+    tilt, joint rotations; normalised), (B, T, 6E + 2 + D - 2); "joints": [joints(physical x), contact bits]
+    (B, T, 6J + 2), the classifiers' view."""
     bits = straight_through_bits(refiner.physical(x)[..., -2:])
-    parts = [e, bits] + ([x[..., :-2]] if with_pose else [])
+    if kind == "joints":
+        return torch.cat([joints(refiner.physical(x), refiner.physical(x_prev)), bits], dim=-1)
+    e = refiner.end_features(x, x_prev)
+    parts = [e, bits] + ([x[..., :-2]] if kind == "pose" else [])
     return torch.cat(parts, dim=-1)
 
 
-def discriminator_inputs(refiner: Refiner, with_pose: bool) -> int:
-    return 6 * refiner.ends + 2 + (refiner.dim - 2 if with_pose else 0)
+def discriminator_inputs(refiner: Refiner, kind: str) -> int:
+    if kind == "joints":
+        return 6 * len(canonical_skeleton().joints) + 2
+    return 6 * refiner.ends + 2 + (refiner.dim - 2 if kind == "pose" else 0)
 
 
 class RefinerStep(nn.Module):

@@ -9,27 +9,34 @@ import torch
 from tqdm import tqdm
 
 from ..data.locomotion import Corpus
+from ..generator.sampling import NOISE_CORRELATION
 from ..models.generator import MixtureLSTM
 from ..paths import DEFAULT_CACHE
 
 TEMPERATURE = 0.5
 
 
-def sample_torch(logits, mu, log_sigma, temperature: float, gen: torch.Generator) -> torch.Tensor:
-    """generator/sampling.sample_mixture in torch: weights sharpened by 1/temperature, sigmas scaled by temperature."""
+def sample_torch(logits, mu, log_sigma, temperature: float, gen: torch.Generator, previous: torch.Tensor | None = None,
+                 correlation: float = 0.0) -> tuple[torch.Tensor, torch.Tensor]:
+    """generator/sampling's rule in torch: weights sharpened by 1/temperature, sigmas scaled by temperature, the normals
+    held over frames (z = correlation * previous + sqrt(1 - correlation^2) * fresh, as sampling.held_normals).
+    Returns the frames and the normals z to pass as `previous` next frame."""
     p = torch.softmax(torch.log_softmax(logits, -1) / temperature, -1)
     k = torch.multinomial(p, 1, generator=gen)[:, 0]
     rows = torch.arange(len(k))
-    noise = torch.randn(mu.shape[0], mu.shape[-1], generator=gen)
-    return mu[rows, k] + torch.exp(log_sigma[rows, k]) * temperature * noise
+    z = torch.randn(mu.shape[0], mu.shape[-1], generator=gen)
+    if previous is not None:
+        z = correlation * previous + (1.0 - correlation * correlation) ** 0.5 * z
+    return mu[rows, k] + torch.exp(log_sigma[rows, k]) * temperature * z, z
 
 
 @torch.no_grad()
 def generate_streams(model: MixtureLSTM, corpus: Corpus, streams: int, frames: int, warmup: int,
-                     temperature: float, seed: int, batch: int = 512) -> np.ndarray:
+                     temperature: float, seed: int, batch: int = 512, correlation: float = NOISE_CORRELATION) -> np.ndarray:
     """(streams, frames + 1, D) normalised: frame 0 is the last real warm-up frame, then `frames` sampled ones.
     Each stream is teacher-forced on `warmup` real frames of a random training window, then runs free with
-    the contact bits snapped to clean 0/1 as generator/shipped.ShippedGenerator does."""
+    the contact bits snapped to clean 0/1 and its normals held over frames with `correlation`, as
+    generator/shipped.ShippedGenerator (and the page) sample."""
     rng = np.random.default_rng(seed)
     gen = torch.Generator().manual_seed(seed)
     mean, std = torch.tensor(corpus.mean, dtype=torch.float32), torch.tensor(corpus.std, dtype=torch.float32)
@@ -47,8 +54,9 @@ def generate_streams(model: MixtureLSTM, corpus: Corpus, streams: int, frames: i
         logits, mu, log_sigma, state = model(x)
         out[a:a + b, 0] = real[:, -1]
         logits, mu, log_sigma = logits[:, -1], mu[:, -1], log_sigma[:, -1]
+        z = None
         for t in range(frames):
-            x = sample_torch(logits, mu, log_sigma, temperature, gen)
+            x, z = sample_torch(logits, mu, log_sigma, temperature, gen, z, correlation)
             x[:, -2:] = torch.where(x[:, -2:] * std[-2:] + mean[-2:] > 0.5, hi, lo)
             out[a:a + b, t + 1] = x.numpy()
             logits, mu, log_sigma, state = model(x.unsqueeze(1), state)
@@ -64,7 +72,8 @@ def generated_cache(model: MixtureLSTM, corpus: Corpus, args: argparse.Namespace
         specs = [(256, args.window, 101)]
     arrays = []
     for streams, frames, seed in specs:
-        path = DEFAULT_CACHE / f"refiner_generated_t{TEMPERATURE}_{streams}x{frames}_w{args.warmup}_s{seed}.npz"
+        rho = f"_rho{NOISE_CORRELATION}" if NOISE_CORRELATION else ""  # the streams before held normals had no suffix
+        path = DEFAULT_CACHE / f"refiner_generated_t{TEMPERATURE}{rho}_{streams}x{frames}_w{args.warmup}_s{seed}.npz"
         if path.exists():
             arrays.append(np.load(path)["x"])
             continue

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..models.refiner import DISCRIMINATOR_INPUTS
 from ..paths import add_mocap_argument
 from ..runs import RUNS_DIR
 from .training import RefinerTraining
@@ -29,9 +30,15 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--pose-weight", type=float, default=1.0,
                         help="extra self-regularisation (eq. 13 has the root only): weight of the mean squared change of "
                              "the other features (tilt, joint rotation vectors, contacts; normalised units). 0 = the paper")
-    parser.add_argument("--d-pose", type=int, default=0,
-                        help="1: D also sees the rest of x (root motion, tilt, joint rotations), not only the end "
-                             "effectors and contacts of eq. 12; 0 = the paper")
+    parser.add_argument("--d-input", choices=DISCRIMINATOR_INPUTS, default="ends",
+                        help="what D sees: ends = the end effectors and contacts of eq. 12 (the paper); pose = also the rest "
+                             "of x (root motion, tilt, joint rotations); joints = every joint's root-frame position and "
+                             "velocity and the contacts, as the report's two-sample classifiers see a frame")
+    parser.add_argument("--d-arch", choices=("lstm", "conv"), default="lstm",
+                        help="lstm: the paper's bidirectional LSTM D, a logit per frame (RMSProp); conv: a window classifier "
+                             "shaped like the report's two-sample test, a logit per window (Adam)")
+    parser.add_argument("--skate-weight", type=float, default=0.0,
+                        help="weight of the mean planted-toe speed (m/s, planted by the generator's bits) in R's loss")
     parser.add_argument("--lr-r", type=float, default=0.002)
     parser.add_argument("--lr-d", type=float, default=0.005)
     parser.add_argument("--initial", type=int, default=75, help="initial updates of each network")

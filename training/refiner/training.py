@@ -24,9 +24,17 @@ One deviation from the paper, and one variant that was tried (measured in docs/m
   flipped a third of the contact bits within 1,000 updates while D won (D(refined) 0.05): the joints D cannot
   see drift freely. The extra term is the mean squared change of all other features (tilt, joint rotations,
   contacts; normalised units), the "self-regularisation" of the paper's Fig. 2 applied to the whole frame.
-- --d-pose 1 (default 0 = the paper): D also sees the rest of the frame (root motion, tilt, joint rotations).
+- --d-input pose (default ends = the paper): D also sees the rest of the frame (root motion, tilt, joint rotations).
   Tried with --pose-weight 0.5 (runs/refiner-dpose): D won faster and validation skating stayed higher
-  (0.95 against 0.71 m/s at 1,500 updates), so the shipped R is trained against the paper's D.
+  (0.95 against 0.71 m/s at 1,500 updates), so the refiner of 2026-11 was trained against the paper's D.
+- --d-input joints: D sees every joint's root-frame position and velocity and the contact bits, what the report's
+  two-sample classifiers see (models/refiner.JointFeatures); --d-arch conv makes D a window classifier shaped like
+  the report's (Adam, one logit per window) instead of the paper's bidirectional LSTM; --skate-weight adds the mean
+  planted-toe speed (planted by the generator's bits) to R's loss. Pilots and runs: docs/models/refiner.md.
+
+The generated streams are drawn as the page draws them, normals held over frames (generator/sampling.py
+NOISE_CORRELATION); streams drawn with fresh normals every frame (the refiner of 2026-11 was trained on those) are
+cached under names without the _rho suffix.
 
 Writes runs/refiner/{train.log, checkpoint.pt, best.pt, last.pt}; best.pt is the checkpoint with the lowest
 validation skating (contact share within 0.1 of the generator's). Longer training lowers that measure but makes
@@ -47,7 +55,7 @@ from tqdm import tqdm
 
 from ..data.locomotion import Corpus, load_clips
 from ..generator.training import load_generator
-from ..models.refiner import Discriminator, Refiner, discriminator_input, discriminator_inputs
+from ..models.refiner import ConvDiscriminator, Discriminator, FeatureGeometry, JointFeatures, Refiner, discriminator_input, discriminator_inputs
 from ..runs import Run
 from .streams import TEMPERATURE, WindowSampler, generated_cache, streams_to_seqs
 
@@ -96,6 +104,30 @@ def skating(refiner: Refiner, x: torch.Tensor, x_prev: torch.Tensor) -> tuple[fl
     return float(s.mean()) if len(s) else float("nan"), float(bits[:, 1:].float().mean())
 
 
+def planted_toe_speed(refiner: Refiner, y: torch.Tensor, xp: torch.Tensor, bits_from: torch.Tensor) -> torch.Tensor:
+    """Mean horizontal toe speed (m/s) of refined windows y after xp over the frame pairs in which the foot is planted by
+    the bits of `bits_from` (the generator's input windows, so R cannot lower it by turning contacts off): the
+    differentiable form of skating(), for --skate-weight."""
+    geo = refiner.geometry
+    _, v = geo.end_effectors(refiner.physical(y), refiner.physical(xp))
+    bits = refiner.physical(bits_from)[..., -2:] > 0.5
+    planted = (bits[:, 1:] & bits[:, :-1]).float()
+    total = torch.zeros(())
+    for side, name in enumerate(TOE_NAMES):
+        speed = torch.sqrt((v[:, 1:, geo.end_names.index(name)][..., [0, 2]] ** 2).sum(-1) + 1e-8)
+        total = total + (speed * planted[..., side]).sum()
+    return total / planted.sum().clamp(min=1.0)
+
+
+def joint_statistics(geometry: FeatureGeometry, refiner: Refiner, sampler: WindowSampler, rng, n: int = 1024) -> tuple[np.ndarray, np.ndarray]:
+    """Mean and standard deviation of every joint's physical root-frame position and velocity over real windows."""
+    x, xp = sampler(rng, n)
+    with torch.no_grad():
+        p, v = geometry.end_effectors(refiner.physical(x), refiner.physical(xp))
+        e = torch.cat([p.flatten(-2), v.flatten(-2)], -1).reshape(-1, p.shape[-2] * 6).numpy()
+    return e.mean(0), np.maximum(e.std(0), 1e-2)
+
+
 def end_statistics(refiner: Refiner, sampler: WindowSampler, rng, n: int = 1024) -> tuple[np.ndarray, np.ndarray]:
     """Mean and standard deviation of the physical [p_end, v_end] over real windows."""
     x, xp = sampler(rng, n)
@@ -134,9 +166,17 @@ class RefinerTraining:
         probe = Refiner(mean, std, refs, args.hidden)
         end_mean, end_std = end_statistics(probe, self.real, np.random.default_rng(3))
         self.refiner = Refiner(mean, std, refs, args.hidden, end_mean, end_std, fps=gmeta["fps"])
-        self.disc = Discriminator(discriminator_inputs(self.refiner, bool(args.d_pose)), args.d_hidden)
+        self.joints = None
+        if args.d_input == "joints":
+            geometry = JointFeatures(refs, np.zeros(1), np.ones(1), fps=gmeta["fps"]).geometry
+            joint_mean, joint_std = joint_statistics(geometry, self.refiner, self.real, np.random.default_rng(4))
+            self.joints = JointFeatures(refs, joint_mean, joint_std, fps=gmeta["fps"])
+        d_inputs = discriminator_inputs(self.refiner, args.d_input)
+        self.disc = ConvDiscriminator(d_inputs, args.d_hidden) if args.d_arch == "conv" else Discriminator(d_inputs, args.d_hidden)
         self.opt_r = torch.optim.RMSprop(self.refiner.parameters(), lr=args.lr_r, alpha=0.9)
-        self.opt_d = torch.optim.RMSprop(self.disc.parameters(), lr=args.lr_d, alpha=0.9)
+        # The convolutional D trains like the report's classifiers (Adam); the paper's D with RMSProp.
+        self.opt_d = torch.optim.Adam(self.disc.parameters(), lr=args.lr_d, betas=(0.5, 0.999)) if args.d_arch == "conv" \
+            else torch.optim.RMSprop(self.disc.parameters(), lr=args.lr_d, alpha=0.9)
         self.meta = {"dim": self.refiner.dim, "hidden": args.hidden, "d_hidden": args.d_hidden, "fps": gmeta["fps"],
                      "mean": mean.tolist(), "std": std.tolist(), "references": refs.tolist(),
                      "end_effectors": self.refiner.geometry.end_names, "end_mean": end_mean.tolist(),
@@ -171,11 +211,14 @@ class RefinerTraining:
         return x, xp, y
 
     def d_fake_input(self, y, xp):
-        return crops(discriminator_input(self.refiner, y, xp, bool(self.args.d_pose)), self.args.crop)
+        return crops(self.d_input(y, xp), self.args.crop)
 
     def d_real_input(self):
         x, xp = self.real_crop(self.rng, self.args.batch)
-        return discriminator_input(self.refiner, x, xp, bool(self.args.d_pose))
+        return self.d_input(x, xp)
+
+    def d_input(self, x, xp):
+        return discriminator_input(self.refiner, x, xp, self.args.d_input, self.joints)
 
     @torch.no_grad()
     def initial_buffer(self) -> torch.Tensor:
@@ -196,6 +239,8 @@ class RefinerTraining:
         loss = args.lam * reg
         if args.pose_weight > 0:
             loss = loss + args.pose_weight * ((y - x)[..., 4:] ** 2).mean()
+        if args.skate_weight > 0:
+            loss = loss + args.skate_weight * planted_toe_speed(self.refiner, y, xp, x)
         adv = torch.zeros(())
         if adversarial:
             logits = self.disc(self.d_fake_input(y, xp))
@@ -265,7 +310,7 @@ class RefinerTraining:
         change = float((y - vx)[..., :-2].abs().mean())
         flips = float(((refiner.physical(y)[..., -2:] > 0.5) != (refiner.physical(vx)[..., -2:] > 0.5)).float().mean())
         pf = torch.sigmoid(self.disc(self.d_fake_input(y, vxp))).mean()
-        pr = torch.sigmoid(self.disc(discriminator_input(refiner, *self.vr, bool(self.args.d_pose)))).mean()
+        pr = torch.sigmoid(self.disc(self.d_input(*self.vr))).mean()
         refiner.train()
         return {"skating": skate, "contact_share": share, "root_mse": root, "feature_change": change,
                 "contact_flips": flips, "d_real": float(pr), "d_refined": float(pf)}
