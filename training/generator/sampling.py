@@ -10,7 +10,7 @@ import numpy as np
 WEIGHT_FLOOR = 1e-12  # log(max(w, floor)): a zero weight stays finite under the temperature
 # How much of each frame's normals carries over to the next (generator.json "sampling"): drawn anew every frame the
 # per-frame noise made sampled walking shake at 3x real motion's jitter. Chosen by measurement in
-# docs/models/refiner.md ("Sampling noise held over frames").
+# docs/models/generator.md ("Noise held over frames").
 NOISE_CORRELATION = 0.8
 
 
