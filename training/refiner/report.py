@@ -170,6 +170,9 @@ def evaluate_refiner(frames: int, n_seeds: int, mocap: str | None, models_dir: P
     real_train = real_training_frames(gen, clips)
 
     real_m, real_speeds, real_planted = variant_measures(real, fps, skel, None)
+    # each clip on its own too: a single generated run is compared with the spread of single real clips
+    per_clip = [metrics.low_foot_speeds(s.positions, fps, skel) for s in real]
+    real_m["low_foot_sliding_per_clip"] = sorted(float(v.mean()) for v in per_clip if len(v))
     report = {"frames_per_seed": frames, "seeds": [gen.info["seeds"][s]["name"] for s in seeds], "temperature": TEMPERATURE,
               "noise_correlation": gen.noise_correlation, "fps": fps, "real": dict(real_m, clips=len(real), frames=int(sum(len(r.positions) for r in real))),
               "variants": {}}
