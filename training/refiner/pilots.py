@@ -15,11 +15,10 @@ import torch
 
 from .. import metrics
 from ..data.locomotion import load_clips
-from ..footlock import plant_feet
 from ..generator.shipped import DecodedMotion, ShippedGenerator
 from ..paths import MODELS_DIR
 from .measures import motion_windows, two_sample_accuracy, windows
-from .report import TEMPERATURE, real_training_frames
+from .report import TEMPERATURE, decode_variants, real_training_frames
 from .shipped import ShippedRefiner
 from .training import load_refiner
 
@@ -65,20 +64,11 @@ def sigma_scale(spec: str, dim: int) -> np.ndarray:
 
 def variant_streams(gen: ShippedGenerator, refiner, stream_seed: int, frames: int) -> dict[str, list[DecodedMotion]]:
     """'raw', 'raw + foot lock', 'refined', 'refined + foot lock' (the refined ones only with a refiner), as the page
-    shows them (plant_feet)."""
+    shows them (report.decode_variants: plant_feet on the decoded frames)."""
     seeds = list(range(len(gen.info["seeds"])))
     seed_x = np.array([gen.info["seeds"][s]["x"] for s in seeds]) * gen.std + gen.mean
     raw = gen.sample(seeds, frames, TEMPERATURE, np.random.default_rng(stream_seed))
-    sources = {"raw": raw} if refiner is None else {"raw": raw, "refined": refiner.refine(raw, seed_x)}
-    out = {}
-    for name, feats in sources.items():
-        for f in feats.astype(np.float64):
-            pos = gen.codec.positions(f)
-            bits = (f[:, -2:] > 0.5).astype(np.uint8)
-            out.setdefault(name, []).append(DecodedMotion(f, pos, bits))
-            locked, labels = plant_feet(pos, bits, gen.info["fps"], gen.skel)
-            out.setdefault(f"{name} + foot lock", []).append(DecodedMotion(f, locked, labels))
-    return out
+    return decode_variants(gen, refiner, raw, seed_x)[0]
 
 
 def measure_pilot(checkpoint: Path | None, shipped_refiner: bool, scale_spec: str = "", rho: float | None = None,

@@ -42,13 +42,14 @@ TARGET_WINDOW, TARGET_FRAME = 0.85, 0.80  # issue 20: refined + foot lock walkin
 DUMP = None  # a path: save the classifier windows there (for experiments)
 
 
-def decode_variants(gen: ShippedGenerator, ref: ShippedRefiner, raw: np.ndarray,
-                    seeds_x: np.ndarray) -> tuple[dict[str, list[DecodedMotion]], np.ndarray]:
-    """Each variant's decoded streams, and the refined features."""
-    refined = ref.refine(raw, seeds_x)
-    out = {v: [] for v in VARIANTS}
+def decode_variants(gen: ShippedGenerator, ref, raw: np.ndarray,
+                    seeds_x: np.ndarray) -> tuple[dict[str, list[DecodedMotion]], np.ndarray | None]:
+    """Each variant's decoded streams, and the refined features. `ref` is anything with ShippedRefiner's refine (the
+    pilots pass a training checkpoint's R), or None for the raw variants alone."""
+    refined = ref.refine(raw, seeds_x) if ref is not None else None
+    out = {v: [] for v in (VARIANTS if ref is not None else VARIANTS[:2])}
     for k in range(len(raw)):
-        for name, feats in (("raw", raw[k]), ("refined", refined[k])):
+        for name, feats in (("raw", raw[k]),) + ((("refined", refined[k]),) if ref is not None else ()):
             f = feats.astype(np.float64)
             pos = gen.codec.positions(f)
             contacts = (f[:, -2:] > 0.5).astype(np.uint8)
