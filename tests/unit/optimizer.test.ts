@@ -13,6 +13,8 @@ import { OptimizerRequests } from '../../web/runtime/optimizerRequests';
 import type { FollowPathParams } from '../../web/runtime/protocol';
 import { followPath } from '../../web/optimizer/pathFollower';
 import { rollout, type SteerRequest, type Variables } from '../../web/optimizer/rollout';
+import { heldNormal, Rng } from '../../web/model/sampler';
+import { noiseCorrelation } from '../../web/model/generatorInfo';
 import { readRepoFile } from './corpus';
 import { bytes, ort, shippedSession } from './shippedModel';
 
@@ -43,7 +45,57 @@ const steer = (target: number[], authority: number) => ({
   },
 });
 
+/**
+ * One particle's variables drawn in the sampler's order (a uniform, then D normals, each frame), no input noise. With
+ * `heldRoot` the root channels (Δtx, Δtz, Δry, which the rollout draws fresh) get the normals free generation would
+ * hold there, so the rollout draws what free generation draws.
+ */
+function samplerOrderVariables(seed: number, T: number, heldRoot?: number): Variables {
+  const rng = new Rng(seed);
+  const v = zeroVariables(1, T);
+  for (let t = 0; t < T; t++) {
+    v.u[t] = rng.uniform();
+    for (let k = 0; k < D; k++) {
+      const fresh = rng.normal();
+      v.z[t * D + k] = heldRoot !== undefined && k < 3 && t > 0 ? heldNormal(v.z[(t - 1) * D + k], fresh, heldRoot) : fresh;
+    }
+  }
+  return v;
+}
+
+function largestDifference(a: ArrayLike<number>, b: ArrayLike<number>): number {
+  let worst = 0;
+  for (let i = 0; i < a.length; i++) worst = Math.max(worst, Math.abs(a[i] - b[i]));
+  return worst;
+}
+
 describe('rollout', () => {
+  it('holds the pose channels\' normals over frames as free generation does (generator.json sampling), not the steered root\'s', async () => {
+    const rho = noiseCorrelation(info);
+    expect(rho).toBeGreaterThan(0);
+    const free = await core.generate({ frames: 24, seed: 7, temperature: 0.5, seedIndex: 0 });
+    const run = (noiseCorrelation: number, heldRoot?: number) => rollout({ step, info, mean: core.mean, std: core.std, start: seedState(0), variables: samplerOrderVariables(7, 24, heldRoot), steering: steer([0, 0, 0], 0), temperature: 0.5, commit: 24, noiseCorrelation });
+    // The rollout keeps its normals as float32 variables, the sampler as doubles: equal up to rounding.
+    expect(largestDifference((await run(rho, rho)).features, free.features)).toBeLessThan(1e-3);
+    expect(largestDifference((await run(rho)).features, free.features)).toBeGreaterThan(1e-2); // a fresh root draws other steps
+    expect(largestDifference((await run(0, rho)).features, free.features)).toBeGreaterThan(1e-2); // and a fresh pose other poses
+  });
+
+  it('carries the held normals across commits: two rollouts continue one', async () => {
+    const rho = noiseCorrelation(info);
+    const whole = samplerOrderVariables(3, 20);
+    const part = (from: number, to: number): Variables => ({ P: 1, T: to - from, u: whole.u.slice(from, to), z: whole.z.slice(from * D, to * D), d: whole.d.slice(from * D, to * D) });
+    const base = { step, info, mean: core.mean, std: core.std, steering: steer([0, 0, 0], 0), temperature: 0.5, noiseCorrelation: rho };
+    const one = await rollout({ ...base, start: seedState(0), variables: whole, commit: 20 });
+    const first = await rollout({ ...base, start: seedState(0), variables: part(0, 8), commit: 8 });
+    expect(first.states[0].held).toHaveLength(D);
+    const second = await rollout({ ...base, start: first.states[0], variables: part(8, 20), commit: 12 });
+    expect(largestDifference(second.features, one.features.subarray(8 * D))).toBeLessThan(1e-5);
+    const { held: _dropped, ...forgetful } = first.states[0];
+    const restarted = await rollout({ ...base, start: forgetful, variables: part(8, 20), commit: 12 });
+    expect(largestDifference(restarted.features, one.features.subarray(8 * D))).toBeGreaterThan(1e-3);
+  });
+
   it('without authority and noise is free generation at temperature 0', async () => {
     const free = await core.generate({ frames: 20, seed: 0, temperature: 0, seedIndex: 0 });
     const r = await rollout({ step, info, mean: core.mean, std: core.std, start: seedState(0), variables: zeroVariables(2, 20), steering: steer([0, 0, 0], 0), temperature: 0, commit: 20 });

@@ -43,6 +43,11 @@ export interface GeneratorInfo {
   sampling?: { noise_correlation: number };
 }
 
+/** ρ of the normals the generator's draws hold over frames (sampler.ts HeldNoise); 0 = fresh every frame. */
+export function noiseCorrelation(info: GeneratorInfo): number {
+  return info.sampling?.noise_correlation ?? 0;
+}
+
 export interface GeneratorSeed {
   name: string;
   category?: string;

@@ -5,7 +5,7 @@
 // batch so the choice is not greedy; only the batch is kept. `LiveController` is what both the live page
 // loop and `simulateControl` run.
 import { decodeFeatures } from '../model/featureDecode';
-import type { GeneratorInfo } from '../model/generatorInfo';
+import { noiseCorrelation, type GeneratorInfo } from '../model/generatorInfo';
 import { Rng } from '../model/sampler';
 import { describeValue } from '../motion/describe';
 import { contactCost, lastToes, particleFeatures, type ToeState } from './objective';
@@ -163,7 +163,7 @@ export class LiveController {
       throw new RangeError(`particles must be an integer from ${MIN_CONTROL_PARTICLES} to ${MAX_CONTROL_PARTICLES}, got ${describeValue(P)}`);
     }
     const { result, particle: b } = await crossEntropySearch({
-      rollout: { step, info, mean, std, start: this.state, temperature: this.o.temperature ?? 0.5, commit: frames, noiseScale: NOISE_SCALE },
+      rollout: { step, info, mean, std, start: this.state, temperature: this.o.temperature ?? 0.5, commit: frames, noiseScale: NOISE_SCALE, noiseCorrelation: noiseCorrelation(info) },
       particles: P,
       frames: CONTROL_HORIZON,
       rounds,

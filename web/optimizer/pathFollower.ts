@@ -5,7 +5,7 @@
 // more locally (the cross-entropy search of search.ts). The best particle's first 17 frames are kept and
 // the next window starts from its state.
 import { decodeFeatures, type RootStart } from '../model/featureDecode';
-import type { GeneratorInfo } from '../model/generatorInfo';
+import { noiseCorrelation, type GeneratorInfo } from '../model/generatorInfo';
 import { Rng } from '../model/sampler';
 import { contactCost, lastToes, particleFeatures, type ToeState } from './objective';
 import { angleDifference, GroundPath } from './path';
@@ -217,7 +217,7 @@ export async function followPath(o: FollowPathOptions): Promise<FollowPathResult
 
   while (frames < maxFrames) {
     const best = await crossEntropySearch({
-      rollout: { step: o.step, info, mean: o.mean, std: o.std, start: state, temperature, commit: COMMIT_FRAMES },
+      rollout: { step: o.step, info, mean: o.mean, std: o.std, start: state, temperature, commit: COMMIT_FRAMES, noiseCorrelation: noiseCorrelation(info) },
       particles: P,
       frames: WINDOW_FRAMES,
       rounds,

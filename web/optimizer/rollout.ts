@@ -10,8 +10,16 @@
 // then ranks whole particles.
 import { integrateRoot, type RootStart } from '../model/featureDecode';
 import type { GeneratorInfo, GeneratorSeed, StepOutputs } from '../model/generatorInfo';
-import { chooseComponent, denormalise, snapContacts } from '../model/sampler';
+import { chooseComponent, denormalise, heldNormal, snapContacts } from '../model/sampler';
 import { repeatState, stateRow } from '../model/lstmState';
+
+/**
+ * The root channels Δtx, Δtz, Δry, which steering moves (steerRoot). Their normals are drawn fresh every frame even
+ * when the pose's are held: a held root normal carries the last frames' step into the proposal and slows a change
+ * of pace (measured with 5 seeds a case in control.md: held everywhere, one of 10 speed changes missed 0.2 m/s
+ * after 1 s, and the lowest foot point slid 0.229 m/s against 0.199).
+ */
+const STEERED_CHANNELS = 3;
 
 /** The paper's input-noise prior: d ~ N(0, 0.05²) on the normalised network input (eq. 16). */
 export const INPUT_NOISE_SIGMA = 0.05;
@@ -19,12 +27,16 @@ const LOG_2PI = Math.log(2 * Math.PI);
 
 export type StepFn = (batch: number, x: Float32Array, h: Float32Array, c: Float32Array) => Promise<StepOutputs>;
 
-/** Where one stream stands: the next network input (normalised), the LSTM state, the root on the ground. */
+/**
+ * Where one stream stands: the next network input (normalised), the LSTM state, the root on the ground, and the
+ * normals its last frame was drawn with (held over frames as the sampler holds them; absent before the first frame).
+ */
 export interface StreamState {
   x: Float32Array;
   h: Float32Array;
   c: Float32Array;
   root: RootStart;
+  held?: Float64Array;
 }
 
 /** A stream at `root` from one of the generator's seed states (copied, so the seed stays as it is). */
@@ -38,7 +50,10 @@ export interface Variables {
   T: number;
   /** P×T uniforms choosing the mixture component. */
   u: Float64Array;
-  /** P×T×D standard normals for the component's draw. */
+  /**
+   * P×T×D standard normals for the component's draw: with a noise correlation ρ those of the pose channels are the
+   * innovations of held normals (frame t draws with ρ·previous + √(1−ρ²)·z), so every variable keeps its N(0, 1) prior.
+   */
   z: Float32Array;
   /** P×T×D standard normals; the input noise is INPUT_NOISE_SIGMA times these. */
   d: Float32Array;
@@ -90,6 +105,11 @@ export interface RolloutOptions {
    * noise term's spread across particles (σ ≈ 20 over 12 frames) swamp the control terms.
    */
   noiseScale?: number;
+  /**
+   * ρ of the normals held over frames (generator.json sampling.noise_correlation; default 0, fresh every frame), so
+   * optimised motion is drawn the way free generation draws it; the held normals carry over from `start.held`.
+   */
+  noiseCorrelation?: number;
 }
 
 /**
@@ -97,7 +117,7 @@ export interface RolloutOptions {
  * in physical units, its move clipped to `reach` of the chosen component's σ.
  */
 function steerRoot(row: Float32Array, sigma: Float32Array, request: SteerRequest, mean: Float32Array, std: Float32Array): void {
-  for (let k = 0; k < 3; k++) {
+  for (let k = 0; k < STEERED_CHANNELS; k++) {
     const proposal = row[k] * std[k] + mean[k];
     const limit = request.reach[k] * sigma[k] * std[k];
     const move = Math.max(-limit, Math.min(limit, request.authority[k] * (request.target[k] - proposal)));
@@ -132,6 +152,16 @@ export async function rollout(o: RolloutOptions): Promise<RolloutResult> {
   if (!(commit >= 1 && commit <= T)) throw new Error(`rollout: commit ${commit} is outside 1…${T}`);
   const tau = Math.max(temperature, 1e-3);
   const noiseScale = o.noiseScale ?? 1;
+  const rho = o.noiseCorrelation ?? 0;
+  if (!(rho >= 0 && rho < 1)) throw new Error(`rollout: noise correlation ${rho} is outside [0, 1)`);
+  // Each particle's normals of its previous frame (all the start's to begin with); null before a stream's first frame.
+  let held: Float64Array | null = null;
+  if (rho > 0 && o.start.held) {
+    if (o.start.held.length !== D) throw new Error(`rollout: the start holds ${o.start.held.length} normals, expected ${D}`);
+    held = new Float64Array(P * D);
+    for (let b = 0; b < P; b++) held.set(o.start.held, b * D);
+  }
+  const drawn = new Float64Array(P * D);
 
   // Every particle starts from the same state.
   let h = repeatState(o.start.h, L, P, H), c = repeatState(o.start.c, L, P, H);
@@ -166,7 +196,11 @@ export async function rollout(o: RolloutOptions): Promise<RolloutResult> {
       const sigma = out.sigma.subarray((b * M + comp) * D, (b * M + comp + 1) * D);
       const zz = v.z.subarray((b * T + t) * D, (b * T + t + 1) * D);
       const row = x.subarray(b * D, (b + 1) * D);
-      for (let k = 0; k < D; k++) row[k] = mu[k] + sigma[k] * temperature * zz[k];
+      const normals = drawn.subarray(b * D, (b + 1) * D);
+      for (let k = 0; k < D; k++) {
+        normals[k] = held && k >= STEERED_CHANNELS ? heldNormal(held[b * D + k], zz[k], rho) : zz[k];
+        row[k] = mu[k] + sigma[k] * temperature * normals[k];
+      }
 
       steering.target(b, t, root[b].x, root[b].z, root[b].heading, request);
       steerRoot(row, sigma, request, mean, std);
@@ -183,6 +217,7 @@ export async function rollout(o: RolloutOptions): Promise<RolloutResult> {
     }
     h = out.h_out;
     c = out.c_out;
+    if (rho > 0) held = drawn.slice();
     if (t === commit - 1) {
       for (let b = 0; b < P; b++) {
         states.push({
@@ -190,6 +225,7 @@ export async function rollout(o: RolloutOptions): Promise<RolloutResult> {
           h: stateRow(h, L, P, H, b),
           c: stateRow(c, L, P, H, b),
           root: { ...root[b] },
+          ...(held ? { held: held.slice(b * D, (b + 1) * D) } : {}),
         });
       }
     }

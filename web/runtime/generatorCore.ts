@@ -4,7 +4,7 @@
 import type { InferenceSession, TensorConstructor } from 'onnxruntime-web';
 import { decodeFeatures, type RootStart } from '../model/featureDecode';
 import { setStateRow } from '../model/lstmState';
-import type { GeneratorInfo, StepInputs, StepOutputs } from '../model/generatorInfo';
+import { noiseCorrelation, type GeneratorInfo, type StepInputs, type StepOutputs } from '../model/generatorInfo';
 import type { BenchmarkResult, GeneratedChunk, GenerateParams, InitResult, ParityResult, StreamInfo, StreamParams } from './protocol';
 import type { RefinerCore, RefinerStream } from './refinerCore';
 import { denormalise, Rng, sampleMixture, snapContacts, type HeldNoise } from '../model/sampler';
@@ -120,7 +120,7 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
       h: Float32Array.from(seed.h),
       c: Float32Array.from(seed.c),
       rng: new Rng(params.seed),
-      noise: { correlation: this.info.sampling?.noise_correlation ?? 0 },
+      noise: { correlation: noiseCorrelation(this.info) },
       root: { x: 0, z: 0, heading: 0 },
       frame: 0,
     };
