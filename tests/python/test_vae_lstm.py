@@ -110,6 +110,23 @@ def test_the_prior_draws_are_the_fixture_s_and_correlated_as_asked():
     assert abs(lag1 - 0.9) < 0.03 and abs(float(long.std()) - 1) < 0.1
 
 
+def test_a_z1_prior_picks_a_start_by_the_first_uniform_and_draws_around_it():
+    prior = {"kind": "posteriors", "means": [[10.0, 10.0, 10.0], [-10.0, 0.0, 5.0]], "sigma": [0.5, 0.0, 2.0]}
+    for seed in range(6):
+        replay = Rng(seed)
+        k = int(replay.uniform() * 2)
+        expected = [prior["means"][k][i] + prior["sigma"][i] * replay.normal() for i in range(3)]
+        z1, _ = prior_latents(seed, 3, z1_prior=prior)
+        np.testing.assert_allclose(z1, expected, atol=1e-5)
+        assert z1[1] == prior["means"][k][1]  # sigma 0: exactly the start
+    # The shipped JSON's prior and the draws the page is checked against (fixture "shipped_prior").
+    info = json.loads((REPO / "public" / "models" / "vae-lstm.json").read_text())
+    shipped = json.loads(FIXTURE.read_text())["shipped_prior"]
+    assert shipped["z1_prior"] and len(info["sampling"]["z1_prior"]["means"]) == info["sampling"]["z1_prior"]["starts"]
+    for seed, z1 in shipped["z1"].items():
+        np.testing.assert_array_equal(prior_latents(int(seed), info["latent"], z1_prior=info["sampling"]["z1_prior"])[0], np.float32(z1))
+
+
 def test_the_shipped_graphs_reproduce_the_fixture_generation():
     fixture = json.loads(FIXTURE.read_text())
     vae = ShippedVae.load(REPO / "public" / "models")

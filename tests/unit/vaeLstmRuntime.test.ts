@@ -21,6 +21,8 @@ interface Fixture {
   generate: { control: number[]; frames: number; z1: number[]; rows: number[] };
   prior: { seed: number; z1: number[]; rho: number; steps: number[][] };
   generate_steps: { zs: number[]; rows: number[] };
+  /** z1 of a few seeds drawn as the shipped JSON says (generation.draw_z1 with its z1_prior). */
+  shipped_prior: { z1_prior: boolean; z1: Record<string, number[]> };
 }
 
 const json = JSON.parse(readRepoFile('public/models/vae-lstm.json'));
@@ -88,13 +90,28 @@ describe('VAE-LSTM generation', () => {
     expect(maxAbsDiff(zs!, p.steps.flat())).toBeLessThan(1e-6);
   });
 
+  it('draws z1 from the posteriors of training starts as the Python side does (generation.draw_z1, sampling.z1_prior)', () => {
+    const sampling = info.sampling;
+    expect(sampling.mode === 'z1' && sampling.z1_prior).toBeTruthy();
+    const prior = sampling.mode === 'z1' ? sampling.z1_prior! : undefined;
+    expect(fixture.shipped_prior.z1_prior).toBe(true);
+    for (const [seed, z1] of Object.entries(fixture.shipped_prior.z1)) {
+      expect(maxAbsDiff(priorLatents(Number(seed), info.latent, 0, 0, prior).z1, z1)).toBe(0);
+    }
+    // Each draw sits at one of the K starts, its own sigma away: nearer to that start than N(0, I) draws would be.
+    const z1 = priorLatents(4, info.latent, 0, 0, prior).z1;
+    const nearest = Math.min(...prior!.means.map((m) => Math.hypot(...m.map((v, i) => (v - z1[i]) / prior!.sigma[i]))));
+    expect(nearest).toBeLessThan(1.5 * Math.sqrt(info.latent));
+    expect(maxAbsDiff(z1, priorLatents(4, info.latent).z1)).toBeGreaterThan(0.5);
+  });
+
   it('the seed draws z1: the same seed gives the same motion, another seed another one', async () => {
     const control = Array.from({ length: 90 * 3 }, (_, i) => (i % 3 === 0 ? 1.2 : 0));
     const a = await core.generate({ seed: 4, frames: 90, control });
     const b = await core.generate({ seed: 4, frames: 90, control });
     const c = await core.generate({ seed: 5, frames: 90, control });
     expect(bytes(b.positions)).toEqual(bytes(a.positions));
-    expect(maxAbsDiff(a.z1, priorLatents(4, info.latent).z1)).toBe(0);
+    expect(maxAbsDiff(a.z1, priorLatents(4, info.latent, 0, 0, info.sampling.mode === 'z1' ? info.sampling.z1_prior : undefined).z1)).toBe(0);
     expect(maxAbsDiff(c.rows, a.rows)).toBeGreaterThan(1e-3);
   });
 
@@ -172,6 +189,9 @@ describe('vae-lstm.json checks', () => {
     expect(() => parseVaeLstmInfo({ ...json, sampling: { mode: 'steps', rho: 1 } })).toThrow(/sampling\.rho must be in \[0, 1\)/);
     expect(() => parseVaeLstmInfo({ ...json, sampling: { mode: 'many' } })).toThrow(/sampling\.mode must be "z1" or "steps"/);
     expect(() => parseVaeLstmInfo({ ...json, sampling: { mode: 'z1', mix: 1 } })).toThrow(/sampling\.mix must be in \[0, 1\)/);
+    const prior = json.sampling.z1_prior;
+    expect(() => parseVaeLstmInfo({ ...json, sampling: { ...json.sampling, z1_prior: { ...prior, means: [prior.means[0].slice(1)] } } })).toThrow(/sampling\.z1_prior\.means must be a non-empty list of rows of 128 finite numbers/);
+    expect(() => parseVaeLstmInfo({ ...json, sampling: { ...json.sampling, z1_prior: { ...prior, sigma: prior.sigma.map(() => -1) } } })).toThrow(/sampling\.z1_prior\.sigma must be 128 numbers, none negative/);
     expect(() => parseVaeLstmInfo({ ...json, rows: { ...json.rows, control: [75, 77] } })).toThrow(/rows\.control is \[75, 77\]/);
   });
 });

@@ -28,7 +28,7 @@ import onnx
 import torch
 from torch import nn
 
-from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, JOINTS, POSITION_DIM
+from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, JOINTS, POSITION_DIM, WindowCorpus
 from ..mocap.skeleton import canonical_skeleton
 from ..models.vae_lstm import KERNEL, POOLING, VaeLstm
 from ..onnx.compact import compact_weights, files_weight_format
@@ -36,11 +36,13 @@ from ..onnx.manifest import register_model
 from ..onnx.sessions import cpu_session
 from ..paths import MODELS_DIR, REPO_ROOT
 from .generation import CHUNK_STEPS, SEED_FRAMES, SEED_PAD, free_latents, prior_latents
+from .prior_bank import posterior_prior
 from .recovery import vae_lstm_from_onnx
 
 PARITY_TOLERANCE = 1e-4
 PRIOR_FIXTURE_SEED = 3
 PRIOR_FIXTURE_RHO = 0.9
+PRIOR_FIXTURE_SEEDS = (0, 4, 1234567)
 FIXTURE = REPO_ROOT / "tests" / "fixtures" / "vae_lstm_reference.json"
 FILES = {"cell": "vae-lstm.onnx", "control": "vae-lstm-control.onnx", "decoder": "vae-lstm-decoder.onnx",
          "inference": "vae-lstm-inference.onnx"}
@@ -193,11 +195,15 @@ def write_fixture(model: VaeLstm, info: dict, path: Path = FIXTURE) -> None:
     # The free mode as the page runs it for this model (with z1 in every step when it was trained so).
     rows = generate_rows(model, ((physical - mean) / std).astype(np.float32), z1, *free_latents(z1, frames // POOLING, info["sampling"]))
     prior, prior_steps = prior_latents(PRIOR_FIXTURE_SEED, model.latent, 5, PRIOR_FIXTURE_RHO)
+    z1_prior = info["sampling"].get("z1_prior")
+    # The shipped draw of z1 for a few seeds (generation.draw_z1 with the JSON's z1_prior, when it has one).
+    shipped_draws = {str(seed): prior_latents(seed, model.latent, z1_prior=z1_prior)[0].tolist() for seed in PRIOR_FIXTURE_SEEDS}
     steps = frames // POOLING
     zs = rng.normal(size=(steps, model.latent)).round(6).astype(np.float32)
     rows_steps = generate_rows(model, ((physical - mean) / std).astype(np.float32), z1, zs)
     fixture = {"model": info["id"], "tolerance": 2e-4, "graphs": graphs_out,
                "prior": {"seed": PRIOR_FIXTURE_SEED, "z1": prior.tolist(), "rho": PRIOR_FIXTURE_RHO, "steps": prior_steps.tolist()},
+               "shipped_prior": {"z1_prior": z1_prior is not None, "z1": shipped_draws},
                "generate_steps": {"zs": zs.round(6).ravel().tolist(), "rows": rows_steps.round(6).ravel().tolist()},
                "generate": {"control": physical.round(6).ravel().tolist(), "frames": frames, "z1": z1.round(6).tolist(),
                             "rows": rows.round(6).ravel().tolist()}}
@@ -234,8 +240,12 @@ def _publish(info: dict, stored: VaeLstm, out: Path) -> None:
 
 
 def export_vae_lstm(model: VaeLstm, meta: dict, report: dict, sampling: dict, out: Path = MODELS_DIR,
-                    weights: str = "int8") -> dict:
+                    weights: str = "int8", prior_corpus: WindowCorpus | None = None) -> dict:
+    """The four graphs and the JSON; with `prior_corpus` a "z1" sampling draws z1 from the posteriors of its
+    training starts (prior_bank.py) instead of N(0, I)."""
     stored, parity = _write_checked(model, out, weights)
+    if prior_corpus is not None and sampling["mode"] == "z1":
+        sampling = sampling | {"z1_prior": posterior_prior(out / FILES["inference"], prior_corpus)}
     info = vae_lstm_info(meta, model, report, sampling) | parity
     _publish(info, stored, out)
     return info
@@ -253,4 +263,18 @@ def rewrite_vae_lstm(source: Path, out: Path = MODELS_DIR, weights: str = "int8"
     stored, parity = _write_checked(model, out, weights)
     info |= parity
     _publish(info, stored, out)
+    return info
+
+
+def refit_z1_prior(corpus: WindowCorpus, models_dir: Path = MODELS_DIR) -> dict:
+    """The shipped model's z1 prior fitted again (prior_bank.py) on its own inference graph, written into its JSON,
+    and the browser fixture written again from the shipped graphs."""
+    path = models_dir / "vae-lstm.json"
+    info = json.loads(path.read_text())
+    if info["sampling"]["mode"] != "z1":
+        raise ValueError(f"{path}: sampling mode {info['sampling']['mode']!r} draws a latent per step; the z1 prior is for mode \"z1\"")
+    info["sampling"] = info["sampling"] | {"z1_prior": posterior_prior(models_dir / info["files"]["inference"], corpus)}
+    path.write_text(json.dumps(info) + "\n")
+    if models_dir.resolve() == MODELS_DIR.resolve():
+        write_fixture(vae_lstm_from_onnx(models_dir, FILES), info)
     return info

@@ -1,7 +1,10 @@
 """How the VAE-LSTM makes motion (the page does the same with the exported graphs, web/runtime/vaeLstmCore.ts):
 
 - From the prior (Algorithm 1): z_1 ~ N(0, I) drawn from a seed, the control signal encoded in one pass, the
-  cell run on its own state for every step, the canvas decoded in one pass.
+  cell run on its own state for every step, the canvas decoded in one pass. A model whose JSON's sampling has a
+  `z1_prior` draws z_1 from that instead: the posteriors of K real training starts, one picked by the seed, plus
+  N(0, sigma²) (draw_z1; prior_bank.py). The posteriors spread wider than N(0, I) (sd 1.3 a dimension), so N(0, I)
+  draws sit near their middle and make motions alike; this mixture of posteriors draws what the cell was trained on.
 - Or (the paper's other way, §3.3: "we could also consider sampling a latent variable z_t for each frame"):
   a latent per step in teacher mode, drawn as an AR(1) sequence with N(0, I) marginals and lag-one
   correlation rho (the posterior's own latents are correlated from step to step). Which a shipped model uses is
@@ -53,12 +56,22 @@ def free_latents(z1: np.ndarray, steps: int, sampling: dict) -> tuple[np.ndarray
     return (np.repeat(np.asarray(z1, np.float32)[None], steps, 0), mix) if mix > 0 else (None, 0.0)
 
 
-def prior_latents(seed: int, latent: int, steps: int = 0, rho: float = 0.0) -> tuple[np.ndarray, np.ndarray | None]:
-    """z1 (latent,) drawn from `seed` by the page's random source (control.Rng normal), and with `steps` the
+def draw_z1(rng: Rng, latent: int, z1_prior: dict | None = None) -> np.ndarray:
+    """z1 (latent,): `latent` normals of `rng`, or with a `z1_prior` (the JSON's sampling.z1_prior: K "means" and one
+    "sigma" per dimension) one uniform picks mean k = floor(u·K), then means[k] + sigma · the normals."""
+    if z1_prior is None:
+        return np.array([rng.normal() for _ in range(latent)], np.float32)
+    means, sigma = z1_prior["means"], z1_prior["sigma"]
+    k = min(int(rng.uniform() * len(means)), len(means) - 1)
+    return np.array([means[k][i] + sigma[i] * rng.normal() for i in range(latent)], np.float32)
+
+
+def prior_latents(seed: int, latent: int, steps: int = 0, rho: float = 0.0, z1_prior: dict | None = None) -> tuple[np.ndarray, np.ndarray | None]:
+    """z1 (latent,) drawn from `seed` by the page's random source (control.Rng; draw_z1), and with `steps` the
     per-step latents (steps, latent): z1 first, then rho · previous + sqrt(1 − rho²) · a new draw, in the
     same stream (web/runtime/vaeLstmCore.ts priorLatents draws the same)."""
     rng = Rng(seed)
-    z1 = np.array([rng.normal() for _ in range(latent)], np.float32)
+    z1 = draw_z1(rng, latent, z1_prior)
     if not steps:
         return z1, None
     zs = np.empty((steps, latent), np.float32)

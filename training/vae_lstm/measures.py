@@ -2,7 +2,8 @@
 graphs as the page runs them (chunked cell, root moved by the control asked for).
 
 - Prediction (the paper's Tables 1 and 2): the latent ERD report's windows of the held-out clips (16 seed
-  frames, then 212 predicted; latent_erd/measures.py), driven by the clip's own control. From 4 initial
+  frames, then 212 predicted; latent_erd/measures.py), driven by the clip's own control, smoothed as the model read
+  it in training (ShippedVae.clip_control), while the root follows the clip's own (raw) control. From 4 initial
   frames: z1 is the posterior mean of the last 4 seed frames (padded as in training); from the prior: z1 is
   a draw of N(0, I). The generation starts at the first of those 4 frames, so its frame 4 + k - 1 is the
   window's predicted frame k. The root starts where the clip's (smoothed) root is at that frame and moves by
@@ -26,7 +27,7 @@ import numpy as np
 
 from .. import metrics
 from ..control import random_control
-from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, POSITION_DIM, WindowCorpus, ground_frame, rows_to_world
+from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, JOINTS, POSITION_DIM, WindowCorpus, ground_frame, rows_to_world, smooth
 from ..latent_erd.measures import FREEZE_FRACTION, HORIZONS, PREDICT_FRAMES, SEED_FRAMES, Window, prediction_errors
 from ..latent_erd.measures import prediction_windows as erd_prediction_windows
 from ..latent_erd.measures import sliding
@@ -100,17 +101,30 @@ class ShippedVae:
         "z1" what the model's free mode reads (generation.free_latents)."""
         sampling = sampling or self.info["sampling"]
         if sampling["mode"] == "z1":
-            z1, _ = prior_latents(seed, self.info["latent"])
+            z1, _ = prior_latents(seed, self.info["latent"], z1_prior=sampling.get("z1_prior"))
             return (z1, *free_latents(z1, -(-frames // 4), sampling))
-        z1, zs = prior_latents(seed, self.info["latent"], -(-frames // 4), sampling["rho"])
+        z1, zs = prior_latents(seed, self.info["latent"], -(-frames // 4), sampling["rho"], sampling.get("z1_prior"))
         return z1, zs, 1.0
 
+    @property
+    def control_sigma(self) -> float:
+        """Frames of Gaussian smoothing on the control the model read in training (its JSON's control_smoothing_frames)."""
+        return float(self.info.get("control_smoothing_frames", 0.0))
+
+    def clip_control(self, clip_rows: np.ndarray) -> np.ndarray:
+        """A whole clip's own control (frames, 3) as the model reads it: smoothed as in training (training.smoothed_control),
+        as a drawn path's has no per-stride sway. The raw signal carries the stride (the hips sway and surge with each
+        step), which pins the phase of the motion it drives to the clip's."""
+        control = clip_rows[:, CONTROL_SLICE]
+        return smooth(control, self.control_sigma) if self.control_sigma > 0 else control
+
     def world(self, control: np.ndarray, z1: np.ndarray, zs: np.ndarray | None = None, mix: float | None = None,
-              start_xz=(0.0, 0.0), start_heading: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-        """World positions (frames, joints, 3) with the root moved by `control`, and the decoded contact bits."""
+              start_xz=(0.0, 0.0), start_heading: float = 0.0, root_control: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """World positions (frames, joints, 3) with the root moved by `root_control` (default `control`, what the model
+        reads, as the page moves it by the control it asks for), and the decoded contact bits."""
         rows = self.rows(control, z1, zs, mix)
         placed = rows.copy()
-        placed[:, CONTROL_SLICE] = control
+        placed[:, CONTROL_SLICE] = control if root_control is None else root_control
         return rows_to_world(placed, self.fps, start_xz, start_heading), (rows[:, CONTACT_SLICE] > 0.5).astype(np.uint8)
 
 
@@ -127,8 +141,8 @@ def vae_prediction(vae: ShippedVae, corpus: WindowCorpus, w: Window, prior: tupl
         prior = (z1, *free_latents(z1, -(-frames // 4), vae.info["sampling"]))
     z1, zs, mix = prior
     xz, heading = ground_frame(c.positions)
-    control = c.rows[begin:begin + frames, CONTROL_SLICE]
-    positions, _ = vae.world(control, z1, zs, mix, xz[begin], float(heading[begin]))
+    control = vae.clip_control(c.rows)[begin:begin + frames]
+    positions, _ = vae.world(control, z1, zs, mix, xz[begin], float(heading[begin]), root_control=c.rows[begin:begin + frames, CONTROL_SLICE])
     return positions[INITIAL_FRAMES:]
 
 
@@ -199,6 +213,28 @@ def local_positions(rows: np.ndarray) -> np.ndarray:
     return local - local[:, :1]
 
 
+# Drawn-path controls (forward m/s, turn rad/s), as the page feeds a drawn path: constant, no per-stride sway.
+DRAWN_CONTROLS = ((0.9, 0.0), (1.2, 0.0), (1.5, 0.0), (1.2, 0.5))
+TOES = (JOINTS.index("LeftToeBase"), JOINTS.index("RightToeBase"))
+
+
+def drawn_control(forward: float, turn: float, frames: int) -> np.ndarray:
+    return np.tile([forward, 0.0, turn], (frames, 1))
+
+
+def drawn_path_diversity(vae: ShippedVae, window: int = 120, sampling: dict | None = None) -> list[dict]:
+    """Prior samples for constant controls (DRAWN_CONTROLS): mean pairwise distance of all joints and of the toes
+    alone, relative to the hips, over the window and over its last 2 s (do the samples converge?)."""
+    out = []
+    for forward, turn in DRAWN_CONTROLS:
+        control = drawn_control(forward, turn, window)
+        samples = [local_positions(vae.rows(control, *vae.prior(1000 + k, window, sampling))) for k in range(DIVERSITY_SAMPLES)]
+        late = [s[-2 * int(vae.fps):] for s in samples]
+        out.append({"forward": forward, "turn": turn, "joints_cm": mean_pairwise(samples), "joints_last_2s_cm": mean_pairwise(late),
+                    "toes_cm": mean_pairwise([s[:, TOES] for s in samples]), "toes_last_2s_cm": mean_pairwise([s[:, TOES] for s in late])})
+    return out
+
+
 def diversity(vae: ShippedVae, corpus: WindowCorpus, window: int = 120, sampling: dict | None = None) -> dict:
     """Prior samples for the control of each held-out window against the real windows of similar control."""
     out = []
@@ -206,24 +242,31 @@ def diversity(vae: ShippedVae, corpus: WindowCorpus, window: int = 120, sampling
     real_windows = [(c.rows[a:a + window]) for c in all_clips for a in range(0, len(c.rows) - window + 1, window // 2)]
     stats = np.array([[r[:, CONTROL_SLICE.start].mean(), r[:, CONTROL_SLICE.start + 2].mean()] for r in real_windows])
     for c in corpus.valid_clips:
+        clip_control = vae.clip_control(c.rows)
         for a in range(0, len(c.rows) - window + 1, window):
-            control = c.rows[a:a + window, CONTROL_SLICE]
+            control = clip_control[a:a + window]
             samples = [local_positions(vae.rows(control, *vae.prior(1000 + k, window, sampling))) for k in range(DIVERSITY_SAMPLES)]
             fwd, turn = control[:, 0].mean(), control[:, 2].mean()
             similar = [local_positions(real_windows[i]) for i in np.flatnonzero((np.abs(stats[:, 0] - fwd) < SIMILAR_SPEED) & (np.abs(stats[:, 1] - turn) < SIMILAR_TURN))]
             out.append({"clip": c.file, "start": a, "forward": round(float(fwd), 2), "turn": round(float(turn), 2),
                         "prior_samples_cm": mean_pairwise(samples), "real_similar_cm": mean_pairwise(similar[:20]) if len(similar) > 1 else None,
+                        "prior_toes_cm": mean_pairwise([x[:, TOES] for x in samples]),
+                        "real_similar_toes_cm": mean_pairwise([x[:, TOES] for x in similar[:20]]) if len(similar) > 1 else None,
                         "real_similar_windows": len(similar)})
     return {"windows": out, "samples": DIVERSITY_SAMPLES,
             "prior_samples_cm": round(float(np.mean([o["prior_samples_cm"] for o in out])), 2),
-            "real_similar_cm": round(float(np.mean([o["real_similar_cm"] for o in out if o["real_similar_cm"] is not None])), 2)}
+            "real_similar_cm": round(float(np.mean([o["real_similar_cm"] for o in out if o["real_similar_cm"] is not None])), 2),
+            "prior_toes_cm": round(float(np.mean([o["prior_toes_cm"] for o in out])), 2),
+            "real_similar_toes_cm": round(float(np.mean([o["real_similar_toes_cm"] for o in out if o["real_similar_toes_cm"] is not None])), 2),
+            "drawn_paths": drawn_path_diversity(vae, window, sampling)}
 
 
 # ---- held-out control ----------------------------------------------------------------------------------------
 
 def held_out_control_runs(vae: ShippedVae, corpus: WindowCorpus, sampling: dict | None = None) -> list[tuple[np.ndarray, np.ndarray]]:
     """Each held-out clip's own control, a prior sample per clip: positions and decoded bits."""
-    return [vae.world(c.rows[:, CONTROL_SLICE], *vae.prior(i, len(c.rows), sampling)) for i, c in enumerate(corpus.valid_clips)]
+    return [vae.world(vae.clip_control(c.rows), *vae.prior(i, len(c.rows), sampling), root_control=c.rows[:, CONTROL_SLICE])
+            for i, c in enumerate(corpus.valid_clips)]
 
 
 def jitter_cm(motions: list[np.ndarray]) -> float:

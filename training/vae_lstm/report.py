@@ -11,7 +11,7 @@ import numpy as np
 
 from .. import metrics
 from ..data.locomotion import load_clips
-from ..data.windows import CONTROL_SLICE, WindowCorpus
+from ..data.windows import WindowCorpus
 from ..latent_erd import measures as erd_measures
 from ..paths import MODELS_DIR, REPO_ROOT, REPORTS_DIR
 from . import measures as m
@@ -28,12 +28,24 @@ OTHER_SAMPLINGS = {"a latent per step, rho 0": {"mode": "steps", "rho": 0.0}, "a
 
 def samplings(shipped: dict) -> dict[str, dict]:
     """The shipped sampling first; for a model trained with z1 in every step (`mix`), also the paper's Algorithm 1
-    on it (z1 only the first state), then OTHER_SAMPLINGS."""
+    on it (z1 only the first state); with a z1 prior from training starts (prior_bank.py), also the shipped way with
+    z1 from N(0, I); then OTHER_SAMPLINGS."""
     mix = shipped.get("mix", 0.0) if shipped["mode"] == "z1" else 0.0
-    if not mix:
-        return {"one z1 (Algorithm 1, shipped)": shipped, **OTHER_SAMPLINGS}
-    return {f"one z1, also {mix:.0%} of every step (shipped)": shipped, "one z1 as Algorithm 1 (only the first state)": {"mode": "z1"},
-            **OTHER_SAMPLINGS}
+    prior = shipped.get("z1_prior") if shipped["mode"] == "z1" else None
+    where = f"z1 from the posteriors of {prior['starts']} training starts" if prior else "one z1"
+    out = {f"{where}, also {mix:.0%} of every step (shipped)" if mix else f"{where} (Algorithm 1, shipped)": shipped}
+    if prior:
+        normal = {k: v for k, v in shipped.items() if k != "z1_prior"}
+        out[f"one z1 from N(0, I), also {mix:.0%} of every step" if mix else "one z1 from N(0, I) (Algorithm 1)"] = normal
+    if mix:
+        out["one z1 from N(0, I) as Algorithm 1 (only the first state)"] = {"mode": "z1"}
+    return out | OTHER_SAMPLINGS
+
+
+def described(sampling: dict) -> dict:
+    """A sampling as the report states it: a z1 prior by where it comes from, not its numbers (vae-lstm.json has them)."""
+    prior = sampling.get("z1_prior")
+    return sampling | {"z1_prior": {k: prior[k] for k in ("kind", "starts", "seed")}} if prior else sampling
 
 
 def evaluate(mocap: str | None, previous: dict, models_dir: Path = MODELS_DIR) -> dict:
@@ -42,7 +54,7 @@ def evaluate(mocap: str | None, previous: dict, models_dir: Path = MODELS_DIR) -
     fps = vae.fps
     report: dict = {"fps": fps, "chunk_frames": vae.info["chunk_steps"] * vae.info["pooling"], "window_frames": vae.info["window"]}
 
-    report["sampling"] = vae.info["sampling"]
+    report["sampling"] = described(vae.info["sampling"])
     windows = erd_measures.prediction_windows(corpus)
     rows = m.prediction_rows(vae, corpus, windows, samplings(vae.info["sampling"]))
     if ERD_JSON.exists():
@@ -74,7 +86,8 @@ def evaluate(mocap: str | None, previous: dict, models_dir: Path = MODELS_DIR) -
         stats = [m.freeze_stats(m.long_run(vae, seed, sampling=sampling)["positions"], fps, median) for seed in range(LONG_RUN_SEEDS)]
         runs_s = m.held_out_control_runs(vae, corpus, sampling)
         report["samplings"][name] = {
-            "sampling": sampling, "diversity_cm": m.diversity(vae, corpus, sampling=sampling)["prior_samples_cm"],
+            "sampling": described(sampling), "diversity_cm": m.diversity(vae, corpus, sampling=sampling)["prior_samples_cm"],
+            "drawn_path_toes_cm": round(float(np.mean([w["toes_cm"] for w in m.drawn_path_diversity(vae, sampling=sampling)])), 2),
             "lowest_second": min(x["lowest_second"] for x in stats), "median_second": round(float(np.mean([x["median_second"] for x in stats])), 3),
             "share_below": round(float(np.mean([x["share_below"] for x in stats])), 4),
             "energy_held_out": round(float(np.mean([metrics.pose_change_per_second(p, fps).mean() for p, _ in runs_s]) / median), 3),
@@ -156,11 +169,20 @@ def write_markdown(r: dict, notes: dict, path: Path) -> None:
               f"For the control signal of each 4 s held-out window, {d['samples']} prior samples: mean pairwise joint distance relative to "
               f"the hips (each in its own facing frame), beside the same between real windows (held-out and training clips) whose mean "
               f"forward speed is within {m.SIMILAR_SPEED} m/s and mean turn within {m.SIMILAR_TURN} rad/s of it.", "",
-              f"Mean over windows: prior samples {d['prior_samples_cm']} cm; real windows with similar control {d['real_similar_cm']} cm.", "",
-              _row(["clip", "start", "forward (m/s)", "turn (rad/s)", "prior samples (cm)", "real, similar control (cm)", "similar real windows"]),
-              _row(["---"] * 7)]
+              "The model reads each clip's control smoothed as in training (10 frames); what is left of the stride's sway in it "
+              "still sets the phase of the steps, so the feet of prior samples for a clip's control keep the clip's stride. A drawn "
+              "path's control has no sway: the second table gives constant controls, as the page feeds a drawn path.", "",
+              f"Mean over windows: prior samples {d['prior_samples_cm']} cm (toes alone {d.get('prior_toes_cm')} cm); real windows with "
+              f"similar control {d['real_similar_cm']} cm (toes {d.get('real_similar_toes_cm')} cm).", "",
+              _row(["clip", "start", "forward (m/s)", "turn (rad/s)", "prior samples (cm)", "toes (cm)", "real, similar control (cm)", "toes (cm)", "similar real windows"]),
+              _row(["---"] * 9)]
     for w in d["windows"]:
-        lines.append(_row([w["clip"], w["start"], w["forward"], w["turn"], w["prior_samples_cm"], w["real_similar_cm"], w["real_similar_windows"]]))
+        lines.append(_row([w["clip"], w["start"], w["forward"], w["turn"], w["prior_samples_cm"], w.get("prior_toes_cm"), w["real_similar_cm"],
+                           w.get("real_similar_toes_cm"), w["real_similar_windows"]]))
+    lines += ["", f"Drawn-path controls (constant; {d['samples']} prior samples each):", "",
+              _row(["forward (m/s)", "turn (rad/s)", "all joints (cm)", "all joints, last 2 s (cm)", "toes (cm)", "toes, last 2 s (cm)"]), _row(["---"] * 6)]
+    for w in d.get("drawn_paths", []):
+        lines.append(_row([w["forward"], w["turn"], w["joints_cm"], w["joints_last_2s_cm"], w["toes_cm"], w["toes_last_2s_cm"]]))
     lines += ["", f"![prior samples beside the real window]({VARIATIONS_PNG})", ""] + notes.get("diversity", [])
     lines += ["", "### Ways of drawing a prior sample", "",
               "The same measures for each way of drawing a prior sample (generation.py): one z1 and the cell on its own state "
@@ -168,11 +190,11 @@ def write_markdown(r: dict, notes: dict, path: Path) -> None:
               "per step in teacher mode (the paper's other way), independent (rho 0) or correlated "
               f"from step to step (AR(1), rho 0.9). The page uses `{json.dumps(r['sampling'])}` (vae-lstm.json). Jitter: RMS second "
               f"difference of the joints relative to the hips, real held-out clips {r['jitter_real_cm']} cm per frame².", "",
-              _row(["prior sample", "diversity (cm)", "long runs: lowest second / median", "mean median second / median", "seconds below 20%",
-                    "energy, held-out control", "jitter (cm/frame²)", "sliding after lock: contact bits / lowest point (m/s)"]), _row(["---"] * 8)]
+              _row(["prior sample", "diversity (cm)", "toes, drawn paths (cm)", "long runs: lowest second / median", "mean median second / median", "seconds below 20%",
+                    "energy, held-out control", "jitter (cm/frame²)", "sliding after lock: contact bits / lowest point (m/s)"]), _row(["---"] * 9)]
     for name, x in r["samplings"].items():
         sl = x["sliding_held_out_control"]
-        lines.append(_row([name, x["diversity_cm"], x["lowest_second"], x["median_second"], f"{x['share_below'] * 100:.1f}%", x["energy_held_out"],
+        lines.append(_row([name, x["diversity_cm"], x.get("drawn_path_toes_cm"), x["lowest_second"], x["median_second"], f"{x['share_below'] * 100:.1f}%", x["energy_held_out"],
                            x["jitter_cm"], f"{sl['contact_bits_after']} / {sl['low_foot_after']}"]))
     e = r["energy"]
     lines += ["", "## Foot sliding", "",
@@ -212,8 +234,9 @@ VARIATION_JOINTS = ("RightHand", "RightToeBase")
 
 
 def variations_figure(models_dir: Path, mocap: str | None, path: Path, samples: int = 4) -> None:
-    """Prior samples for one held-out window's control beside the real window: the right hand's and right toe's
-    height and forward offset from the hips (facing frame) over the 4 s, so the variations are seen, not only counted."""
+    """Prior samples for one held-out window's control beside the real window (top), and for a drawn straight path at
+    1.2 m/s, the page's walk (bottom): the right hand's and right toe's height and forward offset from the hips
+    (facing frame) over the 4 s, so the variations are seen, not only counted."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -224,19 +247,23 @@ def variations_figure(models_dir: Path, mocap: str | None, path: Path, samples: 
     window = vae.info["window"]
     clip = corpus.valid_clips[0]
     real = clip.rows[:window]
-    control = real[:, CONTROL_SLICE]
-    motions = [m.local_positions(vae.rows(control, *vae.prior(1000 + k, window))) for k in range(samples)]
+    cases = ((f"the control of {Path(clip.file).name}, first 4 s", vae.clip_control(clip.rows)[:window], real),
+             ("a drawn straight path at 1.2 m/s", m.drawn_control(1.2, 0.0, window), None))
     t = np.arange(window) / vae.fps
-    fig, axes = plt.subplots(1, 2 * len(VARIATION_JOINTS), figsize=(16, 3.4))
-    for col, (name, axis, label) in enumerate((n, a, lab) for n in VARIATION_JOINTS for a, lab in ((1, "height"), (2, "forward"))):
-        j = JOINTS.index(name)
-        ax = axes[col]
-        for k, mo in enumerate(motions):
-            ax.plot(t, mo[:, j, axis], lw=1, color=f"C{k}", label=f"prior sample {k + 1}")
-        ax.plot(t, m.local_positions(real)[:, j, axis], lw=2, color="k", ls="--", label="real window")
-        ax.set(title=f"{name}: {label} from the hips (m)", xlabel="s")
-    axes[0].legend(fontsize=7)
-    fig.suptitle(f"VAE-LSTM prior samples (one z1 each) for the control of {Path(clip.file).name}, first 4 s", fontsize=9)
+    fig, axes = plt.subplots(len(cases), 2 * len(VARIATION_JOINTS), figsize=(16, 3.2 * len(cases)))
+    for row, (title, control, real_rows) in enumerate(cases):
+        motions = [m.local_positions(vae.rows(control, *vae.prior(1000 + k, window))) for k in range(samples)]
+        for col, (name, axis, label) in enumerate((n, a, lab) for n in VARIATION_JOINTS for a, lab in ((1, "height"), (2, "forward"))):
+            j = JOINTS.index(name)
+            ax = axes[row, col]
+            for k, mo in enumerate(motions):
+                ax.plot(t, mo[:, j, axis], lw=1, color=f"C{k}", label=f"prior sample {k + 1}")
+            if real_rows is not None:
+                ax.plot(t, m.local_positions(real_rows)[:, j, axis], lw=2, color="k", ls="--", label="real window")
+            ax.set(title=f"{name}: {label} from the hips (m)", xlabel="s")
+        axes[row, 0].legend(fontsize=7)
+        axes[row, 0].annotate(title, (0, 1.18), xycoords="axes fraction", fontsize=9, weight="bold")
+    fig.suptitle("VAE-LSTM prior samples (the shipped sampling, seeds 1000-1003)", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=80)
     plt.close(fig)

@@ -14,6 +14,16 @@ export const VAE_LSTM_GRAPHS = {
 
 export type VaeLstmGraph = keyof typeof VAE_LSTM_GRAPHS;
 
+/**
+ * Where a prior sample's z1 comes from when not N(0, I) (training/vae_lstm/prior_bank.py): the posterior means of K
+ * training starts and one sigma per latent dimension; z1 = means[k] + sigma · normals (priorLatents).
+ */
+export interface Z1Prior {
+  kind: 'posteriors';
+  means: number[][];
+  sigma: number[];
+}
+
 export interface VaeLstmInfo {
   id: string;
   kind: string;
@@ -38,8 +48,9 @@ export interface VaeLstmInfo {
    * How a seed's prior sample is drawn (training/vae_lstm/generation.py): "z1", one latent and the cell on its
    * own state (Algorithm 1; with `mix`, a model trained so, z1 is also that share of every step's content, in
    * starts from 4 frames too), or "steps", a latent per step in teacher mode, AR(1) with lag-one correlation rho.
+   * With `z1_prior` z1 is drawn from the posteriors of training starts instead of N(0, I).
    */
-  sampling: { mode: 'z1'; mix?: number } | { mode: 'steps'; rho: number };
+  sampling: { mode: 'z1'; mix?: number; z1_prior?: Z1Prior } | { mode: 'steps'; rho: number };
   onnx: Record<VaeLstmGraph, { inputs: string[]; outputs: string[] }>;
   skeleton: { joints: string[]; parents: number[]; offsets: number[] };
   rows: {
@@ -79,9 +90,12 @@ const format = modelInfoFormat<VaeLstmInfo>('VaeLstmInfoError', 'vae-lstm.json',
     const rho = check.num(sampling.rho, 'sampling.rho');
     if (!(rho >= 0 && rho < 1)) fail(`sampling.rho must be in [0, 1), got ${rho}`);
   } else if (sampling.mode !== 'z1') fail(`sampling.mode must be "z1" or "steps", got ${JSON.stringify(sampling.mode)}`);
-  else if (sampling.mix !== undefined) {
-    const mix = check.num(sampling.mix, 'sampling.mix');
-    if (!(mix >= 0 && mix < 1)) fail(`sampling.mix must be in [0, 1), got ${mix}`);
+  else {
+    if (sampling.mix !== undefined) {
+      const mix = check.num(sampling.mix, 'sampling.mix');
+      if (!(mix >= 0 && mix < 1)) fail(`sampling.mix must be in [0, 1), got ${mix}`);
+    }
+    if (sampling.z1_prior !== undefined) checkZ1Prior(sampling.z1_prior, posInt(root.latent, 'latent'), fail);
   }
   check.skeleton(root.skeleton);
   check.normalisation(root.normalisation, checkRowLayout(check, root.rows, (root.skeleton as { joints: string[] }).joints));
@@ -102,4 +116,14 @@ export async function loadVaeLstmModel(url: string): Promise<VaeLstmModel> {
   const info = await loadVaeLstmInfo(url);
   const urls = Object.fromEntries(Object.entries(info.files).map(([k, f]) => [k, new URL(f, url).href])) as Record<VaeLstmGraph, string>;
   return { info, urls };
+}
+
+function checkZ1Prior(value: unknown, latent: number, fail: (message: string) => never): void {
+  const prior = value as Partial<Z1Prior> | null;
+  if (typeof prior !== 'object' || prior === null || prior.kind !== 'posteriors') fail('sampling.z1_prior must be an object of kind "posteriors"');
+  const finiteRow = (row: unknown): boolean => Array.isArray(row) && row.length === latent && row.every((v) => typeof v === 'number' && Number.isFinite(v));
+  if (!Array.isArray(prior.means) || prior.means.length === 0 || !prior.means.every(finiteRow)) {
+    fail(`sampling.z1_prior.means must be a non-empty list of rows of ${latent} finite numbers`);
+  }
+  if (!finiteRow(prior.sigma) || !prior.sigma!.every((v) => v >= 0)) fail(`sampling.z1_prior.sigma must be ${latent} numbers, none negative`);
 }

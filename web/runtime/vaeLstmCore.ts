@@ -3,8 +3,9 @@
 // (Habibie et al., Algorithm 1; training/vae_lstm/generation.py):
 //   1. the control signal (frames × [forward, sideways, turn], padded to a multiple of 4 frames by repeating
 //      the last) is normalised and encoded in one call (vae-lstm-control.onnx);
-//   2. the prior sample is drawn by the seed (Rng, so the same seed gives the same motion; priorLatents): z1,
-//      and when the model's `sampling` is "steps" a latent per step, or given;
+//   2. the prior sample is drawn by the seed (Rng, so the same seed gives the same motion; priorLatents): z1
+//      (from the posteriors of training starts when the model's sampling has a z1_prior), and when the model's
+//      `sampling` is "steps" a latent per step, or given;
 //   3. the cell runs chunk after chunk of chunk_steps steps (vae-lstm.onnx: the state goes in and out), on its
 //      own state from z1 (Algorithm 1) or in teacher mode on the per-step latents; its states form the canvas;
 //   4. the canvas is decoded in one call (vae-lstm-decoder.onnx) into rows: joint positions in the root's
@@ -17,7 +18,7 @@ import { integrateControl, randomControl, type Root } from '../motion/control';
 import { SkeletonFitter } from '../motion/fitSkeleton';
 import { plantFeet } from '../motion/footLock';
 import { Rng } from '../model/sampler';
-import { VAE_LSTM_GRAPHS, type VaeLstmGraph, type VaeLstmInfo, type VaeLstmModel } from '../model/vaeLstmInfo';
+import { VAE_LSTM_GRAPHS, type VaeLstmGraph, type VaeLstmInfo, type VaeLstmModel, type Z1Prior } from '../model/vaeLstmInfo';
 import type { BenchmarkResult } from './protocol';
 import { checkFrameCount, SessionCore, timeSteps } from './session';
 import type { VaeLstmChunk, VaeLstmGenerateParams, VaeLstmInitResult, VaeLstmParityInputs, VaeLstmParityResult } from './vaeLstmProtocol';
@@ -50,13 +51,20 @@ export function freeLatents(z1: Float32Array, steps: number, sampling: VaeLstmIn
 
 /**
  * A seed's prior draws (training/vae_lstm/generation.py prior_latents, the same numbers): z1, `latent` draws
- * of N(0, 1) from the page's Rng, and with `steps` the per-step latents (steps × latent): z1 first, then
+ * of N(0, 1) from the page's Rng — or with `z1Prior` one uniform picking mean k = floor(u·K), then means[k] + sigma ·
+ * `latent` normals (draw_z1) — and with `steps` the per-step latents (steps × latent): z1 first, then
  * rho · previous + sqrt(1 − rho²) · a new draw, in the same stream.
  */
-export function priorLatents(seed: number, latent: number, steps = 0, rho = 0): { z1: Float32Array; zs?: Float32Array } {
+export function priorLatents(seed: number, latent: number, steps = 0, rho = 0, z1Prior?: Z1Prior): { z1: Float32Array; zs?: Float32Array } {
   const rng = new Rng(seed);
   const z1 = new Float32Array(latent);
-  for (let i = 0; i < latent; i++) z1[i] = rng.normal();
+  if (z1Prior) {
+    const K = z1Prior.means.length;
+    const mean = z1Prior.means[Math.min(Math.floor(rng.uniform() * K), K - 1)];
+    for (let i = 0; i < latent; i++) z1[i] = mean[i] + z1Prior.sigma[i] * rng.normal();
+  } else {
+    for (let i = 0; i < latent; i++) z1[i] = rng.normal();
+  }
   if (!steps) return { z1 };
   const zs = new Float32Array(steps * latent);
   zs.set(z1);
@@ -226,7 +234,7 @@ export class VaeLstmCore {
     const steps = Math.ceil(frames / this.info.pooling);
     const sampling = this.info.sampling;
     const drawn = options.z1 ? { z1: Float32Array.from(options.z1), zs: options.zs ? Float32Array.from(options.zs) : undefined }
-      : sampling.mode === 'steps' ? priorLatents(seed, latent, steps, sampling.rho) : priorLatents(seed, latent);
+      : sampling.mode === 'steps' ? priorLatents(seed, latent, steps, sampling.rho) : priorLatents(seed, latent, 0, 0, sampling.z1_prior);
     const { z1, zs } = drawn;
     if (z1.length !== latent) throw new Error(`z1 has ${z1.length} values, the model's latent has ${latent}`);
     const { rows, cellCalls } = await this.rowsFor(control, z1, zs, signal);
