@@ -18,6 +18,7 @@ from training.vae_lstm.generation import SEED_FRAMES, SEED_PAD, free_latents, pr
 from training.vae_lstm.measures import ShippedVae
 from training.models.losses import energy_loss
 from training.vae_lstm.recovery import vae_lstm_from_onnx
+from training.vae_lstm.stride import phase_start, stride_sway
 from training.vae_lstm.training import kl_per_step, losses
 
 FIXTURE = REPO / "tests" / "fixtures" / "vae_lstm_reference.json"
@@ -125,6 +126,28 @@ def test_a_z1_prior_picks_a_start_by_the_first_uniform_and_draws_around_it():
     assert shipped["z1_prior"] and len(info["sampling"]["z1_prior"]["means"]) == info["sampling"]["z1_prior"]["starts"]
     for seed, z1 in shipped["z1"].items():
         np.testing.assert_array_equal(prior_latents(int(seed), info["latent"], z1_prior=info["sampling"]["z1_prior"])[0], np.float32(z1))
+
+
+def test_the_stride_sway_follows_its_bands_and_period():
+    shape = [[float(i), 0.0, -float(i)] for i in range(4)]
+    stride = {"phase_bins": 4, "bands": [{"speed": 1.0, "period_s": 0.4, "sway": shape},
+                                         {"speed": 2.0, "period_s": 0.2, "sway": [[2 * a, b, 2 * c] for a, b, c in shape]}]}
+    # At 1 m/s, 10 fps: a period of 4 frames, so phase bins 0, 1, 2, 3, 0, ... frame by frame.
+    sway = stride_sway(np.tile([1.0, 0.0, 0.0], (6, 1)), 10.0, stride, 0.0)
+    np.testing.assert_allclose(sway[:, 0], [0, 1, 2, 3, 0, 1], atol=1e-12)
+    np.testing.assert_allclose(sway[:, 2], -sway[:, 0])
+    # Halfway between the bands' speeds: halfway between their sways, and a period between theirs (3 frames).
+    mid = stride_sway(np.tile([1.5, 0.0, 0.0], (3, 1)), 10.0, stride, 0.25)
+    np.testing.assert_allclose(mid[0], [1.5, 0.0, -1.5])
+    # Slower than the first band or faster than the last: that band as it is.
+    np.testing.assert_allclose(stride_sway(np.array([[0.1, 0, 0], [9.0, 0, 0]]), 10.0, stride, 0.5)[:, 0], [2.0, 2 * 3.0])
+    # The shipped JSON's stride and the sway the page is checked against (fixture "stride_sway").
+    info = json.loads((REPO / "public" / "models" / "vae-lstm.json").read_text())
+    fixture = json.loads(FIXTURE.read_text())["stride_sway"]
+    control = np.array(fixture["control"]).reshape(-1, 3)
+    for seed, want in fixture["seeds"].items():
+        assert phase_start(int(seed)) == want["phase"]
+        np.testing.assert_allclose(stride_sway(control, info["fps"], info["stride"], want["phase"]).ravel(), want["sway"], atol=1e-12)
 
 
 def test_the_shipped_graphs_reproduce_the_fixture_generation():

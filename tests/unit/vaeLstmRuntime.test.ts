@@ -7,6 +7,7 @@ import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { integrateControl, PolylinePath } from '../../web/motion/control';
 import { parseVaeLstmInfo, VAE_LSTM_GRAPHS, type VaeLstmGraph, type VaeLstmModel } from '../../web/model/vaeLstmInfo';
 import { freeLatents, priorLatents, VaeLstmCore } from '../../web/runtime/vaeLstmCore';
+import { phaseStart, strideSway } from '../../web/model/vaeLstmStride';
 import { controlForPath, followPathVae } from '../../web/runtime/vaeLstmRequests';
 import { readRepoFile } from './corpus';
 import { bytes, maxAbsDiff, ort, shippedSession } from './shippedModel';
@@ -21,6 +22,8 @@ interface Fixture {
   generate: { control: number[]; frames: number; z1: number[]; rows: number[] };
   prior: { seed: number; z1: number[]; rho: number; steps: number[][] };
   generate_steps: { zs: number[]; rows: number[] };
+  /** The stride's sway for a control and a few seeds (training/vae_lstm/stride.py). */
+  stride_sway: { control: number[]; seeds: Record<string, { phase: number; sway: number[] }> };
   /** z1 of a few seeds drawn as the shipped JSON says (generation.draw_z1 with its z1_prior). */
   shipped_prior: { z1_prior: boolean; z1: Record<string, number[]> };
 }
@@ -103,6 +106,40 @@ describe('VAE-LSTM generation', () => {
     const nearest = Math.min(...prior!.means.map((m) => Math.hypot(...m.map((v, i) => (v - z1[i]) / prior!.sigma[i]))));
     expect(nearest).toBeLessThan(1.5 * Math.sqrt(info.latent));
     expect(maxAbsDiff(z1, priorLatents(4, info.latent).z1)).toBeGreaterThan(0.5);
+  });
+
+  it('adds the stride a drawn path lacks as the Python side does (stride.py: the same phase and sway)', () => {
+    const { control, seeds } = fixture.stride_sway;
+    for (const [seed, want] of Object.entries(seeds)) {
+      expect(phaseStart(Number(seed))).toBe(want.phase);
+      expect(maxAbsDiff(strideSway(control, info.fps, info.stride!, want.phase), want.sway)).toBeLessThan(1e-12);
+    }
+  });
+
+  it('keeps stepping on a drawn straight path with the stride added, and glides without it', async () => {
+    const frames = 450; // 15 s at 1.2 m/s
+    const control = Array.from({ length: frames * 3 }, (_, i) => (i % 3 === 0 ? 1.2 : 0));
+    const J = info.rows.joints.length, toe = info.rows.joints.indexOf('RightToeBase'), D = info.rows.dim;
+    const lastSwing = (rows: Float32Array) => {
+      // The toe's forward offset from the hips (root facing frame) over each of the last 5 seconds: its range, averaged.
+      let sum = 0;
+      for (let s = frames - 150; s < frames; s += 30) {
+        let lo = Infinity, hi = -Infinity;
+        for (let f = s; f < s + 30; f++) {
+          const fwd = rows[f * D + toe * 3 + 2] - rows[f * D + 2];
+          lo = Math.min(lo, fwd);
+          hi = Math.max(hi, fwd);
+        }
+        sum += (hi - lo) / 5;
+      }
+      return sum;
+    };
+    expect(J).toBeGreaterThan(toe);
+    const walking = await core.generate({ seed: 2, frames, control, footLock: false });
+    const gliding = await core.generate({ seed: 2, frames, control, footLock: false, stride: false });
+    expect(lastSwing(walking.rows)).toBeGreaterThan(0.4); // a real walk swings the toe about 0.7 m a second
+    expect(lastSwing(gliding.rows)).toBeLessThan(0.1);
+    expect(Array.from(walking.roots)).toEqual(Array.from(gliding.roots)); // the root moves by the control either way
   });
 
   it('the seed draws z1: the same seed gives the same motion, another seed another one', async () => {
@@ -189,6 +226,9 @@ describe('vae-lstm.json checks', () => {
     expect(() => parseVaeLstmInfo({ ...json, sampling: { mode: 'steps', rho: 1 } })).toThrow(/sampling\.rho must be in \[0, 1\)/);
     expect(() => parseVaeLstmInfo({ ...json, sampling: { mode: 'many' } })).toThrow(/sampling\.mode must be "z1" or "steps"/);
     expect(() => parseVaeLstmInfo({ ...json, sampling: { mode: 'z1', mix: 1 } })).toThrow(/sampling\.mix must be in \[0, 1\)/);
+    expect(() => parseVaeLstmInfo({ ...json, stride: { ...json.stride, phase_bins: 1 } })).toThrow(/stride\.phase_bins must be an integer of at least 2/);
+    expect(() => parseVaeLstmInfo({ ...json, stride: { ...json.stride, bands: [...json.stride.bands].reverse() } })).toThrow(/stride\.bands\[1\]\.speed must be a number above/);
+    expect(() => parseVaeLstmInfo({ ...json, stride: { ...json.stride, bands: [{ ...json.stride.bands[0], sway: [[0, 0, 0]] }] } })).toThrow(/stride\.bands\[0\]\.sway must be 16 rows of 3 finite numbers/);
     const prior = json.sampling.z1_prior;
     expect(() => parseVaeLstmInfo({ ...json, sampling: { ...json.sampling, z1_prior: { ...prior, means: [prior.means[0].slice(1)] } } })).toThrow(/sampling\.z1_prior\.means must be a non-empty list of rows of 128 finite numbers/);
     expect(() => parseVaeLstmInfo({ ...json, sampling: { ...json.sampling, z1_prior: { ...prior, sigma: prior.sigma.map(() => -1) } } })).toThrow(/sampling\.z1_prior\.sigma must be 128 numbers, none negative/);

@@ -37,6 +37,7 @@ from ..onnx.sessions import cpu_session
 from ..paths import MODELS_DIR, REPO_ROOT
 from .generation import CHUNK_STEPS, SEED_FRAMES, SEED_PAD, free_latents, prior_latents
 from .prior_bank import posterior_prior
+from .stride import fit_stride, phase_start, stride_sway
 from .recovery import vae_lstm_from_onnx
 
 PARITY_TOLERANCE = 1e-4
@@ -198,12 +199,19 @@ def write_fixture(model: VaeLstm, info: dict, path: Path = FIXTURE) -> None:
     z1_prior = info["sampling"].get("z1_prior")
     # The shipped draw of z1 for a few seeds (generation.draw_z1 with the JSON's z1_prior, when it has one).
     shipped_draws = {str(seed): prior_latents(seed, model.latent, z1_prior=z1_prior)[0].tolist() for seed in PRIOR_FIXTURE_SEEDS}
+    # The stride's sway added to a drawn control (stride.py), on a control whose speed crosses every band.
+    stride = info.get("stride")
+    sway_control = np.stack([np.linspace(0.0, 3.0, 150), np.zeros(150), np.full(150, 0.3)], axis=1).round(6)
+    sway = {"control": sway_control.ravel().tolist(),
+            "seeds": {str(seed): {"phase": phase_start(seed), "sway": stride_sway(sway_control, info["fps"], stride, phase_start(seed)).ravel().tolist()}
+                      for seed in PRIOR_FIXTURE_SEEDS}} if stride else None
     steps = frames // POOLING
     zs = rng.normal(size=(steps, model.latent)).round(6).astype(np.float32)
     rows_steps = generate_rows(model, ((physical - mean) / std).astype(np.float32), z1, zs)
     fixture = {"model": info["id"], "tolerance": 2e-4, "graphs": graphs_out,
                "prior": {"seed": PRIOR_FIXTURE_SEED, "z1": prior.tolist(), "rho": PRIOR_FIXTURE_RHO, "steps": prior_steps.tolist()},
                "shipped_prior": {"z1_prior": z1_prior is not None, "z1": shipped_draws},
+               "stride_sway": sway,
                "generate_steps": {"zs": zs.round(6).ravel().tolist(), "rows": rows_steps.round(6).ravel().tolist()},
                "generate": {"control": physical.round(6).ravel().tolist(), "frames": frames, "z1": z1.round(6).tolist(),
                             "rows": rows.round(6).ravel().tolist()}}
@@ -242,11 +250,13 @@ def _publish(info: dict, stored: VaeLstm, out: Path) -> None:
 def export_vae_lstm(model: VaeLstm, meta: dict, report: dict, sampling: dict, out: Path = MODELS_DIR,
                     weights: str = "int8", prior_corpus: WindowCorpus | None = None) -> dict:
     """The four graphs and the JSON; with `prior_corpus` a "z1" sampling draws z1 from the posteriors of its
-    training starts (prior_bank.py) instead of N(0, I)."""
+    training starts (prior_bank.py) instead of N(0, I), and a drawn path gets the stride's sway (stride.py)."""
     stored, parity = _write_checked(model, out, weights)
     if prior_corpus is not None and sampling["mode"] == "z1":
         sampling = sampling | {"z1_prior": posterior_prior(out / FILES["inference"], prior_corpus)}
     info = vae_lstm_info(meta, model, report, sampling) | parity
+    if prior_corpus is not None:
+        info["stride"] = fit_stride(prior_corpus, float(meta["control_sigma"]), float(meta["fps"]))
     _publish(info, stored, out)
     return info
 
@@ -266,14 +276,14 @@ def rewrite_vae_lstm(source: Path, out: Path = MODELS_DIR, weights: str = "int8"
     return info
 
 
-def refit_z1_prior(corpus: WindowCorpus, models_dir: Path = MODELS_DIR) -> dict:
-    """The shipped model's z1 prior fitted again (prior_bank.py) on its own inference graph, written into its JSON,
-    and the browser fixture written again from the shipped graphs."""
+def refit_drawn_path_fields(corpus: WindowCorpus, models_dir: Path = MODELS_DIR) -> dict:
+    """The shipped model's z1 prior (prior_bank.py, on its own inference graph) and the stride it adds to a drawn path
+    (stride.py) fitted again and written into its JSON, and the browser fixture written again from the shipped graphs."""
     path = models_dir / "vae-lstm.json"
     info = json.loads(path.read_text())
-    if info["sampling"]["mode"] != "z1":
-        raise ValueError(f"{path}: sampling mode {info['sampling']['mode']!r} draws a latent per step; the z1 prior is for mode \"z1\"")
-    info["sampling"] = info["sampling"] | {"z1_prior": posterior_prior(models_dir / info["files"]["inference"], corpus)}
+    if info["sampling"]["mode"] == "z1":
+        info["sampling"] = info["sampling"] | {"z1_prior": posterior_prior(models_dir / info["files"]["inference"], corpus)}
+    info["stride"] = fit_stride(corpus, float(info["control_smoothing_frames"]), float(info["fps"]))
     path.write_text(json.dumps(info) + "\n")
     if models_dir.resolve() == MODELS_DIR.resolve():
         write_fixture(vae_lstm_from_onnx(models_dir, FILES), info)

@@ -1,5 +1,6 @@
-"""Fit the shipped VAE-LSTM's z1 prior again: the posteriors of random training starts (prior_bank.py), written into
-public/models/vae-lstm.json's sampling.z1_prior, and tests/fixtures/vae_lstm_reference.json written again.
+"""Fit again what the shipped VAE-LSTM draws and reads besides its graphs: the z1 prior, the posteriors of random
+training starts (prior_bank.py; vae-lstm.json sampling.z1_prior), and the stride a drawn path lacks (stride.py;
+vae-lstm.json stride); tests/fixtures/vae_lstm_reference.json is written again.
 
     python -m training.vae_lstm.fit_prior [--mocap DIR]
 
@@ -11,19 +12,19 @@ import argparse
 
 from ..data.locomotion import load_clips
 from ..data.windows import WindowCorpus
-from .exporting import refit_z1_prior
+from .exporting import refit_drawn_path_fields
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--mocap", default=None, help="the corpus (default ../shared/mocap or MOCAP_DIR)")
     args = parser.parse_args(argv)
-    try:
-        info = refit_z1_prior(WindowCorpus(load_clips(args.mocap)))
-    except ValueError as e:
-        raise SystemExit(f"error: {e}")
-    prior = info["sampling"]["z1_prior"]
-    print(f"vae-lstm.json: z1 prior from {prior['starts']} training starts, sigma {sum(prior['sigma']) / len(prior['sigma']):.3f} on average")
+    info = refit_drawn_path_fields(WindowCorpus(load_clips(args.mocap)))
+    prior = info["sampling"].get("z1_prior")
+    if prior:
+        print(f"vae-lstm.json: z1 prior from {prior['starts']} training starts, sigma {sum(prior['sigma']) / len(prior['sigma']):.3f} on average")
+    bands = info["stride"]["bands"]
+    print("vae-lstm.json: stride " + ", ".join(f"{b['speed']:.2f} m/s every {b['period_s']:.2f} s ({b['strides']} strides)" for b in bands))
 
 
 if __name__ == "__main__":

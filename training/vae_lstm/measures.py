@@ -34,6 +34,7 @@ from ..latent_erd.measures import sliding
 from ..onnx.sessions import cpu_session
 from .generation import SEED_FRAMES as INITIAL_FRAMES
 from .generation import SEED_PAD, free_latents, prior_latents
+from .stride import phase_start, stride_sway
 
 LONG_RUN_FRAMES = 3000
 DIVERSITY_SAMPLES = 10
@@ -118,6 +119,12 @@ class ShippedVae:
         control = clip_rows[:, CONTROL_SLICE]
         return smooth(control, self.control_sigma) if self.control_sigma > 0 else control
 
+    def read_control(self, control: np.ndarray, seed: int) -> np.ndarray:
+        """What the model reads for a drawn control (frames, 3), as the page feeds it: with the JSON's "stride", the
+        control plus the sway a real walk has at its speed, from the seed's gait phase (stride.py)."""
+        stride = self.info.get("stride")
+        return control + stride_sway(control, self.fps, stride, phase_start(seed)) if stride else control
+
     def world(self, control: np.ndarray, z1: np.ndarray, zs: np.ndarray | None = None, mix: float | None = None,
               start_xz=(0.0, 0.0), start_heading: float = 0.0, root_control: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """World positions (frames, joints, 3) with the root moved by `root_control` (default `control`, what the model
@@ -184,9 +191,47 @@ def pose_change(positions: np.ndarray, fps: float) -> np.ndarray:
 def long_run(vae: ShippedVae, seed: int, frames: int = LONG_RUN_FRAMES, sampling: dict | None = None) -> dict:
     control = random_control(seed, frames, vae.fps)
     t0 = time.perf_counter()
-    positions, bits = vae.world(control, *vae.prior(seed, frames, sampling))
+    positions, bits = vae.world(vae.read_control(control, seed), *vae.prior(seed, frames, sampling), root_control=control)
     seconds = time.perf_counter() - t0
     return {"seed": seed, "positions": positions, "bits": bits, "control": control, "seconds": seconds}
+
+
+# Drawn paths held for a long run: (forward m/s, turn rad/s). A drawn path's control is constant, with none of the
+# stride's sway a real root's velocity has.
+DRAWN_LONG_RUNS = {"walk, straight, 1.2 m/s": (1.2, 0.0), "walk, turning 0.5 rad/s, 1.2 m/s": (1.2, 0.5), "run, straight, 2.8 m/s": (2.8, 0.0)}
+
+
+def toe_swing(local: np.ndarray, fps: float) -> np.ndarray:
+    """Per whole second, the toes' forward swing (m): the range of each toe's forward offset from the hips in the
+    facing frame over the second, the two toes averaged. A stepping walk swings 0.5-0.9 m; a gliding body ~0."""
+    n = int(fps)
+    seconds = len(local) // n
+    forward = local[:seconds * n, TOES, 2].reshape(seconds, n, len(TOES))
+    return (forward.max(axis=1) - forward.min(axis=1)).mean(axis=1)
+
+
+def drawn_long_run(vae: ShippedVae, forward: float, turn: float, seed: int, median: float, frames: int = LONG_RUN_FRAMES,
+                   sampling: dict | None = None) -> dict:
+    """A prior sample driven by a constant control for `frames` frames: the toes' swing in the first 2 s and the last
+    10 s, and the pose change per second against the real median (freeze_stats)."""
+    control = drawn_control(forward, turn, frames)
+    prior = vae.prior(seed, frames, sampling)
+    read = vae.read_control(control, seed)
+    swing = toe_swing(local_positions(vae.rows(read, *prior)), vae.fps)
+    positions, _ = vae.world(read, *prior, root_control=control)
+    return {"seed": seed, "first_2s_swing_m": round(float(swing[:2].mean()), 3), "last_10s_swing_m": round(float(swing[-10:].mean()), 3),
+            **freeze_stats(positions, vae.fps, median)}
+
+
+def real_toe_swing(corpus: WindowCorpus, fps: float, least_speed: float = 0.8) -> dict:
+    """The held-out clips' toe swing per second, over the seconds whose mean forward speed is at least `least_speed`."""
+    swings = []
+    n = int(fps)
+    for c in corpus.valid_clips:
+        swing = toe_swing(local_positions(c.rows), fps)
+        speed = c.rows[:len(swing) * n, CONTROL_SLICE.start].reshape(len(swing), n).mean(axis=1)
+        swings += swing[speed >= least_speed].tolist()
+    return {"median_m": round(float(np.median(swings)), 3), "seconds": len(swings), "least_speed": least_speed}
 
 
 def chunk_seams(positions: np.ndarray, chunk_frames: int) -> dict:
@@ -228,7 +273,8 @@ def drawn_path_diversity(vae: ShippedVae, window: int = 120, sampling: dict | No
     out = []
     for forward, turn in DRAWN_CONTROLS:
         control = drawn_control(forward, turn, window)
-        samples = [local_positions(vae.rows(control, *vae.prior(1000 + k, window, sampling))) for k in range(DIVERSITY_SAMPLES)]
+        samples = [local_positions(vae.rows(vae.read_control(control, 1000 + k), *vae.prior(1000 + k, window, sampling)))
+                   for k in range(DIVERSITY_SAMPLES)]
         late = [s[-2 * int(vae.fps):] for s in samples]
         out.append({"forward": forward, "turn": turn, "joints_cm": mean_pairwise(samples), "joints_last_2s_cm": mean_pairwise(late),
                     "toes_cm": mean_pairwise([s[:, TOES] for s in samples]), "toes_last_2s_cm": mean_pairwise([s[:, TOES] for s in late])})

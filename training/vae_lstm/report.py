@@ -80,6 +80,9 @@ def evaluate(mocap: str | None, previous: dict, models_dir: Path = MODELS_DIR) -
     report["long_runs"] = {"real_median_pose_change": round(median, 4), "runs": runs,
                            "real_share_below": erd_measures.real_share_below(corpus, fps, median),
                            "real_frame_change_cm": erd_measures.real_frame_change(corpus)}
+    report["drawn_long_runs"] = {"runs": {name: [m.drawn_long_run(vae, forward, turn, seed, median) for seed in range(LONG_RUN_SEEDS)]
+                                          for name, (forward, turn) in m.DRAWN_LONG_RUNS.items()},
+                                 "real_toe_swing": m.real_toe_swing(corpus, fps)}
     report["diversity"] = m.diversity(vae, corpus)
     report["samplings"] = {}
     for name, sampling in samplings(vae.info["sampling"]).items():
@@ -164,6 +167,18 @@ def write_markdown(r: dict, notes: dict, path: Path) -> None:
         s = run["seams"]
         lines.append(_row([run["seed"], run["frames"], run["finite"], run["lowest_second"], run["median_second"], f"{run['share_below'] * 100:.1f}%",
                            s["boundary_cm"], s["elsewhere_cm"], run["x_real_time_native"]]))
+    if "drawn_long_runs" in r:
+        dl = r["drawn_long_runs"]
+        real = dl["real_toe_swing"]
+        lines += ["", "Drawn paths held for 3,000 frames: a constant control, read with the stride's sway added as the page reads a "
+                  f"drawn path (vae-lstm.json `stride`, training/vae_lstm/stride.py), one prior sample per seed. Toe swing: each second's range of the toes' forward offset from the hips (m), the two toes "
+                  f"averaged; real held-out clips {real['median_m']} m (median over {real['seconds']} seconds at {real['least_speed']} m/s or faster).", "",
+                  _row(["drawn path", "seed", "toe swing, first 2 s (m)", "toe swing, last 10 s (m)", "lowest second / real median",
+                        "median second / real median", "seconds below 20%"]), _row(["---"] * 7)]
+        for name, runs in dl["runs"].items():
+            for run in runs:
+                lines.append(_row([name, run["seed"], run["first_2s_swing_m"], run["last_10s_swing_m"], run["lowest_second"],
+                                   run["median_second"], f"{run['share_below'] * 100:.1f}%"]))
     d = r["diversity"]
     lines += ["", "## Variations from the prior", "",
               f"For the control signal of each 4 s held-out window, {d['samples']} prior samples: mean pairwise joint distance relative to "
@@ -171,7 +186,8 @@ def write_markdown(r: dict, notes: dict, path: Path) -> None:
               f"forward speed is within {m.SIMILAR_SPEED} m/s and mean turn within {m.SIMILAR_TURN} rad/s of it.", "",
               "The model reads each clip's control smoothed as in training (10 frames); what is left of the stride's sway in it "
               "still sets the phase of the steps, so the feet of prior samples for a clip's control keep the clip's stride. A drawn "
-              "path's control has no sway: the second table gives constant controls, as the page feeds a drawn path.", "",
+              "path's control has no sway; the page adds the stride's sway from a phase each seed draws (the second table: constant "
+              "controls read so).", "",
               f"Mean over windows: prior samples {d['prior_samples_cm']} cm (toes alone {d.get('prior_toes_cm')} cm); real windows with "
               f"similar control {d['real_similar_cm']} cm (toes {d.get('real_similar_toes_cm')} cm).", "",
               _row(["clip", "start", "forward (m/s)", "turn (rad/s)", "prior samples (cm)", "toes (cm)", "real, similar control (cm)", "toes (cm)", "similar real windows"]),
@@ -252,7 +268,9 @@ def variations_figure(models_dir: Path, mocap: str | None, path: Path, samples: 
     t = np.arange(window) / vae.fps
     fig, axes = plt.subplots(len(cases), 2 * len(VARIATION_JOINTS), figsize=(16, 3.2 * len(cases)))
     for row, (title, control, real_rows) in enumerate(cases):
-        motions = [m.local_positions(vae.rows(control, *vae.prior(1000 + k, window))) for k in range(samples)]
+        # A drawn path is read with the stride's sway added, as the page reads it; a clip's own control has its own.
+        read = (lambda k: control) if real_rows is not None else (lambda k: vae.read_control(control, 1000 + k))
+        motions = [m.local_positions(vae.rows(read(k), *vae.prior(1000 + k, window))) for k in range(samples)]
         for col, (name, axis, label) in enumerate((n, a, lab) for n in VARIATION_JOINTS for a, lab in ((1, "height"), (2, "forward"))):
             j = JOINTS.index(name)
             ax = axes[row, col]

@@ -14,6 +14,12 @@ export const VAE_LSTM_GRAPHS = {
 
 export type VaeLstmGraph = keyof typeof VAE_LSTM_GRAPHS;
 
+/** The stride's sway a drawn path lacks, per speed band (training/vae_lstm/stride.py; vaeLstmStride.ts). */
+export interface VaeLstmStride {
+  phase_bins: number;
+  bands: { speed: number; period_s: number; sway: number[][] }[];
+}
+
 /**
  * Where a prior sample's z1 comes from when not N(0, I) (training/vae_lstm/prior_bank.py): the posterior means of K
  * training starts and one sigma per latent dimension; z1 = means[k] + sigma · normals (priorLatents).
@@ -51,6 +57,8 @@ export interface VaeLstmInfo {
    * With `z1_prior` z1 is drawn from the posteriors of training starts instead of N(0, I).
    */
   sampling: { mode: 'z1'; mix?: number; z1_prior?: Z1Prior } | { mode: 'steps'; rho: number };
+  /** Added to a drawn control before the model reads it (absent: the control is read as given). */
+  stride?: VaeLstmStride;
   onnx: Record<VaeLstmGraph, { inputs: string[]; outputs: string[] }>;
   skeleton: { joints: string[]; parents: number[]; offsets: number[] };
   rows: {
@@ -97,6 +105,7 @@ const format = modelInfoFormat<VaeLstmInfo>('VaeLstmInfoError', 'vae-lstm.json',
     }
     if (sampling.z1_prior !== undefined) checkZ1Prior(sampling.z1_prior, posInt(root.latent, 'latent'), fail);
   }
+  if (root.stride !== undefined) checkStride(root.stride, fail);
   check.skeleton(root.skeleton);
   check.normalisation(root.normalisation, checkRowLayout(check, root.rows, (root.skeleton as { joints: string[] }).joints));
 });
@@ -126,4 +135,20 @@ function checkZ1Prior(value: unknown, latent: number, fail: (message: string) =>
     fail(`sampling.z1_prior.means must be a non-empty list of rows of ${latent} finite numbers`);
   }
   if (!finiteRow(prior.sigma) || !prior.sigma!.every((v) => v >= 0)) fail(`sampling.z1_prior.sigma must be ${latent} numbers, none negative`);
+}
+
+function checkStride(value: unknown, fail: (message: string) => never): void {
+  const stride = value as Partial<VaeLstmStride> | null;
+  const bins = stride?.phase_bins;
+  if (typeof stride !== 'object' || stride === null || !Number.isInteger(bins) || bins! < 2) fail('stride.phase_bins must be an integer of at least 2');
+  const bands = stride.bands;
+  if (!Array.isArray(bands) || bands.length === 0) fail('stride.bands must be a non-empty list');
+  let last = -Infinity;
+  bands.forEach((b, k) => {
+    if (!(typeof b?.speed === 'number' && b.speed > last)) fail(`stride.bands[${k}].speed must be a number above the band before's`);
+    last = b.speed;
+    if (!(typeof b.period_s === 'number' && b.period_s > 0)) fail(`stride.bands[${k}].period_s must be a positive number`);
+    const ok = Array.isArray(b.sway) && b.sway.length === bins && b.sway.every((row) => Array.isArray(row) && row.length === 3 && row.every((v) => typeof v === 'number' && Number.isFinite(v)));
+    if (!ok) fail(`stride.bands[${k}].sway must be ${bins} rows of 3 finite numbers`);
+  });
 }

@@ -10,6 +10,7 @@
 //      own state from z1 (Algorithm 1) or in teacher mode on the per-step latents; its states form the canvas;
 //   4. the canvas is decoded in one call (vae-lstm-decoder.onnx) into rows: joint positions in the root's
 //      facing frame, the decoded control and the contact channels;
+//   (the cell reads the control with the stride's sway a drawn path lacks added, vaeLstmStride.ts)
 //   5. the root moves by the control signal that was asked for (integrateControl), not by the decoded one,
 //      so the motion goes exactly where it was sent; the points are placed at it, fitted to the skeleton,
 //      and the feet are planted (contact labels from the decoded channels, then the lock: footLock.ts).
@@ -18,6 +19,7 @@ import { integrateControl, randomControl, type Root } from '../motion/control';
 import { SkeletonFitter } from '../motion/fitSkeleton';
 import { plantFeet } from '../motion/footLock';
 import { Rng } from '../model/sampler';
+import { withStride } from '../model/vaeLstmStride';
 import { VAE_LSTM_GRAPHS, type VaeLstmGraph, type VaeLstmInfo, type VaeLstmModel, type Z1Prior } from '../model/vaeLstmInfo';
 import type { BenchmarkResult } from './protocol';
 import { checkFrameCount, SessionCore, timeSteps } from './session';
@@ -237,7 +239,9 @@ export class VaeLstmCore {
       : sampling.mode === 'steps' ? priorLatents(seed, latent, steps, sampling.rho) : priorLatents(seed, latent, 0, 0, sampling.z1_prior);
     const { z1, zs } = drawn;
     if (z1.length !== latent) throw new Error(`z1 has ${z1.length} values, the model's latent has ${latent}`);
-    const { rows, cellCalls } = await this.rowsFor(control, z1, zs, signal);
+    // The model reads the control with the stride a drawn path lacks (vaeLstmStride.ts); the root moves by the control.
+    const read = this.info.stride && params.stride !== false ? withStride(control, fps, this.info.stride, seed) : control;
+    const { rows, cellCalls } = await this.rowsFor(read, z1, zs, signal);
     const J = this.skeleton.joints.length;
     const { xz, heading } = integrateControl(control, fps, options.root);
     const predicted = new Float32Array(frames * J * 3);

@@ -13,6 +13,8 @@ export interface VaeLstmGenerateParams {
   control?: ArrayLike<number>;
   /** Lock planted feet (default true). */
   footLock?: boolean;
+  /** Add the stride's sway a drawn path lacks to the control the model reads (default true; vaeLstmStride.ts). */
+  stride?: boolean;
 }
 
 export interface VaeLstmInitResult {
