@@ -109,7 +109,11 @@ const fragmentShader = /* glsl */ `
     spec *= spec; spec *= spec; spec *= spec; spec *= spec;
     vec3 col = vColor * (0.2 + 0.22 * fill + 0.68 * diff) + vec3(0.45, 0.55, 0.9) * (edge * edge * 0.3) + spec * 0.28;
     gl_FragColor = vec4(col, 1.0);
-    #include <fog_fragment>
+    // The scene's linear fog (three.js fog_fragment), held short of hiding the figure: framing a long drawn path
+    // puts it beyond the fog's far distance (14 m under software GL), where it would vanish into the background.
+    #ifdef USE_FOG
+      gl_FragColor.rgb = mix(gl_FragColor.rgb, fogColor, min(smoothstep(fogNear, fogFar, vFogDepth), 0.55));
+    #endif
   }`;
 
 export class Figure {
