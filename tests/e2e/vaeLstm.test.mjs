@@ -76,6 +76,15 @@ describe('the VAE-LSTM in Path mode', { timeout: 400_000 }, () => {
     assert.equal(Number(varied.seed), Number(first.seed) + 1);
     assert.equal(varied.walkedBy, 'vae-lstm');
     assert.ok(worst(varied.positions, first.positions) > 0.01, 'another z, another walk');
+    assert.doesNotMatch(varied.lines[0][1], /runs stop stepping/, 'a walk has no running note');
+
+    // Running: the line says how long the VAE-LSTM's runs last.
+    await page.selectOption('#path-gait', 'run');
+    await page.click('#path-go');
+    await waitUntil(page, () => $ui('path-status').dataset.state === 'done' && $ui('clip-meta').textContent.includes('· run ·'), null,
+      { timeout: 120_000, message: 'the VAE-LSTM runs the path' });
+    assert.match((await pathStatus(page)).lines[0][1], /its runs stop stepping after about 2 s/);
+    await page.selectOption('#path-gait', 'walk');
 
     // Steer runs the generator meanwhile.
     await page.click('#mode-steer');

@@ -72,13 +72,18 @@ function holdTo(motion: Motion, frames: number): Motion {
   return { ...motion, frames, positions, ...(contacts ? { contacts } : {}) };
 }
 
-/** A walk's numbers in one line: error, progress, time to compute, foot sliding. */
-function statsLine(w: Walk): string {
+/** A VAE-LSTM run stops stepping after about this long (docs/models/vae-lstm.md: the corpus's runs are no longer). */
+const VAE_LSTM_RUN_SECONDS = 2;
+
+/** A walk's numbers in one line: error, progress, time to compute, foot sliding; and a VAE-LSTM run's limit. */
+function statsLine(w: Walk, gait: Gait): string {
   const s = w.stats;
   const secs = (w.motion.frames - 1) / w.motion.fps;
   const sliding = Number.isFinite(s.sliding) ? ` · sliding ${s.sliding.toFixed(2)} m/s` : '';
+  const limit = w.model === 'vae-lstm' && gait === 'run' && secs > VAE_LSTM_RUN_SECONDS
+    ? ` · its runs stop stepping after about ${VAE_LSTM_RUN_SECONDS} s (the captured runs it learned from are that short)` : '';
   return `${CONTROL_MODEL_SHORT[w.model]}: error mean ${(s.meanError * 100).toFixed(1)} cm · max ${(s.maxError * 100).toFixed(1)} cm · ${Math.round(s.arcProgress * 100)} % of the path · ` +
-    `${(s.optimizeMs / 1000).toFixed(1)} s for ${secs.toFixed(1)} s of motion${sliding}`;
+    `${(s.optimizeMs / 1000).toFixed(1)} s for ${secs.toFixed(1)} s of motion${sliding}${limit}`;
 }
 
 function pathLength(points: Point[]): number {
@@ -508,7 +513,7 @@ export class PathMode {
       this.status.textContent = 'starting…';
     } else if (current) {
       for (const w of r.other ? [r, r.other] : [r]) {
-        const line = element('span', 'path-stats', statsLine(w));
+        const line = element('span', 'path-stats', statsLine(w, r.gait));
         line.dataset.model = w.model;
         this.status.append(line);
       }
