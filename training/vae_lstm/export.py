@@ -6,7 +6,8 @@ tests/fixtures/vae_lstm_reference.json.
 
 --sampling says how the page draws a seed's prior sample: "z1" (Algorithm 1: one latent, the cell on its own
 state) or "steps" (a latent per step in teacher mode, AR(1) with lag-one correlation --rho); generation.py. For
-"z1", --z1-prior posteriors (the default) draws z1 from the posteriors of training starts (prior_bank.py).
+"z1", --z1-prior posteriors (the default) draws z1 from the posteriors of training starts (prior_bank.py); every
+export also fits the stride a drawn path lacks (stride.py), from the corpus.
 --weights says how the files store their large weights (int8 with a scale per output channel, float16, float32;
 training/onnx/compact.py); parity and the fixture are against torch with the weights as stored.
 --from-shipped DIR reads the network back from DIR's four graphs (default the shipped ones; recovery.py) and keeps
@@ -32,8 +33,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--sampling", choices=["z1", "steps"], default="z1")
     parser.add_argument("--rho", type=float, default=0.9, help="steps: lag-one correlation of the per-step latents")
     parser.add_argument("--z1-prior", choices=["posteriors", "normal"], default="posteriors",
-                        help="z1: draw it from the posteriors of training starts (prior_bank.py; reads the corpus) or N(0, I)")
-    parser.add_argument("--mocap", default=None, help="the corpus for --z1-prior posteriors (default ../shared/mocap or MOCAP_DIR)")
+                        help="z1: draw it from the posteriors of training starts (prior_bank.py) or N(0, I)")
+    parser.add_argument("--mocap", default=None, help="the training corpus, for the z1 prior and the stride (default ../shared/mocap or MOCAP_DIR)")
     parser.add_argument("--weights", choices=FORMATS, default="int8", help="how the files store their large weights")
     parser.add_argument("--from-shipped", type=Path, nargs="?", const=MODELS_DIR, default=None, metavar="DIR",
                         help="no checkpoint: read the network back from DIR's graphs (default the shipped ones) and keep its JSON")
@@ -56,8 +57,8 @@ def main(argv: list[str] | None = None) -> None:
     free_mix = float(meta["args"].get("free_mix", 0.0))
     # A model trained with z1 in every step of its free mode (--free-mix) is run that way (generation.free_latents).
     sampling = ({"mode": "z1", "mix": free_mix} if free_mix > 0 else {"mode": "z1"}) if args.sampling == "z1" else {"mode": "steps", "rho": args.rho}
-    corpus = WindowCorpus(load_clips(args.mocap)) if args.sampling == "z1" and args.z1_prior == "posteriors" else None
-    export_vae_lstm(model, meta, {}, sampling, Path(args.out), args.weights, prior_corpus=corpus)
+    export_vae_lstm(model, meta, {}, sampling, Path(args.out), args.weights, corpus=WindowCorpus(load_clips(args.mocap)),
+                    z1_prior=args.z1_prior == "posteriors")
 
 
 if __name__ == "__main__":

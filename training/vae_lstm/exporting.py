@@ -248,15 +248,14 @@ def _publish(info: dict, stored: VaeLstm, out: Path) -> None:
 
 
 def export_vae_lstm(model: VaeLstm, meta: dict, report: dict, sampling: dict, out: Path = MODELS_DIR,
-                    weights: str = "int8", prior_corpus: WindowCorpus | None = None) -> dict:
-    """The four graphs and the JSON; with `prior_corpus` a "z1" sampling draws z1 from the posteriors of its
-    training starts (prior_bank.py) instead of N(0, I), and a drawn path gets the stride's sway (stride.py)."""
+                    weights: str = "int8", corpus: WindowCorpus | None = None, z1_prior: bool = True) -> dict:
+    """The four graphs and the JSON; with the training `corpus`, fit_sampling_fields: a drawn path gets the stride's
+    sway (stride.py) and, with `z1_prior`, a "z1" sampling draws z1 from the posteriors of its training starts
+    (prior_bank.py) instead of N(0, I)."""
     stored, parity = _write_checked(model, out, weights)
-    if prior_corpus is not None and sampling["mode"] == "z1":
-        sampling = sampling | {"z1_prior": posterior_prior(out / FILES["inference"], prior_corpus)}
     info = vae_lstm_info(meta, model, report, sampling) | parity
-    if prior_corpus is not None:
-        info["stride"] = fit_stride(prior_corpus, float(meta["control_sigma"]), float(meta["fps"]))
+    if corpus is not None:
+        fit_sampling_fields(info, out, corpus, z1_prior)
     _publish(info, stored, out)
     return info
 
@@ -276,14 +275,21 @@ def rewrite_vae_lstm(source: Path, out: Path = MODELS_DIR, weights: str = "int8"
     return info
 
 
-def refit_drawn_path_fields(corpus: WindowCorpus, models_dir: Path = MODELS_DIR) -> dict:
-    """The shipped model's z1 prior (prior_bank.py, on its own inference graph) and the stride it adds to a drawn path
-    (stride.py) fitted again and written into its JSON, and the browser fixture written again from the shipped graphs."""
+def fit_sampling_fields(info: dict, graphs: Path, corpus: WindowCorpus, z1_prior: bool = True) -> None:
+    """Fits into `info` (a vae-lstm.json) what the page draws and reads besides the graphs in `graphs`: the stride a
+    drawn path lacks (stride.py), and (`z1_prior`, for a "z1" sampling) the z1 prior, the posteriors of training
+    starts (prior_bank.py, on the inference graph)."""
+    if z1_prior and info["sampling"]["mode"] == "z1":
+        info["sampling"] = info["sampling"] | {"z1_prior": posterior_prior(graphs / FILES["inference"], corpus)}
+    info["stride"] = fit_stride(corpus, float(info["control_smoothing_frames"]), float(info["fps"]))
+
+
+def refit_sampling_fields(corpus: WindowCorpus, models_dir: Path = MODELS_DIR) -> dict:
+    """fit_sampling_fields on the shipped export's JSON, written back; and the browser fixture written again from the
+    shipped graphs."""
     path = models_dir / "vae-lstm.json"
     info = json.loads(path.read_text())
-    if info["sampling"]["mode"] == "z1":
-        info["sampling"] = info["sampling"] | {"z1_prior": posterior_prior(models_dir / info["files"]["inference"], corpus)}
-    info["stride"] = fit_stride(corpus, float(info["control_smoothing_frames"]), float(info["fps"]))
+    fit_sampling_fields(info, models_dir, corpus)
     path.write_text(json.dumps(info) + "\n")
     if models_dir.resolve() == MODELS_DIR.resolve():
         write_fixture(vae_lstm_from_onnx(models_dir, FILES), info)

@@ -27,7 +27,7 @@ import numpy as np
 
 from .. import metrics
 from ..control import random_control
-from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, JOINTS, POSITION_DIM, WindowCorpus, ground_frame, rows_to_world, smooth
+from ..data.windows import CONTACT_SLICE, CONTROL_SLICE, JOINTS, POSITION_DIM, WindowCorpus, ground_frame, rows_to_world
 from ..latent_erd.measures import FREEZE_FRACTION, HORIZONS, PREDICT_FRAMES, SEED_FRAMES, Window, prediction_errors
 from ..latent_erd.measures import prediction_windows as erd_prediction_windows
 from ..latent_erd.measures import sliding
@@ -35,11 +35,21 @@ from ..onnx.sessions import cpu_session
 from .generation import SEED_FRAMES as INITIAL_FRAMES
 from .generation import SEED_PAD, free_latents, prior_latents
 from .stride import phase_start, stride_sway
+from .training import smoothed_control
 
 LONG_RUN_FRAMES = 3000
 DIVERSITY_SAMPLES = 10
 SIMILAR_SPEED = 0.15  # m/s: real windows whose mean forward speed is this close count as similar control
 SIMILAR_TURN = 0.15  # rad/s, the same for the mean turn
+# Drawn paths (forward m/s, turn rad/s): a drawn path's control is constant, with none of the stride's sway a real
+# root's velocity has (the page adds it: ShippedVae.read_control). For diversity over 4 s, and held for long runs.
+DRAWN_CONTROLS = ((0.9, 0.0), (1.2, 0.0), (1.5, 0.0), (1.2, 0.5))
+DRAWN_LONG_RUNS = {"walk, straight, 1.2 m/s": (1.2, 0.0), "walk, turning 0.5 rad/s, 1.2 m/s": (1.2, 0.5), "run, straight, 2.8 m/s": (2.8, 0.0)}
+TOES = (JOINTS.index("LeftToeBase"), JOINTS.index("RightToeBase"))
+
+
+def drawn_control(forward: float, turn: float, frames: int) -> np.ndarray:
+    return np.tile([forward, 0.0, turn], (frames, 1))
 
 
 @dataclass
@@ -113,11 +123,10 @@ class ShippedVae:
         return float(self.info.get("control_smoothing_frames", 0.0))
 
     def clip_control(self, clip_rows: np.ndarray) -> np.ndarray:
-        """A whole clip's own control (frames, 3) as the model reads it: smoothed as in training (training.smoothed_control),
+        """A whole clip's own control (frames, 3) as the model reads it: smoothed as in training (training.smoothed_control, the same function),
         as a drawn path's has no per-stride sway. The raw signal carries the stride (the hips sway and surge with each
         step), which pins the phase of the motion it drives to the clip's."""
-        control = clip_rows[:, CONTROL_SLICE]
-        return smooth(control, self.control_sigma) if self.control_sigma > 0 else control
+        return smoothed_control(clip_rows, self.control_sigma)
 
     def read_control(self, control: np.ndarray, seed: int) -> np.ndarray:
         """What the model reads for a drawn control (frames, 3), as the page feeds it: with the JSON's "stride", the
@@ -196,11 +205,6 @@ def long_run(vae: ShippedVae, seed: int, frames: int = LONG_RUN_FRAMES, sampling
     return {"seed": seed, "positions": positions, "bits": bits, "control": control, "seconds": seconds}
 
 
-# Drawn paths held for a long run: (forward m/s, turn rad/s). A drawn path's control is constant, with none of the
-# stride's sway a real root's velocity has.
-DRAWN_LONG_RUNS = {"walk, straight, 1.2 m/s": (1.2, 0.0), "walk, turning 0.5 rad/s, 1.2 m/s": (1.2, 0.5), "run, straight, 2.8 m/s": (2.8, 0.0)}
-
-
 def toe_swing(local: np.ndarray, fps: float) -> np.ndarray:
     """Per whole second, the toes' forward swing (m): the range of each toe's forward offset from the hips in the
     facing frame over the second, the two toes averaged. A stepping walk swings 0.5-0.9 m; a gliding body ~0."""
@@ -256,15 +260,6 @@ def mean_pairwise(motions: list[np.ndarray]) -> float:
 def local_positions(rows: np.ndarray) -> np.ndarray:
     local = rows[:, :POSITION_DIM].reshape(len(rows), -1, 3)
     return local - local[:, :1]
-
-
-# Drawn-path controls (forward m/s, turn rad/s), as the page feeds a drawn path: constant, no per-stride sway.
-DRAWN_CONTROLS = ((0.9, 0.0), (1.2, 0.0), (1.5, 0.0), (1.2, 0.5))
-TOES = (JOINTS.index("LeftToeBase"), JOINTS.index("RightToeBase"))
-
-
-def drawn_control(forward: float, turn: float, frames: int) -> np.ndarray:
-    return np.tile([forward, 0.0, turn], (frames, 1))
 
 
 def drawn_path_diversity(vae: ShippedVae, window: int = 120, sampling: dict | None = None) -> list[dict]:

@@ -154,12 +154,13 @@ export async function rollout(o: RolloutOptions): Promise<RolloutResult> {
   const noiseScale = o.noiseScale ?? 1;
   const rho = o.noiseCorrelation ?? 0;
   if (!(rho >= 0 && rho < 1)) throw new Error(`rollout: noise correlation ${rho} is outside [0, 1)`);
-  // Each particle's normals of its previous frame (all the start's to begin with); null before a stream's first frame.
-  let held: Float64Array | null = null;
+  // Each particle's normals of its previous frame (all the start's to begin with), once there is a previous frame.
+  const held = new Float64Array(rho > 0 ? P * D : 0);
+  let holding = false;
   if (rho > 0 && o.start.held) {
     if (o.start.held.length !== D) throw new Error(`rollout: the start holds ${o.start.held.length} normals, expected ${D}`);
-    held = new Float64Array(P * D);
     for (let b = 0; b < P; b++) held.set(o.start.held, b * D);
+    holding = true;
   }
   const drawn = new Float64Array(P * D);
 
@@ -198,7 +199,7 @@ export async function rollout(o: RolloutOptions): Promise<RolloutResult> {
       const row = x.subarray(b * D, (b + 1) * D);
       const normals = drawn.subarray(b * D, (b + 1) * D);
       for (let k = 0; k < D; k++) {
-        normals[k] = held && k >= STEERED_CHANNELS ? heldNormal(held[b * D + k], zz[k], rho) : zz[k];
+        normals[k] = holding && k >= STEERED_CHANNELS ? heldNormal(held[b * D + k], zz[k], rho) : zz[k];
         row[k] = mu[k] + sigma[k] * temperature * normals[k];
       }
 
@@ -217,7 +218,10 @@ export async function rollout(o: RolloutOptions): Promise<RolloutResult> {
     }
     h = out.h_out;
     c = out.c_out;
-    if (rho > 0) held = drawn.slice();
+    if (rho > 0) {
+      held.set(drawn);
+      holding = true;
+    }
     if (t === commit - 1) {
       for (let b = 0; b < P; b++) {
         states.push({
@@ -225,7 +229,7 @@ export async function rollout(o: RolloutOptions): Promise<RolloutResult> {
           h: stateRow(h, L, P, H, b),
           c: stateRow(c, L, P, H, b),
           root: { ...root[b] },
-          ...(held ? { held: held.slice(b * D, (b + 1) * D) } : {}),
+          ...(holding ? { held: held.slice(b * D, (b + 1) * D) } : {}),
         });
       }
     }

@@ -2,7 +2,7 @@
 training starts (prior_bank.py; vae-lstm.json sampling.z1_prior), and the stride a drawn path lacks (stride.py;
 vae-lstm.json stride); tests/fixtures/vae_lstm_reference.json is written again.
 
-    python -m training.vae_lstm.fit_prior [--mocap DIR]
+    python -m training.vae_lstm.fit_sampling [--mocap DIR]
 
 A new export from a checkpoint (python -m training.vae_lstm.export) fits it too.
 """
@@ -12,14 +12,14 @@ import argparse
 
 from ..data.locomotion import load_clips
 from ..data.windows import WindowCorpus
-from .exporting import refit_drawn_path_fields
+from .exporting import refit_sampling_fields
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--mocap", default=None, help="the corpus (default ../shared/mocap or MOCAP_DIR)")
     args = parser.parse_args(argv)
-    info = refit_drawn_path_fields(WindowCorpus(load_clips(args.mocap)))
+    info = refit_sampling_fields(WindowCorpus(load_clips(args.mocap)))
     prior = info["sampling"].get("z1_prior")
     if prior:
         print(f"vae-lstm.json: z1 prior from {prior['starts']} training starts, sigma {sum(prior['sigma']) / len(prior['sigma']):.3f} on average")
