@@ -147,11 +147,11 @@ async function longClipBenchmark(ctx, frames) {
 
 /**
  * Raw step throughput of a model client (`client`: its module, export and options) via its `benchmark`,
- * in a page opened with `?threads=N`. With `generate`, also the end-to-end rate of `generate` (steps,
+ * in a page opened with `?threads=N` in Clip mode with nothing loaded (so no Random walk streams beside it). With `generate`, also the end-to-end rate of `generate` (steps,
  * decoding and, for the dance models, the skeleton fit) after a short warm-up call.
  */
 async function modelBenchmark(ctx, { client, threads, batch, steps, generate }) {
-  const { context, page, problems } = await openPlayground(ctx.browser, `${ctx.url}?threads=${threads}`, VIEWPORT);
+  const { context, page, problems } = await openPlayground(ctx.browser, `${ctx.url}?mode=clip&threads=${threads}`, VIEWPORT);
   try {
     const r = await page.evaluate(
       async ({ client, threads, batch, steps, generate }) => {
@@ -277,7 +277,7 @@ const GENERATOR_BENCHMARKS = [1, 2].flatMap((threads) => [
  * page's thread over the same refined frames, so the refiner's share without it can be reported too.
  */
 async function refinerCostBenchmark(ctx, { frames = 3000, runs = 3 } = {}) {
-  const { context, page, problems } = await openPlayground(ctx.browser, `${ctx.url}?threads=1`, VIEWPORT);
+  const { context, page, problems } = await openPlayground(ctx.browser, `${ctx.url}?mode=clip&threads=1`, VIEWPORT);
   try {
     const r = await page.evaluate(
       async ({ frames, runs }) => {
@@ -385,7 +385,9 @@ async function peersBenchmark(ctx) {
       const args = ['-m', 'training.bench.peers', '--frames', String(FRAMES), ...(first ? ['--ceiling', ceilingFile] : [])];
       return JSON.parse(execFileSync(python, args, { cwd: ROOT, encoding: 'utf8' }).trim().split('\n').pop());
     };
-    const { context, page, problems } = await openPlayground(ctx.browser, ctx.url, VIEWPORT);
+    // Clip mode with nothing loaded: the page runs nothing but the measured calls, as the peers run alone (the plain
+    // URL opens Random walk, whose stream and 60 fps drawing would share this 2-core machine with them).
+    const { context, page, problems } = await openPlayground(ctx.browser, `${ctx.url}?mode=clip`, VIEWPORT);
     const peerRuns = [], pageRuns = [];
     let batch64;
     try {
