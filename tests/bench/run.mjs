@@ -147,8 +147,9 @@ async function longClipBenchmark(ctx, frames) {
 
 /**
  * Raw step throughput of a model client (`client`: its module, export and options) via its `benchmark`,
- * in a page opened with `?threads=N` in Clip mode with nothing loaded (so no Random walk streams beside it). With `generate`, also the end-to-end rate of `generate` (steps,
- * decoding and, for the dance models, the skeleton fit) after a short warm-up call.
+ * in a page opened with `?threads=N` in Clip mode with nothing loaded (so no Random walk streams beside it). With
+ * `generate`, also the end-to-end rate of `generate` (steps, decoding and, for the dance models, the skeleton fit)
+ * after a short warm-up call.
  */
 async function modelBenchmark(ctx, { client, threads, batch, steps, generate }) {
   const { context, page, problems } = await openPlayground(ctx.browser, `${ctx.url}?mode=clip&threads=${threads}`, VIEWPORT);

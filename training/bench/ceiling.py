@@ -11,10 +11,10 @@ The products are those of training/generator/graph.py step_graph (Gemm on weight
 per LSTM layer W_hh (with the summed bias) and W_ih (the first Gemm as its C input), and fc3's three Gemms. Each
 layer's products stay whole here (4H columns, 9 Gemms in all) where the generator runs them per column block
 ((i, f, o) and g, 13 Gemms) so that onnxruntime fuses each block with its nonlinearity: the ceiling keeps the
-fewer, larger calls, the faster form for the products alone. Only shape glue joins them: h and c are split per layer (Split, Reshape), c feeds fc1's and
-fc2's Gemms as their C input (fc widths equal H in MixtureLSTM), each layer's gates are split into blocks
-whose first (H wide) is the layer's c_out and last its h_out and the next layer's input, the states are
-concatenated back, and mu and sigma are reshaped. The weights come from the network's shapes only
+fewer, larger calls, the faster form for the products alone. Only shape glue joins them: h and c are split per
+layer (Split, Reshape), c feeds fc1's and fc2's Gemms as their C input (fc widths equal H in MixtureLSTM), each
+layer's gates are split into blocks whose first (H wide) is the layer's c_out and last its h_out and the next
+layer's input, the states are concatenated back, and mu and sigma are reshaped. The weights come from the network's shapes only
 (MixtureLSTM with generator.json's sizes): random, small enough that the state fed back stays near a fixed
 point of ordinary float magnitude (no denormals, no overflow); the time of dense products does not depend on
 the values otherwise.

@@ -23,10 +23,11 @@ def step_graph(model: MixtureLSTM) -> onnx.ModelProto:
 
     Each LSTM layer is written out at gate level: gates = Gemm(input, W_ih) + Gemm(h, W_hh, b_ih + b_hh) (the
     second Gemm is the first's C input, so no separate Add or Concat), then one Sigmoid over (i, f, o), one
-    Tanh over g, and the cell update. The products run per column block, (i, f, o) and g, each block's own
-    Gemm pair, so onnxruntime fuses each block's last Gemm with its Sigmoid or Tanh (FusedGemm): the same
-    frames bit for bit, and a batch-64 step 1-2% faster in onnxruntime-web (docs/bench.md). The stored
-    weights stay whole (4H columns) and are split by Split nodes on the initializers, folded at load. fc1 and fc2 are Gemm + Relu (fused by onnxruntime); fc3 is three
+    Tanh over g, and the cell update. The products run per column block, (i, f, o) and g, each block with its
+    own Gemm pair, so onnxruntime fuses the block's last Gemm with its Sigmoid or Tanh (FusedGemm): the same
+    frames bit for bit, a batch-64 step a few per cent faster in onnxruntime-web's Node build (docs/bench.md).
+    The stored weights stay whole (4H columns); Split nodes on the initialisers, folded at load, cut them.
+    fc1 and fc2 are Gemm + Relu (fused by onnxruntime); fc3 is three
     Gemms (mixture logits, means, log standard deviations), so no output is a slice of a larger tensor.
     Initializers are named after the torch layers; training/generator/recovery.py reads them back.
     """
@@ -58,8 +59,9 @@ def step_graph(model: MixtureLSTM) -> onnx.ModelProto:
         c_rows = node("Reshape", [c_in[layer], rows], [f"c{layer}_rows"])
         # The column blocks (i, f, o) and g of the stored weights, split apart when the session is created.
         blocks = {}
-        for name, value, axis in ((f"lstm{layer}_ih.weight_t", gates(w_ih).T, 1), (f"lstm{layer}_hh.weight_t", gates(w_hh).T, 1),
-                                  (f"lstm{layer}_hh.bias", gates(b), 0)):
+        stored = ((f"lstm{layer}_ih.weight_t", gates(w_ih).T, 1), (f"lstm{layer}_hh.weight_t", gates(w_hh).T, 1),
+                  (f"lstm{layer}_hh.bias", gates(b), 0))
+        for name, value, axis in stored:
             blocks[name] = node("Split", [const(name, value), gate_split], [f"{name}.ifo", f"{name}.g"], axis=axis)
         pre = {}
         for k, part in enumerate(("ifo", "g")):
