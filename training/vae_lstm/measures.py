@@ -138,9 +138,13 @@ class ShippedVae:
               start_xz=(0.0, 0.0), start_heading: float = 0.0, root_control: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """World positions (frames, joints, 3) with the root moved by `root_control` (default `control`, what the model
         reads, as the page moves it by the control it asks for), and the decoded contact bits."""
-        rows = self.rows(control, z1, zs, mix)
+        return self.place(self.rows(control, z1, zs, mix), control if root_control is None else root_control, start_xz, start_heading)
+
+    def place(self, rows: np.ndarray, root_control: np.ndarray, start_xz=(0.0, 0.0), start_heading: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+        """World positions of rows the model made (rows' own local poses, the root moved by `root_control`), and the
+        decoded contact bits."""
         placed = rows.copy()
-        placed[:, CONTROL_SLICE] = control if root_control is None else root_control
+        placed[:, CONTROL_SLICE] = root_control
         return rows_to_world(placed, self.fps, start_xz, start_heading), (rows[:, CONTACT_SLICE] > 0.5).astype(np.uint8)
 
 
@@ -220,9 +224,9 @@ def drawn_long_run(vae: ShippedVae, forward: float, turn: float, seed: int, medi
     10 s, and the pose change per second against the real median (freeze_stats)."""
     control = drawn_control(forward, turn, frames)
     prior = vae.prior(seed, frames, sampling)
-    read = vae.read_control(control, seed)
-    swing = toe_swing(local_positions(vae.rows(read, *prior)), vae.fps)
-    positions, _ = vae.world(read, *prior, root_control=control)
+    rows = vae.rows(vae.read_control(control, seed), *prior)
+    swing = toe_swing(local_positions(rows), vae.fps)
+    positions, _ = vae.place(rows, control)
     return {"seed": seed, "first_2s_swing_m": round(float(swing[:2].mean()), 3), "last_10s_swing_m": round(float(swing[-10:].mean()), 3),
             **freeze_stats(positions, vae.fps, median)}
 
