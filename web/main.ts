@@ -3,7 +3,7 @@
 // which finds them beside itself; the page does not import that module, so a build keeps it, with its
 // import.meta.url, at the top of the folder as motion-playground.js.)
 import { defineMotionPlayground } from './api/element';
-import { setAssetBase } from './runtime/assetBase';
+import { setAssetBase } from './runtime/worker/assetBase';
 
 setAssetBase(new URL('./', document.baseURI).href);
 defineMotionPlayground();

@@ -134,7 +134,7 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
   test('ONNX parity in the browser: one step and a many-step call match the Python reference within 1e-4', async () => {
     for (const which of ['step', 'steps']) {
       const outputs = await suite.page.evaluate(async (inputs) => {
-        const { DanceClient } = await import('/runtime/danceClient.ts');
+        const { DanceClient } = await import('/runtime/aclstm/danceClient.ts');
         const client = new DanceClient({ model: 'aclstm', threads: 1 });
         try {
           await client.init();
@@ -330,7 +330,7 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
     try {
       const { context, page, problems } = await openPlayground(suite.browser, `${plain.url}?threads=2`);
       const r = await page.evaluate(async () => {
-        const { DanceClient } = await import('/runtime/danceClient.ts');
+        const { DanceClient } = await import('/runtime/aclstm/danceClient.ts');
         const client = new DanceClient({ threads: 2 });
         const info = await client.init();
         client.dispose();

@@ -141,7 +141,7 @@ describe('generator in the page', { timeout: 240_000 }, () => {
 
   test('ONNX parity in the browser: one step matches the Python reference within 1e-4', async () => {
     const outputs = await page.evaluate(async () => {
-      const { GeneratorClient } = await import('/runtime/generatorClient.ts');
+      const { GeneratorClient } = await import('/runtime/generator/generatorClient.ts');
       const client = new GeneratorClient({ threads: 1 });
       try {
         await client.init();

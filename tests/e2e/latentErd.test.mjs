@@ -324,7 +324,7 @@ describe('latent ERD in the page', { timeout: 300_000 }, () => {
   test('parity in the browser: one ERD step and one decoder window within 1e-4; the fixture stream within 1e-4 (rows) and 1 mm', async () => {
     const s = REFERENCE.stream;
     const r = await suite.page.evaluate(async ({ step, decode, stream }) => {
-      const { LatentErdClient } = await import('/runtime/latentErdClient.ts');
+      const { LatentErdClient } = await import('/runtime/latent_erd/latentErdClient.ts');
       const client = new LatentErdClient({ threads: 1 });
       try {
         await client.init();

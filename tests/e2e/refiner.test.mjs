@@ -90,7 +90,7 @@ describe('refiner in the page', { timeout: 300_000 }, () => {
 
   test('refiner parity in the browser: the fixture calls (3 frames, then 1) within 1e-4, and the end effectors', async () => {
     const results = await suite.page.evaluate(async (ref) => {
-      const { GeneratorClient } = await import('/runtime/generatorClient.ts');
+      const { GeneratorClient } = await import('/runtime/generator/generatorClient.ts');
       const client = new GeneratorClient({ threads: 1 });
       try {
         await client.init();

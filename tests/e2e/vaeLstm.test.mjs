@@ -172,7 +172,7 @@ describe('the VAE-LSTM through window.playground', { timeout: 300_000 }, () => {
 
   test('parity in the browser: the four graphs and a whole generation over two chunks of the cell', async () => {
     const r = await suite.page.evaluate(async ({ graphs, generate, steps }) => {
-      const { VaeLstmClient } = await import('/runtime/vaeLstmClient.ts');
+      const { VaeLstmClient } = await import('/runtime/vae_lstm/vaeLstmClient.ts');
       const client = new VaeLstmClient({ threads: 1 });
       try {
         await client.init();

@@ -10,9 +10,9 @@ import { boneLengthChange, canonicalView, floorHeight, footSliding, jerk, meanJo
 import type { Motion } from '../../web/motion/types';
 import { parseGeneratorInfo } from '../../web/model/generatorInfo';
 import { parseManifoldInfo } from '../../web/model/latentErdInfo';
-import { cleanUpOnCanonical, lowpassCleanup, manifoldCleaner, mapCleaner, type CleanupMethod, type CleanupResult } from '../../web/runtime/cleanup';
-import { GeneratorCore } from '../../web/runtime/generatorCore';
-import { projectOnManifold } from '../../web/runtime/manifoldProjection';
+import { cleanUpOnCanonical, lowpassCleanup, manifoldCleaner, mapCleaner, type CleanupMethod, type CleanupResult } from '../../web/runtime/cleanup/cleanup';
+import { GeneratorCore } from '../../web/runtime/generator/generatorCore';
+import { projectOnManifold } from '../../web/runtime/autoencoder/manifoldProjection';
 import { readCorpus, readRepoFile, REPO_ROOT } from '../unit/corpus';
 import { ort, shippedSession } from '../unit/shippedModel';
 

@@ -5,17 +5,17 @@
 // request cancelled part-way rejects, and the streams it ran beside (a refined stream, the live control
 // stream) continue exactly as if it had never run.
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { CANCELLED_ERROR_NAME, CancelledError, checkpoint } from '../../web/runtime/cancellation';
-import { DanceCore } from '../../web/runtime/danceCore';
-import { parseDanceInfo } from '../../web/runtime/danceModel';
-import { GeneratorCore } from '../../web/runtime/generatorCore';
+import { CANCELLED_ERROR_NAME, CancelledError, checkpoint } from '../../web/runtime/worker/cancellation';
+import { DanceCore } from '../../web/runtime/aclstm/danceCore';
+import { parseDanceInfo } from '../../web/runtime/aclstm/danceModel';
+import { GeneratorCore } from '../../web/runtime/generator/generatorCore';
 import { parseGeneratorInfo } from '../../web/model/generatorInfo';
-import { OptimizerRequests } from '../../web/runtime/optimizerRequests';
-import type { GeneratedChunk, WorkerMessage } from '../../web/runtime/protocol';
-import { RefinerCore } from '../../web/runtime/refinerCore';
-import { parseRefinerInfo } from '../../web/runtime/refinerModel';
-import { serveRequests } from '../../web/runtime/requestLoop';
-import { WorkerClient, type ProgressOptions } from '../../web/runtime/workerClient';
+import { OptimizerRequests } from '../../web/runtime/generator/optimizerRequests';
+import type { GeneratedChunk, WorkerMessage } from '../../web/runtime/generator/protocol';
+import { RefinerCore } from '../../web/runtime/refiner/refinerCore';
+import { parseRefinerInfo } from '../../web/runtime/refiner/refinerModel';
+import { serveRequests } from '../../web/runtime/worker/requestLoop';
+import { WorkerClient, type ProgressOptions } from '../../web/runtime/worker/workerClient';
 import { readRepoFile } from './corpus';
 import { bytes, ort, shippedSession } from './shippedModel';
 

@@ -7,8 +7,8 @@ import { addNoise } from '../../web/motion/noise';
 import { medianBoneLengths, SkeletonMapError } from '../../web/motion/skeletonMap';
 import type { Motion } from '../../web/motion/types';
 import { parseGeneratorInfo } from '../../web/model/generatorInfo';
-import { checkCleanupOptions, cleanUpOnCanonical, lowpassCleanup, mapCleaner } from '../../web/runtime/cleanup';
-import { GeneratorCore } from '../../web/runtime/generatorCore';
+import { checkCleanupOptions, cleanUpOnCanonical, lowpassCleanup, mapCleaner } from '../../web/runtime/cleanup/cleanup';
+import { GeneratorCore } from '../../web/runtime/generator/generatorCore';
 import { readCorpus, readRepoFile } from './corpus';
 import { ort, shippedSession } from './shippedModel';
 

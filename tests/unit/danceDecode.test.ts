@@ -1,8 +1,8 @@
 // The dance feature decoder against the Python one (training/data/dance.py decode) via the fixture the
 // export writes (tests/fixtures/aclstm_reference.json), and the dance model JSON checks.
 import { describe, expect, it } from 'vitest';
-import { decodeDance } from '../../web/runtime/danceDecode';
-import { DanceInfoError, parseDanceInfo, seedsOfStyle } from '../../web/runtime/danceModel';
+import { decodeDance } from '../../web/runtime/aclstm/danceDecode';
+import { DanceInfoError, parseDanceInfo, seedsOfStyle } from '../../web/runtime/aclstm/danceModel';
 import { readRepoFile } from './corpus';
 
 const raw = JSON.parse(readRepoFile('public/models/aclstm.json'));

@@ -3,9 +3,9 @@
 // onnxruntime fixture, determinism, streams that continue exactly, fitted frames at exact bone lengths, and
 // feet planted by their contact labels locked in place.
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { DanceCore, STEPS_PER_CALL } from '../../web/runtime/danceCore';
+import { DanceCore, STEPS_PER_CALL } from '../../web/runtime/aclstm/danceCore';
 import { denormalise } from '../../web/model/sampler';
-import { parseDanceInfo, seedsOfStyle } from '../../web/runtime/danceModel';
+import { parseDanceInfo, seedsOfStyle } from '../../web/runtime/aclstm/danceModel';
 import { readRepoFile } from './corpus';
 import { bytes, maxAbsDiff, ort, shippedSession } from './shippedModel';
 

@@ -5,8 +5,8 @@ import { describe, expect, it } from 'vitest';
 import { bestRotation, fitSkeleton } from '../../web/motion/fitSkeleton';
 import { quatFromAxisAngle, quatMultiply, quatRotate, type Quat, type Vec3 } from '../../web/motion/math';
 import type { Skeleton } from '../../web/motion/types';
-import { decodeDance } from '../../web/runtime/danceDecode';
-import { parseDanceInfo } from '../../web/runtime/danceModel';
+import { decodeDance } from '../../web/runtime/aclstm/danceDecode';
+import { parseDanceInfo } from '../../web/runtime/aclstm/danceModel';
 import { readRepoFile } from './corpus';
 
 const info = parseDanceInfo(JSON.parse(readRepoFile('public/models/aclstm.json')), 'public/models/aclstm.json');

@@ -1,8 +1,8 @@
 // GeneratorClient's message handling against a scripted stand-in for the worker: replies matched by
 // id in any order, error replies, a crashed worker, an init that never answers, dispose.
 import { afterEach, beforeEach, describe, expect, it, vi } from 'vitest';
-import { GeneratorClient } from '../../web/runtime/generatorClient';
-import type { GeneratedChunk, GeneratorReply, InitResult } from '../../web/runtime/protocol';
+import { GeneratorClient } from '../../web/runtime/generator/generatorClient';
+import type { GeneratedChunk, GeneratorReply, InitResult } from '../../web/runtime/generator/protocol';
 
 class FakeWorker extends EventTarget {
   static last: FakeWorker;

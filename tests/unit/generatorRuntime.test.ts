@@ -2,7 +2,7 @@
 // Node build (the same wasm runtime the browser worker uses): one-step parity with the Python
 // onnxruntime fixture, seeded determinism, and streams that continue exactly where they stopped.
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { GeneratorCore } from '../../web/runtime/generatorCore';
+import { GeneratorCore } from '../../web/runtime/generator/generatorCore';
 import { parseGeneratorInfo } from '../../web/model/generatorInfo';
 import { readRepoFile } from './corpus';
 import { bytes, maxAbsDiff, ort, shippedSession } from './shippedModel';

@@ -14,8 +14,8 @@ import {
   parseManifoldInfo,
   type LatentErdModel,
 } from '../../web/model/latentErdInfo';
-import { LatentErdCore } from '../../web/runtime/latentErdCore';
-import { LatentErdRequests } from '../../web/runtime/latentErdRequests';
+import { LatentErdCore } from '../../web/runtime/latent_erd/latentErdCore';
+import { LatentErdRequests } from '../../web/runtime/latent_erd/latentErdRequests';
 import { readRepoFile } from './corpus';
 import { bytes, maxAbsDiff, ort, shippedSession } from './shippedModel';
 

@@ -7,9 +7,9 @@ import { controlFromTrajectory, wrap } from '../../web/motion/control';
 import { addNoise } from '../../web/motion/noise';
 import { parseLatentErdInfo, parseManifoldInfo, type LatentErdModel } from '../../web/model/latentErdInfo';
 import { groundFrame, motionRows, rowLayout, smooth, toLocal, toWorld } from '../../web/model/manifoldRows';
-import { LatentErdCore } from '../../web/runtime/latentErdCore';
-import { LatentErdRequests } from '../../web/runtime/latentErdRequests';
-import { manifoldWindow, projectOnManifold, windowStarts, type ManifoldProjectionArgs, type ManifoldWindowInfo } from '../../web/runtime/manifoldProjection';
+import { LatentErdCore } from '../../web/runtime/latent_erd/latentErdCore';
+import { LatentErdRequests } from '../../web/runtime/latent_erd/latentErdRequests';
+import { manifoldWindow, projectOnManifold, windowStarts, type ManifoldProjectionArgs, type ManifoldWindowInfo } from '../../web/runtime/autoencoder/manifoldProjection';
 import { readRepoFile } from './corpus';
 import { maxAbsDiff, ort, shippedSession } from './shippedModel';
 

@@ -1,7 +1,7 @@
 // Reading dropped or picked files (web/runtime/motionFiles.ts): the kind from the name or the contents, gzip.
 import { gzipSync } from 'node:zlib';
 import { describe, expect, it } from 'vitest';
-import { baseName, FileImporter, kindFromName, kindFromText, MAX_FILE_BYTES, readTextFile, type ImportProgress } from '../../web/runtime/motionFiles';
+import { baseName, FileImporter, kindFromName, kindFromText, MAX_FILE_BYTES, readTextFile, type ImportProgress } from '../../web/runtime/import/motionFiles';
 import { readCorpus } from './corpus';
 
 describe('file kinds', () => {

@@ -2,15 +2,15 @@
 // reduces to free generation when steering has no authority, imposes its target with full authority,
 // and the path follower and live controller do what they are for on short runs.
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { GeneratorCore } from '../../web/runtime/generatorCore';
+import { GeneratorCore } from '../../web/runtime/generator/generatorCore';
 import { parseGeneratorInfo } from '../../web/model/generatorInfo';
 import { exportBVH } from '../../web/motion/bvh';
 import { footSkating } from '../../web/motion/footSkating';
 import { validateMotion } from '../../web/motion/validate';
 import { checkSchedule, LiveController, simulateControl } from '../../web/optimizer/liveControl';
 import { angleDifference, GroundPath, type GroundPoint } from '../../web/optimizer/path';
-import { OptimizerRequests } from '../../web/runtime/optimizerRequests';
-import type { FollowPathParams } from '../../web/runtime/protocol';
+import { OptimizerRequests } from '../../web/runtime/generator/optimizerRequests';
+import type { FollowPathParams } from '../../web/runtime/generator/protocol';
 import { followPath } from '../../web/optimizer/pathFollower';
 import { rollout, type SteerRequest, type Variables } from '../../web/optimizer/rollout';
 import { heldNormal, Rng } from '../../web/model/sampler';

@@ -5,7 +5,7 @@
 // with OPTIMIZER_OUTPUT=print to get the new ones, and check the change is meant.
 import { createHash } from 'node:crypto';
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
-import { GeneratorCore } from '../../web/runtime/generatorCore';
+import { GeneratorCore } from '../../web/runtime/generator/generatorCore';
 import { parseGeneratorInfo } from '../../web/model/generatorInfo';
 import { checkSchedule, LiveController, simulateControl } from '../../web/optimizer/liveControl';
 import { GroundPath, type GroundPoint } from '../../web/optimizer/path';

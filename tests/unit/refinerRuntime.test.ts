@@ -4,11 +4,11 @@
 // generator's `refine` streams (raw frames unchanged, refined + foot-locked frames that skate less).
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { footSkating } from '../../web/motion/footSkating';
-import { GeneratorCore } from '../../web/runtime/generatorCore';
+import { GeneratorCore } from '../../web/runtime/generator/generatorCore';
 import { parseGeneratorInfo } from '../../web/model/generatorInfo';
-import { RefinerCore } from '../../web/runtime/refinerCore';
-import { checkRefinerPairing, parseRefinerInfo, type RefinerInfo } from '../../web/runtime/refinerModel';
-import type { GeneratedChunk } from '../../web/runtime/protocol';
+import { RefinerCore } from '../../web/runtime/refiner/refinerCore';
+import { checkRefinerPairing, parseRefinerInfo, type RefinerInfo } from '../../web/runtime/refiner/refinerModel';
+import type { GeneratedChunk } from '../../web/runtime/generator/protocol';
 import { readRepoFile } from './corpus';
 import { bytes, ort, shippedSession } from './shippedModel';
 

@@ -6,9 +6,9 @@
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { integrateControl, PolylinePath } from '../../web/motion/control';
 import { parseVaeLstmInfo, VAE_LSTM_GRAPHS, type VaeLstmGraph, type VaeLstmModel } from '../../web/model/vaeLstmInfo';
-import { freeLatents, priorLatents, VaeLstmCore } from '../../web/runtime/vaeLstmCore';
+import { freeLatents, priorLatents, VaeLstmCore } from '../../web/runtime/vae_lstm/vaeLstmCore';
 import { phaseStart, strideSway } from '../../web/model/vaeLstmStride';
-import { controlForPath, followPathVae } from '../../web/runtime/vaeLstmRequests';
+import { controlForPath, followPathVae } from '../../web/runtime/vae_lstm/vaeLstmRequests';
 import { readRepoFile } from './corpus';
 import { bytes, maxAbsDiff, ort, shippedSession } from './shippedModel';
 

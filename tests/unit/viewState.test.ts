@@ -1,6 +1,6 @@
 import { describe, expect, test } from 'vitest';
 import { embedSnippet, parseView, parseViewValue, viewQuery } from '../../web/ui/viewState';
-import { checkSourceUrl, fetchMotionSource, MAX_SOURCE_BYTES } from '../../web/runtime/motionSource';
+import { checkSourceUrl, fetchMotionSource, MAX_SOURCE_BYTES } from '../../web/runtime/import/motionSource';
 
 describe('view state (attributes and links)', () => {
   test('reads every setting and writes it back the same', () => {

@@ -13,7 +13,7 @@ import type { Motion } from '../motion/types';
 import { App } from '../ui/app';
 import { buildIn, errorMessage, type DomScope } from '../ui/dom';
 import { embedSnippet, FIRST_VIEW, formatViewValue, parseView, parseViewValue, viewQuery, VIEW_KEYS, type Mode, type ViewKey, type ViewState } from '../ui/viewState';
-import { fetchMotionSource } from '../runtime/motionSource';
+import { fetchMotionSource } from '../runtime/import/motionSource';
 import { isControlModel } from '../ui/modes/modelChoice';
 
 const OTHER_ATTRIBUTES = ['src', 'autoplay', 'camera-controls', 'controls', 'poster', 'loading', 'link'] as const;

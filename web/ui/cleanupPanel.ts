@@ -16,11 +16,11 @@ import { bendAngles, bendJoints, cleanupNumbers, type CleanupNumbers } from '../
 import { addNoise } from '../motion/noise';
 import { CANONICAL_JOINTS, mapSkeleton, type CanonicalJoint } from '../motion/skeletonMap';
 import type { Motion } from '../motion/types';
-import { isCancelled } from '../runtime/cancellation';
-import type { CleanupMethod, CleanupStats } from '../runtime/cleanup';
-import type { GeneratorClient } from '../runtime/generatorClient';
-import type { LatentErdClient } from '../runtime/latentErdClient';
-import { baseName } from '../runtime/motionFiles';
+import { isCancelled } from '../runtime/worker/cancellation';
+import type { CleanupMethod, CleanupStats } from '../runtime/cleanup/cleanup';
+import type { GeneratorClient } from '../runtime/generator/generatorClient';
+import type { LatentErdClient } from '../runtime/latent_erd/latentErdClient';
+import { baseName } from '../runtime/import/motionFiles';
 import type { PlaybackState } from '../viewer/playback';
 import { AnglePlot } from './anglePlot';
 import { $, $all, downloadText, errorMessage, setSliderFill } from './dom';

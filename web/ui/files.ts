@@ -1,6 +1,6 @@
 // The page's part of importing dropped or picked files (read and parsed in the import worker:
 // runtime/importClient.ts, runtime/motionFiles.ts): the progress shown while a large import runs.
-import type { ImportProgress, ProgressListener } from '../runtime/motionFiles';
+import type { ImportProgress, ProgressListener } from '../runtime/import/motionFiles';
 import { $ } from './dom';
 
 /** Imports of at least this many bytes (the files together, as given) show their progress. */

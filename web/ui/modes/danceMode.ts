@@ -4,7 +4,7 @@
 // line within seconds: it stops moving).
 
 import { PoseChangeMeter } from '../../motion/poseChange';
-import type { DanceClient, DanceInitResult, DanceMotion } from '../../runtime/danceClient';
+import type { DanceClient, DanceInitResult, DanceMotion } from '../../runtime/aclstm/danceClient';
 import { $ } from '../dom';
 import { PoseChangePlot } from '../poseChangePlot';
 import type { ModeHost } from './host';

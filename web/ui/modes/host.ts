@@ -3,10 +3,10 @@
 // never sees the rest of the page (the import, export and mode switching).
 
 import type { Motion } from '../../motion/types';
-import type { DanceClient, DanceInitResult } from '../../runtime/danceClient';
-import type { GeneratorClient, InitResult } from '../../runtime/generatorClient';
-import type { LatentErdClient, LatentErdInitResult } from '../../runtime/latentErdClient';
-import type { VaeLstmClient, VaeLstmInitResult } from '../../runtime/vaeLstmClient';
+import type { DanceClient, DanceInitResult } from '../../runtime/aclstm/danceClient';
+import type { GeneratorClient, InitResult } from '../../runtime/generator/generatorClient';
+import type { LatentErdClient, LatentErdInitResult } from '../../runtime/latent_erd/latentErdClient';
+import type { VaeLstmClient, VaeLstmInitResult } from '../../runtime/vae_lstm/vaeLstmClient';
 import type { Viewer } from '../../viewer/viewer';
 import type { ModelHost } from '../modelHost';
 import type { ModelChoice } from './modelChoice';

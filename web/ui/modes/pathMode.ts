@@ -12,10 +12,10 @@
 import * as THREE from 'three';
 import { MAX_PATH_LENGTH, MIN_PATH_LENGTH } from '../../optimizer/path';
 import type { Motion } from '../../motion/types';
-import type { FollowedPath, GeneratorClient } from '../../runtime/generatorClient';
-import type { LatentErdClient } from '../../runtime/latentErdClient';
-import type { VaeLstmClient } from '../../runtime/vaeLstmClient';
-import { LATENT_PATH_SPEED } from '../../runtime/latentErdRequests';
+import type { FollowedPath, GeneratorClient } from '../../runtime/generator/generatorClient';
+import type { LatentErdClient } from '../../runtime/latent_erd/latentErdClient';
+import type { VaeLstmClient } from '../../runtime/vae_lstm/vaeLstmClient';
+import { LATENT_PATH_SPEED } from '../../runtime/latent_erd/latentErdRequests';
 import { GroundLine, TARGET_COLOR } from '../../viewer/groundPath';
 import { $, element, errorMessage, readSeed, setSliderFill } from '../dom';
 import type { ModeHost } from './host';

@@ -5,7 +5,7 @@
 
 import { lowFootSample } from '../../motion/footSkating';
 import type { Motion } from '../../motion/types';
-import type { GeneratedMotion, GeneratorClient } from '../../runtime/generatorClient';
+import type { GeneratedMotion, GeneratorClient } from '../../runtime/generator/generatorClient';
 import { CompanionAligner } from '../../viewer/sideBySide';
 import { $, readSeed } from '../dom';
 import type { ModeHost } from './host';

@@ -9,8 +9,8 @@
 // compares target and achieved speed.
 
 import { angleDifference } from '../../optimizer/path';
-import type { GeneratorClient } from '../../runtime/generatorClient';
-import type { LatentErdClient } from '../../runtime/latentErdClient';
+import type { GeneratorClient } from '../../runtime/generator/generatorClient';
+import type { LatentErdClient } from '../../runtime/latent_erd/latentErdClient';
 import { GroundArrow, TARGET_COLOR } from '../../viewer/groundPath';
 import { $, currentScope, setSliderFill } from '../dom';
 import type { ModeHost } from './host';

@@ -1,0 +1,159 @@
+// Main-thread handle on the generator worker: promise methods (ModelClient; requests matched to
+// replies by id: WorkerClient).
+import type { CleanupResult } from '../cleanup/cleanup';
+import type { DenoiseParams } from '../cleanup/cleanupRequests';
+import type { StepInputs } from '../../model/generatorInfo';
+import type { Motion } from '../../motion/types';
+import type {
+  BenchmarkResult,
+  ControlChunkReply,
+  ControlStartParams,
+  ControlTargetParams,
+  FollowPathChunk,
+  FollowPathParams,
+  GeneratedChunk,
+  GenerateParams,
+  InitResult,
+  ParityResult,
+  RefinedFrames,
+  RefinerParityResult,
+  RefinerStepInputs,
+  SimulateControlParams,
+  SimulatedControlChunk,
+  StreamInfo,
+  StreamParams,
+} from './protocol';
+import { sharedDownload } from '../worker/sharedDownloads';
+import { ModelClient, type ProgressOptions, type RequestOptions } from '../worker/workerClient';
+
+export type {
+  BenchmarkResult,
+  ControlStartParams,
+  ControlTargetParams,
+  FollowPathParams,
+  GenerateParams,
+  InitResult,
+  ParityResult,
+  RefinedFrames,
+  RefinerParityResult,
+  RefinerStepInputs,
+  SimulateControlParams,
+  StepInputs,
+  StreamInfo,
+  StreamParams,
+};
+
+/** A followed path: the motion, the path as followed (x, z pairs) and how well it was followed. */
+export type FollowedPath = GeneratedMotion & Pick<FollowPathChunk, 'stats' | 'path'>;
+/** A live-control batch: the motion plus achieved speed and heading per frame. */
+export type ControlledMotion = GeneratedMotion & Pick<ControlChunkReply, 'speed' | 'heading' | 'computeMs'>;
+export type SimulatedControl = GeneratedMotion &
+  Pick<SimulatedControlChunk, 'speed' | 'heading' | 'targetSpeed' | 'targetHeading' | 'computeMs' | 'batchMs' | 'batchFrames'>;
+
+/** Generated frames as a Motion, with the generator's extras. */
+export type GeneratedMotion = Motion & {
+  contacts: Uint8Array;
+  /** frames × D feature rows in physical units. */
+  features: Float32Array;
+  rootHeading: Float32Array;
+  seedIndex: number;
+  /** Index of the first frame within its stream (0 for `generate`). */
+  startFrame: number;
+  /** With `refine`: the same frames refined and foot-locked (the Motion fields above stay the raw frames). */
+  refined?: RefinedFrames;
+};
+
+export interface GeneratorClientOptions {
+  /** Defaults resolve against the page: models/generator.onnx and models/generator.json. */
+  modelUrl?: string;
+  infoUrl?: string;
+  /** onnxruntime-web threads when the page is cross-origin isolated (default 2); without isolation always 1. */
+  threads?: number;
+  /** Gives up on the worker (rejecting `init` and later calls) if `init` has no answer by then: a stalled download or wasm. */
+  initTimeoutMs?: number;
+}
+
+export class GeneratorClient extends ModelClient<StreamParams, InitResult, GeneratedChunk, StreamInfo, ParityResult, StepInputs, GeneratedMotion> {
+  constructor(options: GeneratorClientOptions = {}) {
+    super(new Worker(new URL('./generator.worker.ts', import.meta.url), { type: 'module', name: 'generator' }), 'generator', {
+      ...options,
+      modelUrl: options.modelUrl ?? 'models/generator.onnx',
+      infoUrl: options.infoUrl ?? 'models/generator.json',
+    });
+  }
+
+  /** Also the refiner's ONNX file (named in refiner.json beside the generator's JSON), for the first refined stream. */
+  protected override prefetch(): void {
+    super.prefetch();
+    const refinerInfo = new URL('refiner.json', this.urls.infoUrl).href;
+    fetch(refinerInfo)
+      .then((r) => (r.ok ? (r.json() as Promise<{ file?: unknown }>) : null))
+      .then((info) => {
+        if (typeof info?.file === 'string') sharedDownload(new URL(info.file, refinerInfo).href).catch(() => undefined);
+      })
+      .catch(() => undefined);
+  }
+
+  /**
+   * One raw ONNX step. Without inputs it uses the first and last seed states at batch 2, the inputs of
+   * tests/fixtures/generator_reference.json's `step`.
+   */
+  parity(inputs?: StepInputs): Promise<ParityResult> {
+    return this.parityRequest(inputs);
+  }
+
+  /**
+   * One raw refiner step (the refiner is loaded in the worker on first use) and, with `frames` (physical
+   * generator frames, frames × D), their root-frame end effectors: the inputs of tests/fixtures/refiner_reference.json.
+   */
+  refinerParity(inputs: RefinerStepInputs, frames?: ArrayLike<number>): Promise<RefinerParityResult> {
+    return this.request<RefinerParityResult>('refinerParity', { inputs, ...(frames ? { frames: Array.from(frames) } : {}) });
+  }
+
+  /**
+   * Follows a ground path (optimised in the worker); `onProgress` hears the share of the path done;
+   * cancelled with `signal` (the optimiser stops at its next model step).
+   */
+  async followPath(params: FollowPathParams, options: ProgressOptions = {}): Promise<FollowedPath> {
+    const chunk = await this.request<FollowPathChunk>('followPath', { ...params }, options);
+    return { ...this.toMotion(chunk), stats: chunk.stats, path: chunk.path };
+  }
+
+  /** Starts (or replaces) the live-control stream at the origin, facing +z. */
+  controlStart(params: ControlStartParams, options: RequestOptions = {}): Promise<StreamInfo> {
+    return this.request<StreamInfo>('controlStart', { ...params }, options);
+  }
+
+  /**
+   * The control stream's next `frames` frames (1…12), optimised toward `target`. Cancelled with `signal`
+   * while queued it never runs; once running it runs whole (as `pull`).
+   */
+  async controlPull(frames: number, target: ControlTargetParams, options: RequestOptions = {}): Promise<ControlledMotion> {
+    const chunk = await this.request<ControlChunkReply>('controlPull', { frames, ...target }, options);
+    return { ...this.toMotion(chunk), speed: chunk.speed, heading: chunk.heading, computeMs: chunk.computeMs };
+  }
+
+  /** The live-control loop driven by a schedule instead of a person; cancelled with `signal` (as followPath). */
+  async simulateControl(params: SimulateControlParams, options: ProgressOptions = {}): Promise<SimulatedControl> {
+    const c = await this.request<SimulatedControlChunk>('simulateControl', { ...params }, options);
+    const { speed, heading, targetSpeed, targetHeading, computeMs, batchMs, batchFrames } = c;
+    return { ...this.toMotion(c), speed, heading, targetSpeed, targetHeading, computeMs, batchMs, batchFrames };
+  }
+
+  /** Motion clean-up with `map` or `lowpass` (cleanup.ts) in the worker; `onProgress` hears the share done; `signal` cancels it. */
+  denoise(params: DenoiseParams, options: ProgressOptions = {}): Promise<CleanupResult> {
+    return this.request<CleanupResult>('denoise', { ...params }, options);
+  }
+
+  protected toMotion(chunk: GeneratedChunk): GeneratedMotion {
+    return {
+      ...this.motionOf(chunk),
+      contacts: chunk.contacts,
+      features: chunk.features,
+      rootHeading: chunk.rootHeading,
+      seedIndex: chunk.seedIndex,
+      startFrame: chunk.startFrame,
+      ...(chunk.refined ? { refined: chunk.refined } : {}),
+    };
+  }
+}

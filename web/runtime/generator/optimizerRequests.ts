@@ -1,0 +1,139 @@
+// The generator worker's optimiser requests: path following, and live control by speed and heading
+// (one live stream at a time, and its scripted twin simulateControl). The algorithms live in
+// web/optimizer/; this file checks the requests and packs results for the page. followPath and
+// simulateControl stop at the next model step once cancelled (their optimiser runs with a step that
+// passes a checkpoint, cancellation.ts); a controlPull that has started runs whole, so the live stream
+// always stands where its last reply left it.
+import { followPath, gaitSeeds, type Gait } from '../../optimizer/pathFollower';
+import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed, optional } from '../../optimizer/options';
+import { checkSchedule, LiveController, simulateControl } from '../../optimizer/liveControl';
+import { checkPathPoints, GroundPath, moveBack, relativeToStart } from '../../optimizer/path';
+import { PlantedFeet, plantFeet } from '../../motion/footLock';
+import { footStats } from '../../motion/footSkating';
+import type { StepFn } from '../../optimizer/rollout';
+import type { GeneratorCore } from './generatorCore';
+import type { ControlChunkReply, ControlStartParams, ControlTargetParams, FollowPathChunk, FollowPathParams, SimulateControlParams, SimulatedControlChunk, StreamInfo } from './protocol';
+
+export class OptimizerRequests {
+  private live: { controller: LiveController; seedIndex: number; feet: PlantedFeet } | undefined;
+
+  constructor(private readonly core: GeneratorCore) {}
+
+  /** The generator step the optimiser runs; with `signal`, each step is a cancellation checkpoint. */
+  private stepFn(signal?: AbortSignal): StepFn {
+    return (batch, x, h, c) => this.core.step(batch, x, h, c, signal);
+  }
+
+  private controller(seed: number, gait: Gait, signal?: AbortSignal): { controller: LiveController; seedIndex: number } {
+    const info = this.core.info;
+    const seeds = gaitSeeds(info, gait);
+    const seedIndex = seeds[seed % seeds.length];
+    return { controller: new LiveController({ step: this.stepFn(signal), info, mean: this.core.mean, std: this.core.std, seed, seedIndex }), seedIndex };
+  }
+
+  /** Handles one optimiser request; undefined when `request` is not one. */
+  handle(request: { type: string } & Record<string, unknown>, progress: (fraction: number) => void, signal?: AbortSignal): Promise<unknown> | undefined {
+    switch (request.type) {
+      case 'followPath':
+        return this.followPath(request as unknown as FollowPathParams, progress, signal);
+      case 'controlStart':
+        return Promise.resolve(this.controlStart(request as unknown as ControlStartParams));
+      case 'controlPull':
+        return this.controlPull(request as unknown as ControlTargetParams & { frames: number; particles?: number });
+      case 'simulateControl':
+        return this.simulate(request as unknown as SimulateControlParams, progress, signal);
+      default:
+        return undefined;
+    }
+  }
+
+  async followPath(p: FollowPathParams, progress: (fraction: number) => void, signal?: AbortSignal): Promise<FollowPathChunk> {
+    const points = checkPathPoints(p.points);
+    const gait = checkGait(p.gait);
+    const seed = checkSeed(p.seed);
+    const fitSigma = checkFitSigma(optional(p.fitSigma, 0.1));
+    const lock = checkFootLock(p.footLock);
+    // Followed, locked and measured near the origin; moved back to where the path is last.
+    const { origin, local } = relativeToStart(points);
+    const path = p.stroke ? GroundPath.fromStroke(local) : GroundPath.fromPoints(local);
+    const info = this.core.info;
+    const r = await followPath({ step: this.stepFn(signal), info, mean: this.core.mean, std: this.core.std, path, gait, seed, fitSigma, onProgress: progress });
+    const shown = lock ? this.plant(r.positions, r.contacts) : { positions: r.positions, contacts: r.contacts };
+    const stats = { ...r.stats, ...footStats(this.core.info, r.frames, shown, { positions: r.positions, contacts: r.contacts }) };
+    return { frames: r.frames, features: r.features, positions: moveBack(shown.positions, origin), contacts: shown.contacts, rootHeading: r.rootHeading, seedIndex: r.seedIndex, startFrame: 0, stats, path: path.flatAt(origin) };
+  }
+
+  /** Contacts labelled on a whole motion of the generator's skeleton and planted feet locked (hips and above unchanged). */
+  private plant(positions: Float32Array, bits: Uint8Array): { positions: Float32Array; contacts: Uint8Array } {
+    const { skeleton, fps } = this.core.info;
+    return plantFeet(positions, bits, skeleton.joints, skeleton.offsets, fps);
+  }
+
+  controlStart(p: ControlStartParams): StreamInfo {
+    this.live = undefined;
+    const { joints, offsets } = this.core.info.skeleton;
+    this.live = { ...this.controller(checkSeed(p.seed), checkGait(p.gait)), feet: new PlantedFeet(joints, offsets, this.core.info.fps) };
+    return { seedIndex: this.live.seedIndex, seedName: this.core.info.seeds[this.live.seedIndex].name };
+  }
+
+  async controlPull(p: ControlTargetParams & { frames: number; particles?: number }): Promise<ControlChunkReply> {
+    const live = this.live;
+    if (!live) throw new Error('no control stream: send controlStart first');
+    const startFrame = live.controller.frame;
+    const chunk = await live.controller.advance({ speed: p.speed, heading: p.heading }, p.frames, p.particles);
+    // Contacts labelled and planted feet locked frame by frame, continuing across batches (as simulateControl's
+    // whole-run lock); the chunk's contacts become the labels.
+    const n = this.core.info.skeleton.joints.length * 3;
+    const bits = new Uint8Array(2);
+    for (let f = 0; f < chunk.frames; f++) {
+      const pose = chunk.positions.subarray(f * n, (f + 1) * n);
+      const labels = chunk.contacts.subarray(f * 2, f * 2 + 2);
+      bits.set(labels);
+      live.feet.step(pose, bits, labels);
+    }
+    return { ...chunk, seedIndex: live.seedIndex, startFrame };
+  }
+
+  async simulate(p: SimulateControlParams, progress: (fraction: number) => void, signal?: AbortSignal): Promise<SimulatedControlChunk> {
+    checkSeconds(p.seconds);
+    const schedule = checkSchedule(p.schedule);
+    const seed = checkSeed(p.seed);
+    const gait = p.gait === undefined ? (schedule[0].speed >= 2 ? 'run' : 'walk') : checkGait(p.gait);
+    const { controller, seedIndex } = this.controller(seed, gait, signal);
+    const fps = this.core.info.fps;
+    const sim = await simulateControl(controller, schedule, p.seconds, fps, progress);
+    const frames = sim.targets.length;
+    const D = this.core.info.onnx.dim;
+    const J = this.core.info.skeleton.joints.length;
+    const out: SimulatedControlChunk = {
+      frames,
+      features: new Float32Array(frames * D),
+      positions: new Float32Array(frames * J * 3),
+      contacts: new Uint8Array(frames * 2),
+      rootHeading: new Float32Array(frames),
+      seedIndex,
+      startFrame: 0,
+      speed: new Float32Array(frames),
+      heading: new Float32Array(frames),
+      targetSpeed: Float32Array.from(sim.targets, (t) => t.speed),
+      targetHeading: Float32Array.from(sim.targets, (t) => t.heading),
+      computeMs: new Float32Array(frames),
+      batchMs: Float32Array.from(sim.chunks, (c) => c.computeMs),
+      batchFrames: Uint8Array.from(sim.chunks, (c) => c.frames),
+    };
+    let at = 0;
+    const lock = checkFootLock(p.footLock);
+    for (const c of sim.chunks) {
+      out.features.set(c.features, at * D);
+      out.positions.set(c.positions, at * J * 3);
+      out.contacts.set(c.contacts, at * 2);
+      out.rootHeading.set(c.rootHeading, at);
+      out.speed.set(c.speed, at);
+      out.heading.set(c.heading, at);
+      out.computeMs.fill(c.computeMs / c.frames, at, at + c.frames);
+      at += c.frames;
+    }
+    if (lock) ({ positions: out.positions, contacts: out.contacts } = this.plant(out.positions, out.contacts));
+    return out;
+  }
+}
