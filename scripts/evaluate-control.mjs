@@ -13,7 +13,7 @@
 import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import { launchBrowser, openPlayground, ROOT, startServer } from '../tests/e2e/harness.mjs';
+import { launchBrowser, openPlayground, ROOT, startServer } from '../tests/support/browser.mjs';
 import { controlRow, mean, rootSpeed, SCENARIOS, SIM_SECONDS } from './controlScenarios.mjs';
 
 const SEEDS = Number(process.env.SEEDS ?? 3);

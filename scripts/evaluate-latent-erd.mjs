@@ -16,7 +16,7 @@
 import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import { launchBrowser, openPlayground, ROOT, startServer } from '../tests/e2e/harness.mjs';
+import { launchBrowser, openPlayground, ROOT, startServer } from '../tests/support/browser.mjs';
 import { controlRow, mean, percentile, rootSpeed, SCENARIOS, SIM_SECONDS } from './controlScenarios.mjs';
 
 const SEEDS = Number(process.env.SEEDS ?? 3);

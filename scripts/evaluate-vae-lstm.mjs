@@ -15,7 +15,7 @@
 import { existsSync, readFileSync, writeFileSync } from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import { launchBrowser, openPlayground, ROOT, startServer } from '../tests/e2e/harness.mjs';
+import { launchBrowser, openPlayground, ROOT, startServer } from '../tests/support/browser.mjs';
 
 const SEEDS = Number(process.env.SEEDS ?? 3);
 const OUT = process.env.OUT ?? path.join(ROOT, 'docs/models/vae-lstm-browser.json');
