@@ -1,6 +1,7 @@
 """Evaluate the shipped generator against its held-out real clips and write docs/models/generator.{md,json,png}.
 
     python -m training.generator.evaluate [--frames 10000] [--seeds 5] [--temperature 0.5] [--sweep 1.0,0.5,0.25]
+    python -m training.generator.evaluate --from-json    # generator.md again from generator.json, measuring nothing
 
 Foot skating, root speed and turning-rate distributions, NPSS, a long stability run and a temperature
 sweep (training/generator/report.py).
@@ -11,7 +12,7 @@ import argparse
 from pathlib import Path
 
 from ..paths import MODELS_DIR, REPORTS_DIR
-from .report import write_generator_report
+from .report import rewrite_generator_markdown, write_generator_report
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -23,7 +24,12 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--sweep-frames", type=int, default=3000)
     parser.add_argument("--mocap", default=None)
     parser.add_argument("--models", type=Path, default=MODELS_DIR, help="directory with the exported model")
+    parser.add_argument("--from-json", action="store_true", help="only write generator.md from the stored generator.json")
     args = parser.parse_args(argv)
+    if args.from_json:
+        rewrite_generator_markdown()
+        print(f"wrote {REPORTS_DIR / 'generator.md'} from generator.json")
+        return
     sweep = [float(t) for t in args.sweep.split(",") if t.strip()]
     report = write_generator_report(args.frames, args.seeds, args.temperature, sweep, args.sweep_frames, args.mocap,
                                     args.models)

@@ -147,12 +147,55 @@ HELD_NOISE_NOTE = (
     "100% of frames) and the jitter of fresh noise kept it above the freeze line; at 0.8 it walks (0.45 m/s). Stability "
     "decides ρ: at 0.9 walk 16_19 drops below the freeze line for 1 second, at 0.95 for 23, so 0.8 is shipped. At τ = 1 "
     "held noise lets two streams leave the root height band (below); at ρ = 0 every τ row was stable.")
+REPORT_JSON = REPORTS_DIR / "generator.json"
+REPORT_MD = REPORTS_DIR / "generator.md"
 
 
-def write_markdown(report: dict) -> None:
+def targets(report: dict) -> list[tuple[str, bool, str]]:
+    """Each target the report checks: (the target, whether it is met, the measured numbers)."""
+    r, g = report["real"], report["generated"]
+    stable = sum(run["stable"] for run in report["runs"])
+    return [
+        ("foot skating no more than real", g["foot_skating_mean"] <= r["foot_skating"],
+         f"{g['foot_skating_mean'] / r['foot_skating']:.1f}× real"),
+        ("lowest-point sliding no more than real", g["low_foot_sliding"] <= r["low_foot_sliding"],
+         f"{g['low_foot_sliding'] / r['low_foot_sliding']:.1f}× real"),
+        ("NPSS no further from the held-out clips than half of them from the other half",
+         g["npss_mean"] <= r["npss_half_vs_half"], f"{g['npss_mean']:.3f} against {r['npss_half_vs_half']:.3f}"),
+        (f"every {report['frames_per_seed']:,}-frame run stable", report["all_stable"],
+         f"{stable} of {len(report['runs'])}"),
+    ]
+
+
+def summary_lines(report: dict) -> list[str]:
+    """The five lines a report opens with: what the model does, how the page uses it, the headline numbers against
+    real held-out clips, and what is not met."""
+    r, g = report["real"], report["generated"]
+    unmet = [f"{name} ({numbers})" for name, met, numbers in targets(report) if not met]
+    met = [name for name, met, _ in targets(report) if met]
+    return [
+        "- **What it does:** generates walking and running frame by frame: an LSTM gives a Gaussian mixture over the "
+        "next frame (pose, root motion, foot contacts) and a frame is drawn from it.",
+        f"- **In the page:** Random walk samples it in a worker at temperature {report['temperature']} (noise held over "
+        "frames); the refiner and the foot lock clean it up, and Path and Steer drive it with the MAP optimiser.",
+        f"- **Against {r['clips']} real held-out clips:** foot skating {g['foot_skating_mean']:.3f} m/s against "
+        f"{r['foot_skating']:.3f}; lowest-point sliding {g['low_foot_sliding']:.3f} m/s against {r['low_foot_sliding']:.3f}.",
+        f"- **Also:** root speed {g['root_speed']['mean']:.2f} m/s against {r['root_speed']['mean']:.2f}, turning "
+        f"{g['turning_rate_abs']['mean']:.2f} rad/s against {r['turning_rate_abs']['mean']:.2f}, NPSS {g['npss_mean']:.3f} "
+        f"(real half against half {r['npss_half_vs_half']:.3f}).",
+        "- **Not met:** " + ("; ".join(unmet) if unmet else "nothing") + (f". Met: {'; '.join(met)}." if met else "."),
+    ]
+
+
+def generator_markdown(report: dict) -> str:
+    """docs/models/generator.md from the numbers in generator.json (nothing here measures)."""
     r, g = report["real"], report["generated"]
     lines = [
         "# Generator report (LSTM + Gaussian mixture)",
+        "",
+        *summary_lines(report),
+        "",
+        "![distributions and stability](generator.png)",
         "",
         "Made by `python -m training.generator.evaluate` from the shipped `public/models/generator.onnx`",
         f"({report['bytes'] / 1e6:.2f} MB), sampled with onnxruntime at temperature {report['temperature']} as the page samples it "
@@ -160,8 +203,6 @@ def write_markdown(report: dict) -> None:
         f"rows too), {report['frames_per_seed']} frames per seed at {report['fps']} fps, against {r['clips']} held-out real clips "
         f"({r['frames']} frames). Training: {report['training']['epochs']} epochs, validation NLL "
         f"{report['training']['valid_nll_per_frame']:.2f} per frame.",
-        "",
-        "![distributions and stability](generator.png)",
         "",
         "| measure | real held-out | generated |",
         "|---|---|---|",
@@ -197,37 +238,27 @@ def write_markdown(report: dict) -> None:
                   + f". The freeze line does not catch it: it measures pose change, and the independent draw of every "
                   "frame keeps the joints jittering above it. Standing runs are counted as stable, and their spectra "
                   "raise the mean NPSS.", ""]
+    if report.get("sweep"):
+        lines += ["## Temperature", "",
+                  "Sampling temperature τ scales the mixture's standard deviations (and sharpens its weights). "
+                  f"Each row: {report['sweep'][0]['frames_per_seed']} frames for each of the same seeds.", "",
+                  "| τ | foot skating (m/s) | root speed mean (m/s) | turning abs. mean (rad/s) | NPSS | min pose change (m/s) | all stable |",
+                  "|---|---|---|---|---|---|---|"]
+        for row in report["sweep"]:
+            rg = row["generated"]
+            lines.append(f"| {row['temperature']} | {rg['foot_skating_mean']:.3f} | {rg['root_speed']['mean']:.2f} | "
+                         f"{rg['turning_rate_abs']['mean']:.2f} | {rg['npss_mean']:.3f} | "
+                         f"{min(run['min_pose_change'] for run in row['runs']):.3f} | {'yes' if row['all_stable'] else 'no'} |")
+        unstable = [(row["temperature"], run) for row in report["sweep"] for run in row["runs"] if not run["stable"]]
+        if unstable:
+            lines += ["", "Not stable: " + "; ".join(
+                f"τ {t}, {run['seed']}: " + ", ".join(why for why, bad in (
+                    ("not finite", not run["finite"]), (f"{run['frozen_seconds']} frozen seconds", run["frozen_seconds"] > 0),
+                    (f"root height {run['root_height_min']:.2f}–{run['root_height_max']:.2f} m, outside the band", not run["height_in_band"])) if bad)
+                for t, run in unstable) + "."]
+        lines.append("")
     m = report["model_info"]
     lines += [
-        "## Model", "",
-        f"FC {m['dim']}→{m['hidden']} → FC → 2 × LSTM({m['hidden']}) → FC to a {m['mixtures']}-component diagonal mixture "
-        f"over {m['dim']} features; {m['parameters']:,} parameters, {report['bytes'] / 1e6:.2f} MB of ONNX "
-        f"(weights stored as {report.get('weights', 'float32')}: int8 with the mixture head float16, computed in float32; "
-        "a float32 file was 3.11 MB and its report numbers differ from these by no more than float16 storage's do, "
-        "see [weights.md](weights.md)). "
-        "The ONNX step is written by `training/generator/graph.py` directly as a gate-level graph (Gemm products and "
-        "the gate maths, no ONNX LSTM op); its parity with torch is in generator.json. "
-        f"The width was chosen for the browser budget: in onnxruntime (1 thread) a step costs about 0.3 ms at batch 1 "
-        f"(widths 128/192/256 gave 10.9k/3.7k/2.8k steps/s at batch 1 and 83k/51k/31k particle-steps/s at batch 64). "
-        f"Trained on {m['train_frames']:,} frames (walk and run clips, mirrored, and 0.9×/1.1× speed copies), "
-        f"{report['training']['epochs']} epochs{m['stop_note']}, dropout 0.25; the training log is copied to "
-        "[generator-train.log](generator-train.log). A width-128 variant was trained and measured, and not shipped "
-        "([bench.md](../bench.md)).",
-        "",
-        "Real skating is pooled over the held-out clips each measured on its own (frame pairs never span two clips); "
-        "reports before 2026-12-01 joined the clips end to end and gave 0.393 m/s.",
-        "",
-        "**Rotation parameterisation.** Joint rotations are rotation vectors relative to each joint's mean rotation. "
-        f"Measured over {report['wraparound']['pairs_checked']:,} consecutive joint-frame pairs of the walking and running "
-        f"data whose true rotation changes by less than {report['wraparound']['small_turn_rad']} rad: the largest jump is "
-        f"{report['wraparound']['rotvec_max_jump']:.2f} in rotation-vector units, against {report['wraparound']['euler_zyx_max_jump']:.2f} rad for "
-        f"ZYX Euler angles of the same rotations (Euler angles jump near gimbal lock and at ±π). The largest angle from a "
-        f"reference is {report['wraparound']['rotvec_max_angle_from_reference']:.2f} rad, inside the chart's π limit.",
-        "",
-        "**Initial state (eq. 26).** Each seed's (h, c) is optimised so the following real frames are likely. "
-        "Mean NLL per frame of the next 5 real frames, zero state → estimated state: "
-        + "; ".join(f"{sd['name']}: {sd['nll_zero_state']:.0f} → {sd['nll_estimated_state']:.0f}" for sd in m["seeds"]) + ".",
-        "",
         "## Reading the numbers", "",
         f"- Foot skating is {g['foot_skating_mean'] / r['foot_skating']:.1f}× that of real motion measured the same way: "
         f"every frame draws new noise from the mixture (held only in part, correlation {report.get('noise_correlation', 0.0)}), so "
@@ -243,29 +274,53 @@ def write_markdown(report: dict) -> None:
         + "Faster walking, running and sharp turns are in the model but need steering (path and speed control) to come out.",
         "- NPSS is on a scale set by the real data: two halves of the held-out set differ by the first column's value.",
         "",
+        "## Model", "",
+        f"FC {m['dim']}→{m['hidden']} → FC → 2 × LSTM({m['hidden']}) → FC to a {m['mixtures']}-component diagonal mixture "
+        f"over {m['dim']} features; {m['parameters']:,} parameters, {report['bytes'] / 1e6:.2f} MB of ONNX "
+        f"(weights stored as {report.get('weights', 'float32')}: int8 with the mixture head float16, computed in float32; "
+        "a float32 file was 3.11 MB and its report numbers differ from these by no more than float16 storage's do, "
+        "see [weights.md](weights.md)). "
+        "The ONNX step is written by `training/generator/graph.py` directly as a gate-level graph (Gemm products and "
+        "the gate maths, no ONNX LSTM op); its parity with torch is in generator.json. "
+        f"The width was chosen for the browser budget: in onnxruntime (1 thread) a step costs about 0.3 ms at batch 1 "
+        f"(widths 128/192/256 gave 10.9k/3.7k/2.8k steps/s at batch 1 and 83k/51k/31k particle-steps/s at batch 64). "
+        f"Trained on {m['train_frames']:,} frames (walk and run clips, mirrored, and 0.9×/1.1× speed copies), "
+        f"{report['training']['epochs']} epochs{m['stop_note']}, dropout 0.25; the training log is copied to "
+        "[generator-train.log](generator-train.log). A width-128 variant was trained and measured, and not shipped "
+        "([bench.md](../bench.md)).",
+        "",
+        "**Rotation parameterisation.** Joint rotations are rotation vectors relative to each joint's mean rotation. "
+        f"Measured over {report['wraparound']['pairs_checked']:,} consecutive joint-frame pairs of the walking and running "
+        f"data whose true rotation changes by less than {report['wraparound']['small_turn_rad']} rad: the largest jump is "
+        f"{report['wraparound']['rotvec_max_jump']:.2f} in rotation-vector units, against {report['wraparound']['euler_zyx_max_jump']:.2f} rad for "
+        f"ZYX Euler angles of the same rotations (Euler angles jump near gimbal lock and at ±π). The largest angle from a "
+        f"reference is {report['wraparound']['rotvec_max_angle_from_reference']:.2f} rad, inside the chart's π limit.",
+        "",
+        "**Initial state (eq. 26).** Each seed's (h, c) is optimised so the following real frames are likely. "
+        "Mean NLL per frame of the next 5 real frames, zero state → estimated state: "
+        + "; ".join(f"{sd['name']}: {sd['nll_zero_state']:.0f} → {sd['nll_estimated_state']:.0f}" for sd in m["seeds"]) + ".",
+        "",
+        "## History", "",
+        "Real skating is pooled over the held-out clips each measured on its own (frame pairs never span two clips); "
+        "reports before 2026-12-01 joined the clips end to end and gave 0.393 m/s.",
+        "",
         HELD_NOISE_NOTE,
         "",
     ]
-    if report.get("sweep"):
-        lines += ["## Temperature", "",
-                  "Sampling temperature τ scales the mixture's standard deviations (and sharpens its weights). "
-                  f"Each row: {report['sweep'][0]['frames_per_seed']} frames for each of the same seeds.", "",
-                  "| τ | foot skating (m/s) | root speed mean (m/s) | turning abs. mean (rad/s) | NPSS | min pose change (m/s) | all stable |",
-                  "|---|---|---|---|---|---|---|"]
-        for row in report["sweep"]:
-            g = row["generated"]
-            lines.append(f"| {row['temperature']} | {g['foot_skating_mean']:.3f} | {g['root_speed']['mean']:.2f} | "
-                         f"{g['turning_rate_abs']['mean']:.2f} | {g['npss_mean']:.3f} | "
-                         f"{min(r['min_pose_change'] for r in row['runs']):.3f} | {'yes' if row['all_stable'] else 'no'} |")
-        unstable = [(row["temperature"], r) for row in report["sweep"] for r in row["runs"] if not r["stable"]]
-        if unstable:
-            lines += ["", "Not stable: " + "; ".join(
-                f"τ {t}, {r['seed']}: " + ", ".join(why for why, bad in (
-                    ("not finite", not r["finite"]), (f"{r['frozen_seconds']} frozen seconds", r["frozen_seconds"] > 0),
-                    (f"root height {r['root_height_min']:.2f}–{r['root_height_max']:.2f} m, outside the band", not r["height_in_band"])) if bad)
-                for t, r in unstable) + "."]
-        lines.append("")
-    (REPORTS_DIR / "generator.md").write_text("\n".join(lines))
+    return "\n".join(lines)
+
+
+def slim_report(report: dict) -> dict:
+    """What generator.json keeps: no per-second curves, and of the seeds only their names and likelihoods."""
+    slim_runs = lambda rep: [{k: v for k, v in r.items() if k != "pose_change_curve"} for r in rep["runs"]]
+    seeds = [{k: sd[k] for k in ("name", "nll_zero_state", "nll_estimated_state")} for sd in report["model_info"]["seeds"]]
+    return dict(report, runs=slim_runs(report), sweep=[dict(row, runs=slim_runs(row)) for row in report["sweep"]],
+                model_info=dict(report["model_info"], seeds=seeds))
+
+
+def rewrite_generator_markdown() -> None:
+    """generator.md again from the committed generator.json, without measuring."""
+    REPORT_MD.write_text(generator_markdown(json.loads(REPORT_JSON.read_text())))
 
 
 def write_generator_report(frames: int, n_seeds: int, temperature: float, sweep: list[float], sweep_frames: int,
@@ -274,9 +329,6 @@ def write_generator_report(frames: int, n_seeds: int, temperature: float, sweep:
     REPORTS_DIR.mkdir(parents=True, exist_ok=True)
     report = evaluate_generator(frames, n_seeds, temperature, mocap, models_dir)
     report["sweep"] = [evaluate_generator(sweep_frames, n_seeds, t, mocap, models_dir, plot=False) for t in sweep]
-    slim_runs = lambda rep: [{k: v for k, v in r.items() if k != "pose_change_curve"} for r in rep["runs"]]
-    slim = dict(report, runs=slim_runs(report), sweep=[dict(row, runs=slim_runs(row)) for row in report["sweep"]],
-                model_info={k: v for k, v in report["model_info"].items() if k != "seeds"})
-    (REPORTS_DIR / "generator.json").write_text(json.dumps(slim, indent=1) + "\n")
-    write_markdown(report)
+    REPORT_JSON.write_text(json.dumps(slim_report(report), indent=1) + "\n")
+    REPORT_MD.write_text(generator_markdown(report))
     return report
