@@ -1,6 +1,7 @@
 """Report on the shipped refiner: raw generator output, refined, refined + foot lock, and real held-out clips.
 
     python -m training.refiner.evaluate [--frames 3000] [--seeds 8]
+    python -m training.refiner.evaluate --from-json    # refiner.md again from refiner.json, measuring nothing
 
 Writes docs/models/refiner.{md,json,png}; what is measured and how is in training/refiner/report.py.
 """
@@ -9,17 +10,20 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..paths import MODELS_DIR, REPORTS_DIR
-from .report import write_refiner_report
+from ..paths import REPORTS_DIR
+from ..runs import add_report_arguments
+from .report import rewrite_refiner_markdown, write_refiner_report
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--frames", type=int, default=3000, help="frames per seed")
-    parser.add_argument("--seeds", type=int, default=8, help="seeds (8: all of the generator's)")
-    parser.add_argument("--mocap", default=None)
-    parser.add_argument("--models", type=Path, default=MODELS_DIR, help="directory with the exported models")
+    add_report_arguments(parser, frames=3000, seeds=8, seeds_help="seeds (8: all of the generator's)")
+    parser.add_argument("--from-json", action="store_true", help="only write refiner.md from the stored refiner.json")
     args = parser.parse_args(argv)
+    if args.from_json:
+        rewrite_refiner_markdown()
+        print(f"wrote {REPORTS_DIR / 'refiner.md'} from refiner.json")
+        return
     write_refiner_report(args.frames, args.seeds, args.mocap, args.models)
     print(f"wrote {REPORTS_DIR / 'refiner.md'}")
 
