@@ -1,6 +1,7 @@
 """Evaluate the shipped dance models, acLSTM against its vanilla baseline, and write docs/models/aclstm.{md,json,png}.
 
     python -m training.aclstm.evaluate [--frames 20000] [--seeds 5] [--also LABEL=path/to/model.json]
+    python -m training.aclstm.evaluate --from-json    # aclstm.md again from aclstm.json, measuring nothing
 
 What is measured: training/aclstm/report.py.
 """
@@ -9,19 +10,22 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..paths import MODELS_DIR, REPORTS_DIR
-from .report import write_dance_report
+from ..paths import REPORTS_DIR
+from ..runs import add_report_arguments
+from .report import rewrite_aclstm_markdown, write_dance_report
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--frames", type=int, default=20000, help="frames per seed")
-    parser.add_argument("--seeds", type=int, default=5, help="seeds per style")
-    parser.add_argument("--mocap", default=None)
-    parser.add_argument("--models", type=Path, default=MODELS_DIR, help="directory with the exported models")
+    add_report_arguments(parser, frames=20000, seeds=5, seeds_help="seeds per style")
     parser.add_argument("--also", action="append", default=[], metavar="LABEL=JSON",
                         help="another exported dance model to compare (not shipped), e.g. 'acLSTM v=20=/tmp/x/aclstm.json'")
+    parser.add_argument("--from-json", action="store_true", help="only write aclstm.md from the stored aclstm.json")
     args = parser.parse_args(argv)
+    if args.from_json:
+        rewrite_aclstm_markdown()
+        print(f"wrote {REPORTS_DIR / 'aclstm.md'} from aclstm.json")
+        return
     extra = []
     for item in args.also:
         label, sep, path = item.rpartition("=")
