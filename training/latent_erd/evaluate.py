@@ -1,6 +1,7 @@
 """Measure the shipped latent ERD and write docs/models/latent-erd.{md,json}.
 
     python -m training.latent_erd.evaluate [--frames 10000] [--seeds 5]
+    python -m training.latent_erd.evaluate --from-json    # latent-erd.md again from latent-erd.json, measuring nothing
 
 Run npm run evaluate:latent-erd first for the page's numbers (paths, live control); the measures are
 described in training/latent_erd/measures.py.
@@ -12,7 +13,7 @@ import json
 from pathlib import Path
 
 from ..paths import REPO_ROOT, REPORTS_DIR, add_mocap_argument
-from .report import write_report
+from .report import rewrite_latent_erd_markdown, write_report
 
 NOTES = REPORTS_DIR / "latent-erd-notes.json"
 
@@ -24,7 +25,12 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--seeds", type=int, default=5)
     parser.add_argument("--pose-checkpoint", default=str(REPO_ROOT / "runs" / "pose-erd" / "last.pt"),
                         help="the pose-space baseline: its last checkpoint, after the input-noise ramp (its best next-step loss came before the noise)")
+    parser.add_argument("--from-json", action="store_true", help="only write latent-erd.md from the stored latent-erd.json")
     args = parser.parse_args(argv)
+    if args.from_json:
+        rewrite_latent_erd_markdown()
+        print(f"wrote {REPORTS_DIR / 'latent-erd.md'} from latent-erd.json")
+        return
     notes = json.loads(NOTES.read_text()) if NOTES.exists() else {}
     report = write_report(args.mocap, args.frames, args.seeds, Path(args.pose_checkpoint), notes)
     print(f"wrote {REPORTS_DIR / 'latent-erd.md'}: {report['long_runs']['collapsed']} of {args.seeds} long runs collapsed")
