@@ -3,6 +3,7 @@
     python -m training.vae_lstm.evaluate
     python -m training.vae_lstm.evaluate --map-windows     # cache/vae-lstm-map-windows.json for npm run evaluate:vae-lstm
     python -m training.vae_lstm.evaluate --models DIR --out DIR2   # another export (e.g. its float32 files), report in DIR2
+    python -m training.vae_lstm.evaluate --from-json     # vae-lstm.md again from vae-lstm.json, measuring nothing
 
 Run npm run evaluate:vae-lstm first for the page's numbers on the benchmark paths; the measures are described in
 training/vae_lstm/measures.py, the prose around them is docs/models/vae-lstm-notes.json.
@@ -17,7 +18,7 @@ from ..data.locomotion import load_clips
 from ..data.windows import WindowCorpus
 from ..paths import DEFAULT_CACHE, MODELS_DIR, REPORTS_DIR, add_mocap_argument
 from .measures import map_follow_windows
-from .report import write_report
+from .report import rewrite_vae_lstm_markdown, write_report
 
 MAP_WINDOWS = DEFAULT_CACHE / "vae-lstm-map-windows.json"
 
@@ -29,7 +30,12 @@ def main(argv: list[str] | None = None) -> None:
                         help=f"write only {MAP_WINDOWS}: the prediction windows' root paths for the MAP follower in the page")
     parser.add_argument("--models", type=Path, default=MODELS_DIR, help="the folder holding vae-lstm.json and its graphs")
     parser.add_argument("--out", type=Path, default=REPORTS_DIR, help="where to write vae-lstm.{md,json}")
+    parser.add_argument("--from-json", action="store_true", help="only write vae-lstm.md from the stored vae-lstm.json")
     args = parser.parse_args(argv)
+    if args.from_json:
+        rewrite_vae_lstm_markdown()
+        print(f"wrote {REPORTS_DIR / 'vae-lstm.md'} from vae-lstm.json")
+        return
     if args.map_windows:
         MAP_WINDOWS.parent.mkdir(parents=True, exist_ok=True)
         MAP_WINDOWS.write_text(json.dumps(map_follow_windows(WindowCorpus(load_clips(args.mocap)))))
