@@ -121,7 +121,7 @@ function markdown(r) {
   const walk = r.paths.filter((p) => p.gait === 'walk');
   const run = r.paths.filter((p) => p.gait === 'run');
   const pass = (ok) => (ok ? 'yes' : '**no**');
-  lines.push('# Path following and live control', '');
+  lines.push('# Path following and live control', '', ...summaryLines(r), '');
   lines.push(
     `Made by \`npm run evaluate:control\` (${r.date}) in headless Chromium through \`playground.followPath\` and \`playground.simulateControl\`, ${r.seeds} seeds per case, one onnxruntime-web thread (cross-origin isolated: ${r.crossOriginIsolated}), 1-minute load average ${fmt(r.loadBefore, 1)} before and ${fmt(r.loadAfter, 1)} after on this 2-core machine (timings are only meaningful near 1, this run alone). ` +
       'The optimiser is `web/optimizer/` over the shipped generator (see [generator.md](generator.md)); paths are `tests/fixtures/benchmark_paths.json`.',
@@ -187,6 +187,49 @@ function markdown(r) {
   return lines.join('\n') + '\n';
 }
 
+// The checks the report makes, each [what, met, the measured numbers]: the five lines at the top say which fail.
+function controlChecks(r) {
+  const T = r.targets;
+  const walk = r.paths.filter((p) => p.gait === 'walk');
+  const heads = r.control.filter((c) => c.kind === 'heading');
+  const walkSpeeds = r.control.filter((c) => c.kind === 'speed' && !c.scenario.startsWith('run'));
+  const walkControl = r.control.filter((c) => !c.scenario.startsWith('run'));
+  const p95 = Math.max(...r.control.map((c) => c.p95ms));
+  const skateRatio = mean(walk.map((p) => p.skatingBeforeLock)) / mean(walk.map((p) => p.freeSkating));
+  const slides = [...walk.map((p) => p.sliding), ...walkControl.map((c) => c.sliding)];
+  return [
+    ['walking paths within the fit, progress and speed targets', walk.every((p) => p.meanError <= T.meanError && p.maxError <= T.maxError && p.arcProgress >= T.arcProgress && p.realtime >= T.realtime), `worst mean error ${fmt(Math.max(...walk.map((p) => p.meanError)), 3)} m`],
+    [`skating before the lock ≤ ${T.skatingRatio}× unconstrained`, skateRatio <= T.skatingRatio, `${fmt(skateRatio, 2)}×`],
+    ['turns within their limits', heads.every((c) => c.headingResponse <= c.limit), `worst ${fmt(Math.max(...heads.map((c) => c.headingResponse)))} s`],
+    [`walking speed within ${T.speedError} m/s of the target`, walkSpeeds.every((c) => c.speedError <= T.speedError), `worst ${fmt(Math.max(...walkSpeeds.map((c) => c.speedError)))} m/s`],
+    [`compute p95 < ${T.p95ms} ms per frame`, p95 < T.p95ms, `${fmt(p95, 1)} ms`],
+    ['every walking run slides no more than the real clips pooled', slides.every((v) => v <= r.realSliding), `${slides.filter((v) => v > r.realSliding).length} of ${slides.length} runs above ${fmt(r.realSliding, 3)} m/s, the worst ${fmt(Math.max(...slides), 3)}`],
+  ];
+}
+
+// The five lines a report opens with: what it does, how the page uses it, headline numbers against real clips, what is not met.
+function summaryLines(r) {
+  const walk = r.paths.filter((p) => p.gait === 'walk');
+  const walkControl = r.control.filter((c) => !c.scenario.startsWith('run'));
+  const heads = (name) => r.control.filter((c) => c.scenario === name).map((c) => c.headingResponse);
+  const unmet = controlChecks(r).filter(([, met]) => !met).map(([what, , numbers]) => `${what} (${numbers})`);
+  return [
+    '- **What it does:** steers the generator: an optimiser picks the most likely motion under the generator whose root follows a drawn path or live steering.',
+    '- **In the page:** Path mode (draw a path, **Go**) and Steer mode (keys, slider, stick) with the generator model; the motion is foot-locked before it is shown.',
+    `- **Walking the benchmark paths:** mean error ${fmt(mean(walk.map((p) => p.meanError)), 3)} m from the path, ${fmt(Math.min(...walk.map((p) => p.realtime)), 2)}× real time at least; after the foot lock feet slide ${fmt(mean(walk.map((p) => p.sliding)), 3)} m/s against the real held-out clips' ${fmt(r.realSliding, 3)} (lowest point).`,
+    `- **Live control:** heading within 15° after ${fmt(Math.max(...heads('turn 90°')))} s for a 90° turn and ${fmt(Math.max(...heads('turn 180°')))} s for 180° (worst runs); walking control runs slide ${fmt(mean(walkControl.map((c) => c.sliding)), 3)} m/s against ${fmt(r.realSliding, 3)}.`,
+    `- **Not met:** ${unmet.length ? unmet.join('; ') : 'nothing'}.`,
+  ];
+}
+
+// npm run evaluate:control -- --from-json: control.md again from the stored control.json, measuring nothing
+// (--stdout: print it instead, for tests/python/test_reports.py).
+function writeFromJson() {
+  const r = JSON.parse(readFileSync(path.join(OUT, 'control.json'), 'utf8'));
+  if (process.argv.includes('--stdout')) process.stdout.write(markdown(r));
+  else writeFileSync(path.join(OUT, 'control.md'), markdown(r));
+}
+
 // A single run is one short motion: compare it with single real clips, whose sliding spreads widely (the pooled
 // figure is dominated by a few long, slow clips).
 function perClipLines(r, runs, what) {
@@ -200,7 +243,7 @@ function perClipLines(r, runs, what) {
   ];
 }
 
-main().catch((err) => {
+(process.argv.includes('--from-json') ? Promise.resolve().then(writeFromJson) : main()).catch((err) => {
   console.error(err);
   process.exit(1);
 });
