@@ -335,17 +335,22 @@ def results_lines(r: dict) -> list[str]:
         + (" (the difference is within the spread between classifier seeds)" if within_spread else "") + ".",
         "",
         "## Reading the numbers", "",
-        "- The foot lock does nearly all of the skating removal: on its own it takes the raw generator from "
-        f"{sk['raw']:.3f} to {sk['raw + foot lock']:.3f} m/s; the refiner alone halves skating "
-        f"({sk['raw']:.3f} → {sk['refined']:.3f} m/s, planted toes visibly calmer) and leaves less for the lock to pull back.",
+        f"- The foot lock alone removes {1 - sk['raw + foot lock'] / sk['raw']:.0%} of the raw generator's skating "
+        f"({sk['raw']:.3f} → {sk['raw + foot lock']:.3f} m/s); the refiner alone removes {1 - sk['refined'] / sk['raw']:.0%} "
+        f"({sk['raw']:.3f} → {sk['refined']:.3f} m/s), and the lock after it ends "
+        f"{'lower' if sk['refined + foot lock'] < sk['raw + foot lock'] else 'no lower'} than the lock on raw motion "
+        f"({sk['refined + foot lock']:.3f} against {sk['raw + foot lock']:.3f} m/s).",
         "- Every generated variant stays easy to tell from real motion: the window classifier is right "
-        f"{100 * min(ts[v]['balanced_accuracy_mean'] for v in VARIANTS):.0f}-100% of the time and single frames give "
+        f"{100 * min(ts[v]['balanced_accuracy_mean'] for v in VARIANTS):.0f}-"
+        f"{100 * max(ts[v]['balanced_accuracy_mean'] for v in VARIANTS):.0f}% of the time and single frames give "
         f"it away {100 * min(ts[v]['frame_balanced_accuracy_mean'] for v in VARIANTS):.0f}-"
         f"{100 * max(ts[v]['frame_balanced_accuracy_mean'] for v in VARIANTS):.0f}% of the time. Against raw, the refiner "
         f"{accuracy_change(ts['raw'], ts['refined'])}; it does not make the motion indistinguishable. The foot lock, on "
         f"the refined motion, {accuracy_change(ts['refined'], ts['refined + foot lock'])} (perfectly still toes and "
         "IK-bent legs are themselves unlike real motion).",
-        f"- Refined hands move faster than raw ones (W1 to real {V['raw']['speed_wasserstein']['hands']:.2f} → "
+        f"- Refined hands move {'faster' if V['refined']['speeds']['hands']['mean'] > V['raw']['speeds']['hands']['mean'] else 'slower'} "
+        f"than raw ones (mean {V['raw']['speeds']['hands']['mean']:.2f} → {V['refined']['speeds']['hands']['mean']:.2f} m/s, real "
+        f"{real['speeds']['hands']['mean']:.2f}; W1 to real {V['raw']['speed_wasserstein']['hands']:.2f} → "
         f"{V['refined']['speed_wasserstein']['hands']:.2f} m/s): D sees the wrists and R trades them off against the feet.",
         "",
     ]
