@@ -1,15 +1,53 @@
-"""Shared plumbing for training runs: run directory, log file, timed checkpoints, resume."""
+"""Shared plumbing for training runs: run directory, log file, timed checkpoints, resume; the start and end every
+training loop shares (TrainingLoop), and the flags the train, export and evaluate commands share."""
 from __future__ import annotations
 
+import argparse
+import json
 import logging
 import time
 from pathlib import Path
 
+import numpy as np
 import torch
+from tqdm import tqdm
 
-from .paths import REPO_ROOT
+from .paths import MODELS_DIR, REPO_ROOT, add_mocap_argument
 
 RUNS_DIR = REPO_ROOT / "runs"
+
+
+def add_run_arguments(parser: argparse.ArgumentParser, run: str, minutes: float, iterations: int | None = None) -> None:
+    """The flags every train command has, with its default run name and time budget (TrainingLoop reads them),
+    and --iterations with its default where the command counts its run in iterations."""
+    add_mocap_argument(parser)
+    parser.add_argument("--run", default=run, help="run name under runs/")
+    if iterations is not None:
+        parser.add_argument("--iterations", type=int, default=iterations, help="training iterations in all")
+    parser.add_argument("--minutes", type=float, default=minutes, help="stop cleanly after this much training time")
+    parser.add_argument("--checkpoint-minutes", type=float, default=3.0, help="minutes between checkpoints")
+    parser.add_argument("--resume", action="store_true", help="continue from runs/<run>/checkpoint.pt")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--threads", type=int, default=1, help="torch CPU threads (1 is steadiest when the machine is shared)")
+
+
+def add_export_arguments(parser: argparse.ArgumentParser, weight_formats, weights_help: str, shipped_help: str) -> None:
+    """The flags the export commands share: where the files go, how they store their large weights
+    (`weight_formats`: onnx/compact.py FORMATS, passed in since runs.py sits below onnx/), and --from-shipped DIR
+    (default public/models) to rewrite an exported model without a checkpoint."""
+    parser.add_argument("--out", type=Path, default=MODELS_DIR)
+    parser.add_argument("--weights", choices=weight_formats, default="int8", help=weights_help)
+    parser.add_argument("--from-shipped", type=Path, nargs="?", const=MODELS_DIR, default=None, metavar="DIR",
+                        help=shipped_help)
+
+
+def add_report_arguments(parser: argparse.ArgumentParser, frames: int, seeds: int, seeds_help: str | None = None) -> None:
+    """The flags the evaluate commands of the exported models share: how long and how many runs to draw, the
+    corpus and the folder of the exported models."""
+    parser.add_argument("--frames", type=int, default=frames, help="frames per seed")
+    parser.add_argument("--seeds", type=int, default=seeds, help=seeds_help)
+    add_mocap_argument(parser)
+    parser.add_argument("--models", type=Path, default=MODELS_DIR, help="directory with the exported models")
 
 
 class Run:
@@ -58,18 +96,92 @@ class Run:
         torch.set_rng_state(state["torch_rng"])
         return state
 
-    def start(self, resume: bool, rng, **parts) -> tuple[int, float, float]:
-        """(iteration, best, seconds trained before) to start from: from the latest checkpoint (restoring
-        `parts` and the random generators, as `resume`) when `resume`, else a fresh start."""
-        if not resume:
-            return 0, float("inf"), 0.0
-        state = self.resume(rng, **parts)
-        self.log.info("resumed at iteration %d", state["iteration"])
-        return state["iteration"], state["best"], state["elapsed"]
 
-    @staticmethod
-    def state(rng, iteration: int, best: float, elapsed: float, meta: dict, **parts) -> dict:
-        """A checkpoint that `start` reads back: each part's state_dict under its name, the random generators,
-        the counters and the meta."""
-        return {**{k: p.state_dict() for k, p in parts.items()}, "rng": rng.bit_generator.state,
-                "torch_rng": torch.get_rng_state(), "iteration": iteration, "best": best, "elapsed": elapsed, "meta": meta}
+class TrainingLoop:
+    """The start and end of a training loop, from the flags of add_run_arguments (args.run, .minutes,
+    .checkpoint_minutes, .resume, .seed, .threads): the run directory, torch's threads and seed, resuming,
+    the clock over all sessions of the run, the progress bar, timed checkpoints, the stop at --minutes, and
+    the last checkpoint and summary.json at the end. A recipe keeps its best validation measure in `best`.
+
+    A checkpoint holds each part's state_dict under its name, the random generators, `iteration`, `best`,
+    `elapsed` (seconds trained in all sessions), `meta` and what the recipe adds to it (`extra`)."""
+
+    def __init__(self, args: argparse.Namespace):
+        self.args = args
+        torch.set_num_threads(args.threads)
+        self.run = Run(args.run, args.checkpoint_minutes)
+        self.log = self.run.log
+        self.best = float("inf")
+        self.stopped = "iterations done"
+        self.elapsed_before = 0.0
+        self.t0 = time.monotonic()
+
+    def seed(self) -> np.random.Generator:
+        """numpy's generator for --seed, with torch's seeded too. Each recipe calls it where it always seeded (some
+        before building the model, some after), so a run draws the same numbers as before."""
+        torch.manual_seed(self.args.seed)
+        self.rng = np.random.default_rng(self.args.seed)
+        return self.rng
+
+    def start(self, meta: dict, position: str = "iteration {iteration}", **parts) -> int:
+        """Resume from runs/<run>/checkpoint.pt with --resume (restoring `parts`, the random generators of
+        seed(), `best` and the clock; the checkpoint stays in `resumed` for the recipe's own counters), else
+        start fresh. Returns the iteration to start from. `position` says in the log where a checkpoint stands,
+        from its fields; `parts["model"]` is counted in `parameters`."""
+        self.meta, self.parts, self.position = meta, parts, position
+        self.parameters = sum(p.numel() for p in parts["model"].parameters())
+        self.resumed = self.run.resume(self.rng, **parts) if self.args.resume else None
+        iteration = 0
+        if self.resumed is not None:
+            iteration, self.best = self.resumed["iteration"], self.resumed["best"]
+            self.start_clock(self.resumed["elapsed"])
+            self.log.info("resumed at " + position.format(**self.resumed))
+        else:
+            self.start_clock(0.0)
+        return iteration
+
+    def start_clock(self, elapsed_before: float) -> None:
+        """Count training time from now on top of `elapsed_before` seconds of earlier sessions."""
+        self.elapsed_before, self.t0 = elapsed_before, time.monotonic()
+
+    def elapsed(self) -> float:
+        """Seconds trained, in all sessions of the run."""
+        return self.elapsed_before + time.monotonic() - self.t0
+
+    def out_of_time(self) -> bool:
+        """Whether the --minutes budget is used; if so, that is why the run stopped."""
+        if self.elapsed() <= self.args.minutes * 60:
+            return False
+        self.stopped = f"time budget of {self.args.minutes:.0f} minutes used"
+        return True
+
+    def progress_bar(self, desc: str, total: int, initial: int, unit: str = "it") -> tqdm:
+        self.bar = tqdm(total=total, initial=initial, desc=desc, unit=unit)
+        return self.bar
+
+    def checkpoint(self, iteration: int, **extra) -> dict:
+        return {**{k: p.state_dict() for k, p in self.parts.items()}, "rng": self.rng.bit_generator.state,
+                "torch_rng": torch.get_rng_state(), "iteration": iteration, "best": self.best,
+                "elapsed": self.elapsed(), **extra, "meta": self.meta}
+
+    def save(self, iteration: int, **extra) -> None:
+        self.run.save(self.checkpoint(iteration, **extra))
+
+    def step_done(self, iteration: int, **extra) -> bool:
+        """After a step: a checkpoint at `iteration` when one is due; True when the time budget is used (stop)."""
+        if self.run.due():
+            self.save(iteration, **extra)
+        return self.out_of_time()
+
+    def finish(self, iteration: int, summary: dict, save_last: bool = False, **extra) -> None:
+        """Close the bar, log why the run stopped, save the checkpoint at `iteration` (with `extra`) and, with
+        `save_last`, the last weights as last.pt beside best.pt; write summary.json: `summary`, then the minutes
+        trained and the parameter count."""
+        self.bar.close()
+        self.log.info("stopped: %s (%s)", self.stopped, self.position.format(iteration=iteration, **extra))
+        self.save(iteration, **extra)
+        if save_last:
+            self.run.save({"model": self.parts["model"].state_dict(), "iteration": iteration, "meta": self.meta},
+                          self.run.dir / "last.pt")
+        summary = {**summary, "minutes": self.elapsed() / 60, "parameters": self.parameters}
+        (self.run.dir / "summary.json").write_text(json.dumps(summary, indent=1))

@@ -9,14 +9,13 @@ from __future__ import annotations
 
 import argparse
 
-from ..paths import add_mocap_argument
+from ..runs import add_run_arguments
 from .training import train_dance_model
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    add_mocap_argument(parser)
-    parser.add_argument("--run", default="aclstm", help="run name under runs/")
+    add_run_arguments(parser, run="aclstm", minutes=75.0, iterations=20000)
     parser.add_argument("--condition", type=int, default=5, help="v: self-fed frames per cycle (0: vanilla teacher forcing)")
     parser.add_argument("--ground-truth", type=int, default=5, help="u: real frames per cycle")
     parser.add_argument("--condition-max", type=int, default=0,
@@ -35,14 +34,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--window", type=int, default=100)
     parser.add_argument("--lr", type=float, default=1e-3)
     parser.add_argument("--decay", type=float, default=0.95, help="learning-rate factor per epoch")
-    parser.add_argument("--iterations", type=int, default=20000)
     parser.add_argument("--iters-per-epoch", type=int, default=250)
-    parser.add_argument("--minutes", type=float, default=75.0, help="stop cleanly after this much training time")
-    parser.add_argument("--checkpoint-minutes", type=float, default=3.0)
-    parser.add_argument("--resume", action="store_true", help="continue from runs/<run>/checkpoint.pt")
     parser.add_argument("--no-mirror", action="store_true", help="no left/right mirroring of training windows")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--threads", type=int, default=1)
     args = parser.parse_args(argv)
     stopped, best, run_dir = train_dance_model(args)
     print(f"done: {stopped}; best validation loss {best:.4f}; checkpoints in {run_dir}")

@@ -14,18 +14,15 @@ Styles are drawn equally often. Losses are in normalised units (per-feature mean
 from __future__ import annotations
 
 import argparse
-import json
-import time
 from pathlib import Path
 
 import numpy as np
 import torch
-from tqdm import tqdm
 
 from ..data.dance import MODEL_FPS, STYLES, DanceClip, encode, load_clips, mirror, mirror_pairs, resample_positions, rotate_y
 from ..models.aclstm import DanceLSTM
 from ..models.losses import energy_loss
-from ..runs import Run
+from ..runs import TrainingLoop
 
 SPEEDS = (0.8, 1.2)
 
@@ -112,46 +109,31 @@ def validation_losses(model: DanceLSTM, corpus: DanceCorpus, condition: int) -> 
 def train_dance_model(args: argparse.Namespace) -> tuple[str, float, Path]:
     """One training run with the options of python -m training.aclstm.train (kept in the checkpoint's meta);
     returns why it stopped, the best validation loss and the run directory."""
-    torch.set_num_threads(args.threads)
-    run = Run(args.run, args.checkpoint_minutes)
-    rng = np.random.default_rng(args.seed)
-    torch.manual_seed(args.seed)
+    loop = TrainingLoop(args)
+    run = loop.run
+    rng = loop.seed()
     skel, clips = load_clips(args.mocap)
     corpus = DanceCorpus(clips, args.window, np.random.default_rng(12345), skel.names, not args.no_mirror)
     dim = corpus.mean.shape[0]
     model = DanceLSTM(dim, len(STYLES), args.hidden, args.layers, args.head)
     optimiser = torch.optim.Adam(model.parameters(), lr=args.lr)
     scheduler = torch.optim.lr_scheduler.ExponentialLR(optimiser, gamma=args.decay)
-    iteration, best, elapsed_before, history = 0, float("inf"), 0.0, []
-    if args.resume:
-        state = run.resume(rng, model=model, optimiser=optimiser, scheduler=scheduler)
-        iteration, best, elapsed_before, history = state["iteration"], state["best"], state["elapsed"], state["history"]
-        run.log.info("resumed at iteration %d", iteration)
     meta = {"dim": dim, "styles": list(STYLES), "hidden": args.hidden, "layers": args.layers, "head": args.head, "fps": MODEL_FPS,
             "mean": corpus.mean.tolist(), "std": corpus.std.tolist(), "skeleton": skel.to_json(),
             "valid_files": corpus.valid_files, "args": vars(args)}
-    params = sum(p.numel() for p in model.parameters())
+    iteration = loop.start(meta, model=model, optimiser=optimiser, scheduler=scheduler)
+    history = loop.resumed["history"] if loop.resumed else []  # validation results, kept in every checkpoint
     run.log.info("start: %s, u=%d v=%d, %d features, %d parameters, batch %d x %d frames", args.run,
-                 args.ground_truth, args.condition, dim, params, args.batch, args.window)
-    t0 = time.monotonic()
-
-    def elapsed() -> float:
-        return elapsed_before + time.monotonic() - t0
-
-    def checkpoint() -> dict:
-        return {"model": model.state_dict(), "optimiser": optimiser.state_dict(), "scheduler": scheduler.state_dict(),
-                "rng": rng.bit_generator.state, "torch_rng": torch.get_rng_state(), "iteration": iteration,
-                "best": best, "elapsed": elapsed(), "history": history, "meta": meta}
-
+                 args.ground_truth, args.condition, dim, loop.parameters, args.batch, args.window)
     noise_rng = torch.Generator().manual_seed(args.seed + iteration)
-    bar = tqdm(total=args.iterations, initial=iteration, desc=args.run, unit="it")
-    losses, stopped = [], "iterations done"
+    bar = loop.progress_bar(args.run, args.iterations, iteration)
+    losses = []
     while iteration < args.iterations:
         x, style = corpus.batch(rng, args.batch)
         # Schedules over the time budget (so a resumed run continues them): the self-fed stretch grows from
         # v = condition to condition_max, and noise on the real input frames from noise[0] to noise[1]
         # (normalised units; the targets stay clean).
-        progress = min(1.0, elapsed() / (args.minutes * 60))
+        progress = min(1.0, loop.elapsed() / (args.minutes * 60))
         condition = args.condition
         if args.condition and args.condition_max:
             condition = int(round(args.condition + (args.condition_max - args.condition) * progress))
@@ -179,28 +161,21 @@ def train_dance_model(args: argparse.Namespace) -> tuple[str, float, Path]:
         if iteration % args.iters_per_epoch == 0:
             scheduler.step()
             val = validation_losses(model, corpus, args.condition)
-            history.append({"iteration": iteration, "minutes": round(elapsed() / 60, 2), "train": float(np.mean(losses)),
+            history.append({"iteration": iteration, "minutes": round(loop.elapsed() / 60, 2), "train": float(np.mean(losses)),
                             "valid": val})
-            if val["objective"] < best:
-                best = val["objective"]
+            if val["objective"] < loop.best:
+                loop.best = val["objective"]
                 run.save({"model": model.state_dict(), "iteration": iteration, "valid": val, "meta": meta}, run.best_path)
             run.log.info("iteration %d train %.4f valid %.4f (tf %s, ac %s) best %.4f lr %.2e minutes %.1f", iteration,
                          np.mean(losses), val["objective"],
                          "/".join(f"{val[s]['teacher_forced']:.3f}" for s in STYLES),
                          "/".join(f"{val[s]['auto_conditioned']:.3f}" for s in STYLES),
-                         best, scheduler.get_last_lr()[0], elapsed() / 60)
+                         loop.best, scheduler.get_last_lr()[0], loop.elapsed() / 60)
             losses = []
-            run.save(checkpoint())
-        elif run.due():
-            run.save(checkpoint())
-        if elapsed() > args.minutes * 60:
-            stopped = f"time budget of {args.minutes:.0f} minutes used"
+            loop.save(iteration, history=history)
+        if loop.step_done(iteration, history=history):
             break
-    run.save(checkpoint())
-    # The last weights also count as a candidate: save them as "last.pt" for the evaluation to compare.
-    run.save({"model": model.state_dict(), "iteration": iteration, "meta": meta}, run.dir / "last.pt")
-    bar.close()
-    run.log.info("stopped: %s at iteration %d", stopped, iteration)
-    (run.dir / "summary.json").write_text(json.dumps({"best_valid": best, "iterations": iteration, "stopped": stopped,
-                                                       "minutes": elapsed() / 60, "parameters": params}, indent=1))
-    return stopped, best, run.dir
+    # The last weights also count as a candidate: last.pt, for the evaluation to compare.
+    loop.finish(iteration, {"best_valid": loop.best, "iterations": iteration, "stopped": loop.stopped},
+                save_last=True, history=history)
+    return loop.stopped, loop.best, run.dir

@@ -9,14 +9,13 @@ from __future__ import annotations
 
 import argparse
 
-from ..paths import add_mocap_argument
+from ..runs import add_run_arguments
 from .training import CONTROL_WEIGHT, SPARSITY, train_autoencoder
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    add_mocap_argument(parser)
-    parser.add_argument("--run", default="autoencoder", help="run name under runs/")
+    add_run_arguments(parser, run="autoencoder", minutes=40.0, iterations=12000)
     parser.add_argument("--hidden", type=int, default=96, help="channels of the first convolution")
     parser.add_argument("--latent", type=int, default=256, help="channels of the latent")
     parser.add_argument("--control-weight", type=float, default=CONTROL_WEIGHT, help="loss weight of the control channels")
@@ -24,12 +23,6 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--batch", type=int, default=32)
     parser.add_argument("--lr", type=float, default=1e-3)
     parser.add_argument("--mask", type=float, default=0.3, help="masked-noise probability (thesis: 0.3)")
-    parser.add_argument("--iterations", type=int, default=12000)
-    parser.add_argument("--minutes", type=float, default=40.0, help="stop cleanly after this much training time")
-    parser.add_argument("--checkpoint-minutes", type=float, default=3.0)
-    parser.add_argument("--resume", action="store_true", help="continue from runs/<run>/checkpoint.pt")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--threads", type=int, default=1)
     args = parser.parse_args(argv)
     best, run_dir = train_autoencoder(args)
     print(f"done: best held-out reconstruction {best:.2f} cm per joint; checkpoints in {run_dir}")

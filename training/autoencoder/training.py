@@ -9,18 +9,15 @@ latent is off (SPARSITY).
 from __future__ import annotations
 
 import argparse
-import json
-import time
 from pathlib import Path
 
 import numpy as np
 import torch
-from tqdm import tqdm
 
 from ..data.locomotion import FPS, load_clips
 from ..data.windows import CONTROL_SLICE, POSITION_DIM, ROW_DIM, WINDOW, WindowCorpus
 from ..models.autoencoder import MotionAutoencoder, masked_noise
-from ..runs import Run
+from ..runs import TrainingLoop
 
 # Holden's Lasso term: an L1 penalty on the latent. With ReLU latents it kills channels: at 1e-3, 232 of the
 # 256 channels never fired on the training windows (55 live without the control weighting, 24 with it), so it
@@ -74,34 +71,25 @@ def live_channels(model: MotionAutoencoder, corpus: WindowCorpus) -> int:
 def train_autoencoder(args: argparse.Namespace) -> tuple[float, Path]:
     """One run with the options of python -m training.autoencoder.train; returns the best held-out
     reconstruction error (cm, clean input) and the run directory."""
-    torch.set_num_threads(args.threads)
-    run = Run(args.run, args.checkpoint_minutes)
+    loop = TrainingLoop(args)
+    run = loop.run
     corpus = WindowCorpus(load_clips(args.mocap))
     valid = corpus.valid_windows()
     model = MotionAutoencoder(ROW_DIM, args.hidden, args.latent)
     optimiser = torch.optim.Adam(model.parameters(), lr=args.lr)
     milestones = [int(args.iterations * 0.7), int(args.iterations * 0.9)]
     scheduler = torch.optim.lr_scheduler.MultiStepLR(optimiser, milestones, gamma=0.5)
-    rng = np.random.default_rng(args.seed)
-    torch.manual_seed(args.seed)
-    parts = {"model": model, "optimiser": optimiser, "scheduler": scheduler}
-    start, best, elapsed_before = run.start(args.resume, rng, **parts)
+    rng = loop.seed()
     meta = {"dim": ROW_DIM, "hidden": args.hidden, "latent": args.latent, "fps": FPS, "window": WINDOW,
             "mean": corpus.mean.tolist(), "std": corpus.std.tolist(), "valid_files": corpus.valid_files,
             "train_frames": corpus.train_frames, "args": vars(args)}
-    params = sum(p.numel() for p in model.parameters())
-    run.log.info("start: %d parameters, %d training frames (augmented), %d held-out windows", params,
+    start = loop.start(meta, model=model, optimiser=optimiser, scheduler=scheduler)
+    run.log.info("start: %d parameters, %d training frames (augmented), %d held-out windows", loop.parameters,
                  corpus.train_frames, len(valid))
-    t0 = time.monotonic()
-    elapsed = lambda: elapsed_before + time.monotonic() - t0
-
-    def checkpoint(iteration: int) -> dict:
-        return run.state(rng, iteration, best, elapsed(), meta, **parts)
-
     weights = torch.ones(ROW_DIM)
     weights[CONTROL_SLICE] = args.control_weight
     weights /= weights.mean()
-    bar = tqdm(total=args.iterations, initial=start, desc="autoencoder", unit="it")
+    bar = loop.progress_bar("autoencoder", args.iterations, start)
     losses, it = [], start
     for it in range(start, args.iterations):
         x = corpus.batch(rng, args.batch)
@@ -119,19 +107,13 @@ def train_autoencoder(args: argparse.Namespace) -> tuple[float, Path]:
             clean, noisy = position_error_cm(model, corpus, valid), position_error_cm(model, corpus, valid, args.mask)
             turn = control_rmse(model, corpus, valid)
             model.train()
-            if clean < best:
-                best = clean
+            if clean < loop.best:
+                loop.best = clean
                 run.save({"model": model.state_dict(), "iteration": it + 1, "valid_cm": clean, "meta": meta}, run.best_path)
             run.log.info("iteration %d loss %.4f held-out error %.2f cm clean, %.2f cm masked (p=%.1f) best %.2f; control RMS "
-                         "error %s minutes %.1f", it + 1, np.mean(losses[-VALIDATE_EVERY:]), clean, noisy, args.mask, best,
-                         np.round(turn, 3).tolist(), elapsed() / 60)
-        if run.due():
-            run.save(checkpoint(it + 1))
-        if elapsed() > args.minutes * 60:
-            run.log.info("stopped: time budget of %.0f minutes used (iteration %d)", args.minutes, it + 1)
+                         "error %s minutes %.1f", it + 1, np.mean(losses[-VALIDATE_EVERY:]), clean, noisy, args.mask, loop.best,
+                         np.round(turn, 3).tolist(), loop.elapsed() / 60)
+        if loop.step_done(it + 1):
             break
-    bar.close()
-    run.save(checkpoint(it + 1))
-    (run.dir / "summary.json").write_text(json.dumps({"best_valid_cm": best, "iterations": it + 1,
-                                                       "minutes": elapsed() / 60, "parameters": params}, indent=1))
-    return best, run.dir
+    loop.finish(it + 1, {"best_valid_cm": loop.best, "iterations": it + 1})
+    return loop.best, run.dir

@@ -9,25 +9,19 @@ from __future__ import annotations
 
 import argparse
 
-from ..paths import add_mocap_argument
+from ..runs import add_run_arguments
 from .training import train_generator
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    add_mocap_argument(parser)
+    add_run_arguments(parser, run="generator", minutes=85.0)
     parser.add_argument("--epochs", type=int, default=150)
     parser.add_argument("--hidden", type=int, default=192)
     parser.add_argument("--batch", type=int, default=20)
     parser.add_argument("--window", type=int, default=50)
     parser.add_argument("--lr", type=float, default=1e-3)
     parser.add_argument("--dropout", type=float, default=0.25)
-    parser.add_argument("--minutes", type=float, default=85.0, help="stop cleanly after this much training time")
-    parser.add_argument("--checkpoint-minutes", type=float, default=3.0)
-    parser.add_argument("--run", default="generator", help="run name under runs/")
-    parser.add_argument("--resume", action="store_true", help="continue from runs/<run>/checkpoint.pt")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--threads", type=int, default=1, help="torch CPU threads (1 is steadiest when the machine is shared)")
     parser.add_argument("--iters-per-epoch", type=int, default=200,
                         help="iterations between learning-rate decays; 150 x 200 matches the paper's ~30k iterations")
     args = parser.parse_args(argv)

@@ -11,17 +11,14 @@ training NLL keeps falling.
 from __future__ import annotations
 
 import argparse
-import json
-import time
 from pathlib import Path
 
 import numpy as np
 import torch
-from tqdm import tqdm
 
 from ..data.locomotion import FPS, Corpus, load_clips
 from ..models.generator import MixtureLSTM, mixture_nll
-from ..runs import Run
+from ..runs import TrainingLoop
 
 NOISE_SIGMA = 0.05
 
@@ -55,42 +52,29 @@ def validation_nll(model: MixtureLSTM, corpus: Corpus) -> float:
 def train_generator(args: argparse.Namespace) -> tuple[float, Path]:
     """One training run with the options of python -m training.generator.train (all kept in the checkpoint's
     meta); returns the best validation NLL and the run directory."""
-    torch.set_num_threads(args.threads)
-    run = Run(args.run, args.checkpoint_minutes)
+    loop = TrainingLoop(args)
+    run = loop.run
     corpus = Corpus(load_clips(args.mocap))
     dim = corpus.mean.shape[0]
     model = MixtureLSTM(dim, args.hidden, dropout=args.dropout)
     optimiser = torch.optim.RMSprop(model.parameters(), lr=args.lr, alpha=0.9)
     scheduler = torch.optim.lr_scheduler.ExponentialLR(optimiser, gamma=0.95)
-    rng = np.random.default_rng(args.seed)
-    torch.manual_seed(args.seed)
+    rng = loop.seed()
     iters_per_epoch = args.iters_per_epoch
-    start_epoch, start_iter, best, elapsed_before = 0, 0, float("inf"), 0.0
-    if args.resume:
-        state = run.resume(rng, model=model, optimiser=optimiser, scheduler=scheduler)
-        start_epoch, start_iter, best = state["epoch"], state["iteration"], state["best"]
-        elapsed_before = state["elapsed"]
-        run.log.info("resumed at epoch %d iteration %d", start_epoch, start_iter)
     meta = {"dim": dim, "hidden": args.hidden, "mixtures": model.mixtures, "fps": FPS,
             "mean": corpus.mean.tolist(), "std": corpus.std.tolist(),
             "references": corpus.codec.references.tolist(), "valid_files": corpus.valid_files,
             "train_frames": corpus.train_frames, "args": vars(args)}
-    params = sum(p.numel() for p in model.parameters())
+    # The checkpoint's "iteration" counts within its "epoch" (0-based), the epoch the schedule is in.
+    iteration = loop.start(meta, "epoch {epoch} iteration {iteration}", model=model, optimiser=optimiser, scheduler=scheduler)
+    epoch = loop.resumed["epoch"] if loop.resumed else 0
     run.log.info("start: %d features, %d parameters, %d training frames (with mirroring), %d validation clips, "
-                 "%d iterations per epoch", dim, params, corpus.train_frames, len(corpus.valid), iters_per_epoch)
-    t0 = time.monotonic()
-
-    def checkpoint(epoch: int, iteration: int) -> dict:
-        return {"model": model.state_dict(), "optimiser": optimiser.state_dict(), "scheduler": scheduler.state_dict(),
-                "rng": rng.bit_generator.state, "torch_rng": torch.get_rng_state(), "epoch": epoch,
-                "iteration": iteration, "best": best, "elapsed": elapsed_before + time.monotonic() - t0, "meta": meta}
-
-    total = args.epochs * iters_per_epoch
-    bar = tqdm(total=total, initial=start_epoch * iters_per_epoch + start_iter, desc="generator", unit="it")
+                 "%d iterations per epoch", dim, loop.parameters, corpus.train_frames, len(corpus.valid), iters_per_epoch)
+    bar = loop.progress_bar("generator", args.epochs * iters_per_epoch, epoch * iters_per_epoch + iteration)
     out_of_time = False
-    for epoch in range(start_epoch, args.epochs):
+    while epoch < args.epochs:
         losses = []
-        for it in range(start_iter if epoch == start_epoch else 0, iters_per_epoch):
+        while iteration < iters_per_epoch:
             x, mask = corpus.batch(rng, args.batch, args.window)
             inputs = x[:, :-1] + NOISE_SIGMA * torch.randn_like(x[:, :-1])
             logits, mu, log_sigma, _ = model(inputs)
@@ -100,27 +84,24 @@ def train_generator(args: argparse.Namespace) -> tuple[float, Path]:
             loss.backward()
             torch.nn.utils.clip_grad_value_(model.parameters(), 5.0)
             optimiser.step()
+            iteration += 1
             losses.append(float(loss))
             bar.update(1)
             bar.set_postfix(epoch=epoch + 1, nll=f"{np.mean(losses[-50:]):.2f}")
-            if run.due():
-                run.save(checkpoint(epoch, it + 1))
-            if elapsed_before + time.monotonic() - t0 > args.minutes * 60:
-                out_of_time = True
-                run.save(checkpoint(epoch, it + 1))
+            out_of_time = loop.step_done(iteration, epoch=epoch)
+            if out_of_time:
                 break
         if out_of_time:
-            run.log.info("stopped: time budget of %.0f minutes used (epoch %d)", args.minutes, epoch + 1)
             break
         scheduler.step()
         val = validation_nll(model, corpus)
-        if val < best:
-            best = val
-            run.save({"model": model.state_dict(), "epoch": epoch + 1, "valid_nll": val, "meta": meta}, run.best_path)
-        run.save(checkpoint(epoch + 1, 0))
-        run.log.info("epoch %d train_nll %.3f valid_nll %.3f best %.3f lr %.2e minutes %.1f", epoch + 1,
-                     np.mean(losses), val, best, scheduler.get_last_lr()[0], (elapsed_before + time.monotonic() - t0) / 60)
-    bar.close()
-    (run.dir / "summary.json").write_text(json.dumps({"best_valid_nll": best, "epochs_done": epoch + 1 if not out_of_time else epoch,
-                                                       "minutes": (elapsed_before + time.monotonic() - t0) / 60, "parameters": params}, indent=1))
-    return best, run.dir
+        epoch, iteration = epoch + 1, 0
+        if val < loop.best:
+            loop.best = val
+            run.save({"model": model.state_dict(), "epoch": epoch, "valid_nll": val, "meta": meta}, run.best_path)
+        loop.save(iteration, epoch=epoch)
+        run.log.info("epoch %d train_nll %.3f valid_nll %.3f best %.3f lr %.2e minutes %.1f", epoch,
+                     np.mean(losses), val, loop.best, scheduler.get_last_lr()[0], loop.elapsed() / 60)
+    # `epoch` is the number of whole epochs done: the one the time budget cut short does not count.
+    loop.finish(iteration, {"best_valid_nll": loop.best, "epochs_done": epoch}, epoch=epoch)
+    return loop.best, run.dir

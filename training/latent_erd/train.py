@@ -10,16 +10,16 @@ from __future__ import annotations
 
 import argparse
 
-from ..paths import REPO_ROOT, add_mocap_argument
+from ..paths import REPO_ROOT
+from ..runs import add_run_arguments
 from .training import train_erd
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    add_mocap_argument(parser)
+    add_run_arguments(parser, run="latent-erd", minutes=60.0, iterations=12000)
     parser.add_argument("--space", choices=["latent", "pose"], default="latent")
     parser.add_argument("--autoencoder", default=str(REPO_ROOT / "runs" / "autoencoder" / "best.pt"))
-    parser.add_argument("--run", default="latent-erd", help="run name under runs/")
     parser.add_argument("--hidden", type=int, default=224, help="LSTM units (the thesis's 256 does not fit 8 MB)")
     parser.add_argument("--layers", type=int, default=3)
     parser.add_argument("--dropout", type=float, default=0.2)
@@ -33,12 +33,6 @@ def main(argv: list[str] | None = None) -> None:
                         help="weight of the motion-energy term (training.py energy_loss); 0 is mean squared error alone")
     parser.add_argument("--control-sigma", type=float, default=0.0,
                         help="latent ERD: read the control smoothed over this many frames (sequences.py); 0 reads it as it is")
-    parser.add_argument("--iterations", type=int, default=12000)
-    parser.add_argument("--minutes", type=float, default=60.0, help="stop cleanly after this much training time")
-    parser.add_argument("--checkpoint-minutes", type=float, default=3.0)
-    parser.add_argument("--resume", action="store_true", help="continue from runs/<run>/checkpoint.pt")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--threads", type=int, default=1)
     args = parser.parse_args(argv)
     best, run_dir = train_erd(args)
     print(f"done: best held-out free-running loss {best:.4f}; checkpoints in {run_dir}")

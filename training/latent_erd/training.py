@@ -23,19 +23,16 @@ smoothed (sequences.py) it ships (pilots: docs/models/latent-erd-notes.json).
 from __future__ import annotations
 
 import argparse
-import json
-import time
 from pathlib import Path
 
 import numpy as np
 import torch
-from tqdm import tqdm
 
 from ..autoencoder.training import load_autoencoder
 from ..data.locomotion import FPS, load_clips
 from ..data.windows import WindowCorpus
 from ..models.erd import ControlERD
-from ..runs import Run
+from ..runs import TrainingLoop
 from .sequences import StepSequences, latent_sequences, pose_sequences
 
 VALIDATE_EVERY = 250
@@ -91,8 +88,8 @@ def validation_loss(model: ControlERD, valid: StepSequences, steps: int = 40) ->
 
 
 def train_erd(args: argparse.Namespace) -> tuple[float, Path]:
-    torch.set_num_threads(args.threads)
-    run = Run(args.run, args.checkpoint_minutes)
+    loop = TrainingLoop(args)
+    run = loop.run
     corpus = WindowCorpus(load_clips(args.mocap))
     meta = {"space": args.space, "fps": FPS, "hidden": args.hidden, "layers": args.layers, "dropout": args.dropout,
             "row_mean": corpus.mean.tolist(), "row_std": corpus.std.tolist(), "valid_files": corpus.valid_files,
@@ -110,20 +107,11 @@ def train_erd(args: argparse.Namespace) -> tuple[float, Path]:
     model.set_range(allx.min(axis=0), allx.max(axis=0))
     optimiser = torch.optim.Adam(model.parameters(), lr=args.lr)
     scheduler = torch.optim.lr_scheduler.MultiStepLR(optimiser, [int(args.iterations * 0.6), int(args.iterations * 0.85)], 0.5)
-    rng = np.random.default_rng(args.seed)
-    torch.manual_seed(args.seed)
-    parts = {"model": model, "optimiser": optimiser, "scheduler": scheduler}
-    start, best, elapsed_before = run.start(args.resume, rng, **parts)
-    params = sum(p.numel() for p in model.parameters())
+    rng = loop.seed()
+    start = loop.start(meta, model=model, optimiser=optimiser, scheduler=scheduler)
     run.log.info("start: %s space, %d parameters, %d training sequences, %d held-out, steps of %d x %d",
-                 args.space, params, len(train.xs), len(valid.xs), args.batch, args.steps)
-    t0 = time.monotonic()
-    elapsed = lambda: elapsed_before + time.monotonic() - t0
-
-    def checkpoint(iteration: int) -> dict:
-        return run.state(rng, iteration, best, elapsed(), meta, **parts)
-
-    bar = tqdm(total=args.iterations, initial=start, desc=f"{args.space} ERD", unit="it")
+                 args.space, loop.parameters, len(train.xs), len(valid.xs), args.batch, args.steps)
+    bar = loop.progress_bar(f"{args.space} ERD", args.iterations, start)
     losses, it = [], start
     for it in range(start, args.iterations):
         x, c, y, mask = train.batch(rng, args.batch, args.steps)
@@ -143,19 +131,12 @@ def train_erd(args: argparse.Namespace) -> tuple[float, Path]:
         bar.set_postfix(loss=f"{np.mean(losses[-50:]):.4f}", noise=f"{sigma:.2f}", self_fed=free)
         if (it + 1) % VALIDATE_EVERY == 0 or it + 1 == args.iterations:
             val = validation_loss(model, valid)
-            if val < best:
-                best = val
+            if val < loop.best:
+                loop.best = val
                 run.save({"model": model.state_dict(), "iteration": it + 1, "valid_loss": val, "meta": meta}, run.best_path)
             run.log.info("iteration %d train %.4f held-out %.4f best %.4f noise %.2f self-fed %d of %d steps minutes %.1f", it + 1,
-                         np.mean(losses[-VALIDATE_EVERY:]), val, best, sigma, free, args.steps, elapsed() / 60)
-        if run.due():
-            run.save(checkpoint(it + 1))
-        if elapsed() > args.minutes * 60:
-            run.log.info("stopped: time budget of %.0f minutes used (iteration %d)", args.minutes, it + 1)
+                         np.mean(losses[-VALIDATE_EVERY:]), val, loop.best, sigma, free, args.steps, loop.elapsed() / 60)
+        if loop.step_done(it + 1):
             break
-    bar.close()
-    run.save(checkpoint(it + 1))
-    run.save({"model": model.state_dict(), "iteration": it + 1, "meta": meta}, run.dir / "last.pt")
-    (run.dir / "summary.json").write_text(json.dumps({"best_valid_loss": best, "iterations": it + 1,
-                                                       "minutes": elapsed() / 60, "parameters": params}, indent=1))
-    return best, run.dir
+    loop.finish(it + 1, {"best_valid_loss": loop.best, "iterations": it + 1}, save_last=True)
+    return loop.best, run.dir

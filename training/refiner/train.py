@@ -11,14 +11,13 @@ import argparse
 from pathlib import Path
 
 from ..models.refiner import DISCRIMINATOR_INPUTS
-from ..paths import add_mocap_argument
-from ..runs import RUNS_DIR
+from ..runs import RUNS_DIR, add_run_arguments
 from .training import RefinerTraining
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    add_mocap_argument(parser)
+    add_run_arguments(parser, run="refiner", minutes=50.0)
     parser.add_argument("--generator", type=Path, default=RUNS_DIR / "generator" / "best.pt")
     parser.add_argument("--hidden", type=int, default=96, help="refiner width (FC1 and LSTM)")
     parser.add_argument("--d-hidden", type=int, default=64, help="discriminator width (FC1 and each LSTM direction)")
@@ -47,13 +46,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--streams", type=int, default=2048, help="short generated streams for training")
     parser.add_argument("--long-streams", type=int, default=96, help="long (1200-frame) generated streams")
     parser.add_argument("--warmup", type=int, default=10, help="teacher-forced real frames before sampling")
-    parser.add_argument("--minutes", type=float, default=50.0, help="stop cleanly after this much training time")
-    parser.add_argument("--checkpoint-minutes", type=float, default=3.0)
     parser.add_argument("--eval-every", type=int, default=250, help="refiner updates between validation checks")
-    parser.add_argument("--run", default="refiner")
-    parser.add_argument("--resume", action="store_true", help="continue from runs/<run>/checkpoint.pt")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--threads", type=int, default=1)
     args = parser.parse_args(argv)
 
     state = RefinerTraining(args).train()

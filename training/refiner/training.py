@@ -45,18 +45,16 @@ from __future__ import annotations
 
 import argparse
 import json
-import time
 from pathlib import Path
 
 import numpy as np
 import torch
 import torch.nn.functional as F
-from tqdm import tqdm
 
 from ..data.locomotion import Corpus, load_clips
 from ..generator.training import load_generator
 from ..models.refiner import ConvDiscriminator, Discriminator, FeatureGeometry, JointFeatures, Refiner, discriminator_input, discriminator_inputs
-from ..runs import Run
+from ..runs import TrainingLoop
 from .streams import TEMPERATURE, WindowSampler, generated_cache, streams_to_seqs
 
 TOE_NAMES = ("LeftToeBase", "RightToeBase")
@@ -144,8 +142,9 @@ class RefinerTraining:
 
     def __init__(self, args: argparse.Namespace):
         self.args = args
-        torch.set_num_threads(args.threads)
-        self.run = Run(args.run, args.checkpoint_minutes)
+        # Threads, run directory, seed and clock; the refiner keeps its own checkpoints (two networks, D's buffer).
+        self.loop = TrainingLoop(args)
+        self.run = self.loop.run
         generator, gmeta, _ = load_generator(args.generator)
         corpus = Corpus(load_clips(args.mocap))
         if np.abs(corpus.mean - np.array(gmeta["mean"])).max() > 1e-5:
@@ -153,8 +152,7 @@ class RefinerTraining:
         mean, std, refs = np.array(gmeta["mean"]), np.array(gmeta["std"]), np.array(gmeta["references"])
         corpus.mean, corpus.std = mean, std
 
-        self.rng = np.random.default_rng(args.seed)
-        torch.manual_seed(args.seed)
+        self.rng = self.loop.seed()
         self.real = WindowSampler(corpus.train, args.window, corpus.weights)
         self.real_crop = WindowSampler(corpus.train, args.crop, corpus.weights)
         self.fake = WindowSampler(streams_to_seqs(generated_cache(generator, corpus, args, "train")), args.window)
@@ -198,10 +196,10 @@ class RefinerTraining:
                               "%d real training sequences, args %s", params_r, args.hidden, params_d, args.d_hidden,
                               len(self.fake.seqs), len(self.real.seqs), json.dumps(self.meta["args"]))
         self.validate_before_training()
-        self.t0 = time.monotonic()
+        self.loop.start_clock(self.state["elapsed"])
 
     def elapsed(self) -> float:
-        return self.state["elapsed"] + time.monotonic() - self.t0
+        return self.loop.elapsed()
 
     # ---- windows -----------------------------------------------------------------------------------
 
@@ -349,7 +347,7 @@ class RefinerTraining:
         """The §4.2.2 schedule until --iterations R updates or --minutes; writes last.pt and summary.json and
         returns the final counters."""
         args, state = self.args, self.state
-        bar = tqdm(total=args.iterations, initial=state["r_updates"], desc="refiner", unit="R-update")
+        bar = self.loop.progress_bar("refiner", args.iterations, state["r_updates"], unit="R-update")
         adv_hist, root_hist, d_hist = [], [], []
         last = None
         next_eval = (state["r_updates"] // args.eval_every + 1) * args.eval_every
@@ -376,8 +374,8 @@ class RefinerTraining:
                 self.validation_step(adv_hist, d_hist, root_hist)
             if self.run.due():
                 self.run.save(self.checkpoint())
-            if self.elapsed() > args.minutes * 60:
-                self.run.log.info("stopped: time budget of %.0f minutes used", args.minutes)
+            if self.loop.out_of_time():
+                self.run.log.info("stopped: %s", self.loop.stopped)
                 break
         bar.close()
         self.run.save(self.checkpoint())

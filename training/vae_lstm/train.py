@@ -8,14 +8,13 @@ from __future__ import annotations
 
 import argparse
 
-from ..paths import add_mocap_argument
+from ..runs import add_run_arguments
 from .training import L1_PAPER, train_vae_lstm
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    add_mocap_argument(parser)
-    parser.add_argument("--run", default="vae-lstm", help="run name under runs/")
+    add_run_arguments(parser, run="vae-lstm", minutes=60.0, iterations=20000)
     parser.add_argument("--latent", type=int, default=128, help="latent and cell size (the paper's 128)")
     parser.add_argument("--control-features", type=int, default=128)
     parser.add_argument("--inference-features", type=int, default=256)
@@ -31,12 +30,6 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--control-sigma", type=float, default=10.0, help="frames of smoothing on the control the cell reads")
     parser.add_argument("--batch", type=int, default=32)
     parser.add_argument("--lr", type=float, default=5e-4)
-    parser.add_argument("--iterations", type=int, default=20000)
-    parser.add_argument("--minutes", type=float, default=60.0, help="stop cleanly after this much training time")
-    parser.add_argument("--checkpoint-minutes", type=float, default=3.0)
-    parser.add_argument("--resume", action="store_true", help="continue from runs/<run>/checkpoint.pt")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--threads", type=int, default=1)
     args = parser.parse_args(argv)
     best, run_dir = train_vae_lstm(args)
     print(f"done: best held-out error from 4 frames {best:.2f} cm; checkpoints in {run_dir}")

@@ -27,19 +27,16 @@ stick has no per-stride sway, and the latent ERD learnt to use that sway as its 
 from __future__ import annotations
 
 import argparse
-import json
-import time
 from pathlib import Path
 
 import numpy as np
 import torch
-from tqdm import tqdm
 
 from ..data.locomotion import FPS, load_clips
 from ..data.windows import CONTROL_SLICE, POSITION_DIM, ROW_DIM, WINDOW, WindowCorpus, smooth, window_at
 from ..models.losses import energy_loss
 from ..models.vae_lstm import VaeLstm
-from ..runs import Run
+from ..runs import TrainingLoop
 from .generation import SEED_FRAMES, seed_window
 
 VALIDATE_EVERY = 250
@@ -139,8 +136,8 @@ def l1_penalty(model: VaeLstm) -> torch.Tensor:
 
 
 def train_vae_lstm(args: argparse.Namespace) -> tuple[float, Path]:
-    torch.set_num_threads(args.threads)
-    run = Run(args.run, args.checkpoint_minutes)
+    loop = TrainingLoop(args)
+    run = loop.run
     corpus = WindowCorpus(load_clips(args.mocap))
     train = ControlWindows(corpus.train, corpus.weights, args.control_sigma)
     valid = ControlWindows(corpus.valid, np.ones(len(corpus.valid)), args.control_sigma)
@@ -152,21 +149,12 @@ def train_vae_lstm(args: argparse.Namespace) -> tuple[float, Path]:
             "row_mean": corpus.mean.tolist(), "row_std": corpus.std.tolist(), "valid_files": corpus.valid_files, "args": vars(args)}
     optimiser = torch.optim.Adam(model.parameters(), lr=args.lr)
     scheduler = torch.optim.lr_scheduler.MultiStepLR(optimiser, [int(args.iterations * 0.7), int(args.iterations * 0.9)], 0.5)
-    rng = np.random.default_rng(args.seed)
-    torch.manual_seed(args.seed)
-    parts = {"model": model, "optimiser": optimiser, "scheduler": scheduler}
-    start, best, elapsed_before = run.start(args.resume, rng, **parts)
-    params = sum(p.numel() for p in model.parameters())
+    rng = loop.seed()
+    start = loop.start(meta, model=model, optimiser=optimiser, scheduler=scheduler)
     values = args.batch * WINDOW * ROW_DIM
     run.log.info("start: %d parameters, %d training clips, %d held-out windows, batch %d, beta %g, free %g, energy %g, l1 %g",
-                 params, len(train.rows), len(vx), args.batch, args.beta, args.free, args.energy, args.l1)
-    t0 = time.monotonic()
-    elapsed = lambda: elapsed_before + time.monotonic() - t0
-
-    def checkpoint(iteration: int) -> dict:
-        return run.state(rng, iteration, best, elapsed(), meta, **parts)
-
-    bar = tqdm(total=args.iterations, initial=start, desc="VAE-LSTM", unit="it")
+                 loop.parameters, len(train.rows), len(vx), args.batch, args.beta, args.free, args.energy, args.l1)
+    bar = loop.progress_bar("VAE-LSTM", args.iterations, start)
     history, it = [], start
     for it in range(start, args.iterations):
         x, c = train.batch(rng, args.batch)
@@ -189,20 +177,14 @@ def train_vae_lstm(args: argparse.Namespace) -> tuple[float, Path]:
             posterior = position_error_cm(model, corpus, vx, vc, None, args.free_mix)
             prior = position_error_cm(model, corpus, vx, vc, 0, args.free_mix)
             model.train()
-            if posterior < best:
-                best = posterior
+            if posterior < loop.best:
+                loop.best = posterior
                 run.save({"model": model.state_dict(), "iteration": it + 1, "valid_cm": posterior, "prior_cm": prior, "meta": meta},
                          run.best_path)
             recent = np.mean(history[-VALIDATE_EVERY:], axis=0)
             run.log.info("iteration %d teacher %.4f free %.4f kl %.1f energy %.4f held-out cm: from 4 frames %.2f, prior %.2f, best %.2f, minutes %.1f",
-                         it + 1, recent[0], recent[1], recent[2], recent[3], posterior, prior, best, elapsed() / 60)
-        if run.due():
-            run.save(checkpoint(it + 1))
-        if elapsed() > args.minutes * 60:
-            run.log.info("stopped: time budget of %.0f minutes used (iteration %d)", args.minutes, it + 1)
+                         it + 1, recent[0], recent[1], recent[2], recent[3], posterior, prior, loop.best, loop.elapsed() / 60)
+        if loop.step_done(it + 1):
             break
-    bar.close()
-    run.save(checkpoint(it + 1))
-    (run.dir / "summary.json").write_text(json.dumps({"best_valid_cm": best, "iterations": it + 1,
-                                                       "minutes": elapsed() / 60, "parameters": params}, indent=1))
-    return best, run.dir
+    loop.finish(it + 1, {"best_valid_cm": loop.best, "iterations": it + 1})
+    return loop.best, run.dir
