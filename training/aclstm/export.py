@@ -11,8 +11,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..paths import MODELS_DIR
-from ..runs import RUNS_DIR
+from ..runs import RUNS_DIR, add_export_arguments
 from ..onnx.compact import FORMATS
 from .exporting import export_dance_model, rewrite_dance_model
 
@@ -22,12 +21,10 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--run", default="aclstm", help="run under runs/")
     parser.add_argument("--checkpoint", default="best.pt", help="file in the run directory (best.pt or last.pt)")
     parser.add_argument("--id", default=None, help="model id and file name (default: the run name)")
-    parser.add_argument("--out", type=Path, default=MODELS_DIR)
     parser.add_argument("--mocap", default=None)
-    parser.add_argument("--weights", choices=FORMATS, default="int8", help="how the file stores its large weights (int8 with a scale per output channel)")
     parser.add_argument("--temperature", type=float, default=0.2, help="a Gaussian head's sampling temperature (kept in the JSON)")
-    parser.add_argument("--from-shipped", type=Path, nargs="?", const=MODELS_DIR, default=None, metavar="DIR",
-                        help="no checkpoint: read the network back from DIR/<id>.onnx (default the shipped one) and keep its JSON")
+    add_export_arguments(parser, FORMATS, weights_help="how the file stores its large weights (int8 with a scale per output channel)",
+                         shipped_help="no checkpoint: read the network back from DIR/<id>.onnx (default the shipped one) and keep its JSON")
     args = parser.parse_args(argv)
     model_id = args.id or args.run
     if args.from_shipped is not None:

@@ -18,7 +18,8 @@ from pathlib import Path
 from ..data.locomotion import load_clips
 from ..data.windows import WindowCorpus
 from ..onnx.compact import FORMATS
-from ..paths import MODELS_DIR, REPO_ROOT, add_mocap_argument
+from ..paths import REPO_ROOT, add_mocap_argument
+from ..runs import add_export_arguments
 from .exporting import export_autoencoder, rewrite_autoencoder
 from .training import load_autoencoder
 
@@ -27,20 +28,18 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_mocap_argument(parser)
     parser.add_argument("--checkpoint", default=str(REPO_ROOT / "runs" / "autoencoder" / "best.pt"))
-    parser.add_argument("--out", default=str(MODELS_DIR))
-    parser.add_argument("--weights", choices=FORMATS, default="int8", help="how the files store their large weights")
-    parser.add_argument("--from-shipped", type=Path, nargs="?", const=MODELS_DIR, default=None, metavar="DIR",
-                        help="no checkpoint: read the network back from DIR's graphs and manifold.json")
+    add_export_arguments(parser, FORMATS, weights_help="how the files store their large weights",
+                         shipped_help="no checkpoint: read the network back from DIR's graphs and manifold.json")
     args = parser.parse_args(argv)
     corpus = WindowCorpus(load_clips(args.mocap))
     if args.from_shipped is not None:
         try:
-            rewrite_autoencoder(args.from_shipped, corpus, Path(args.out), args.weights)
+            rewrite_autoencoder(args.from_shipped, corpus, args.out, args.weights)
         except (OSError, ValueError, KeyError) as error:
             raise SystemExit(f"error: cannot read the autoencoder back from {args.from_shipped}: {error}")
         return
     model, meta = load_autoencoder(Path(args.checkpoint))
-    export_autoencoder(model, meta, corpus, Path(args.out), args.weights)
+    export_autoencoder(model, meta, corpus, args.out, args.weights)
 
 
 if __name__ == "__main__":

@@ -14,8 +14,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..paths import MODELS_DIR
-from ..runs import RUNS_DIR
+from ..runs import RUNS_DIR, add_export_arguments
 from ..onnx.compact import FORMATS
 from .exporting import export_generator, rewrite_generator
 
@@ -23,12 +22,10 @@ from .exporting import export_generator, rewrite_generator
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--checkpoint", type=Path, default=RUNS_DIR / "generator" / "best.pt")
-    parser.add_argument("--out", type=Path, default=MODELS_DIR)
     parser.add_argument("--mocap", default=None)
-    parser.add_argument("--weights", choices=FORMATS, default="int8",
-                        help="how the file stores its weights (int8: the mixture head float16, training/generator/graph.py)")
-    parser.add_argument("--from-shipped", type=Path, nargs="?", const=MODELS_DIR, default=None, metavar="DIR",
-                        help="no checkpoint: read the network back from DIR/generator.onnx (default the shipped one) and keep its JSON")
+    add_export_arguments(parser, FORMATS,
+                         weights_help="how the file stores its weights (int8: the mixture head float16, training/generator/graph.py)",
+                         shipped_help="no checkpoint: read the network back from DIR/generator.onnx (default the shipped one) and keep its JSON")
     args = parser.parse_args(argv)
     if args.from_shipped is not None:
         onnx_path = rewrite_generator(args.from_shipped, args.out, args.weights)

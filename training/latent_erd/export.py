@@ -21,7 +21,8 @@ from ..autoencoder.training import load_autoencoder
 from ..data.locomotion import load_clips
 from ..data.windows import WindowCorpus
 from ..onnx.compact import FORMATS
-from ..paths import MODELS_DIR, REPO_ROOT, add_mocap_argument
+from ..paths import REPO_ROOT, add_mocap_argument
+from ..runs import add_export_arguments
 from .exporting import export_latent_erd, reseed, rewrite_latent_erd
 from .training import load_erd
 
@@ -30,14 +31,12 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_mocap_argument(parser)
     parser.add_argument("--checkpoint", default=str(REPO_ROOT / "runs" / "latent-erd" / "best.pt"))
-    parser.add_argument("--out", default=str(MODELS_DIR))
-    parser.add_argument("--weights", choices=FORMATS, default="int8", help="how the file stores its large weights")
-    parser.add_argument("--from-shipped", type=Path, nargs="?", const=MODELS_DIR, default=None, metavar="DIR",
-                        help="no checkpoint: read the network back from DIR/latent-erd.onnx and keep DIR/latent-erd.json")
+    add_export_arguments(parser, FORMATS, weights_help="how the file stores its large weights",
+                         shipped_help="no checkpoint: read the network back from DIR/latent-erd.onnx and keep DIR/latent-erd.json")
     parser.add_argument("--seeds-only", action="store_true",
                         help="rewrite only the seeds of --out's latent-erd.json (and the fixture), for its ONNX as it is")
     args = parser.parse_args(argv)
-    out = Path(args.out)
+    out = args.out
     if args.seeds_only or args.from_shipped is not None:
         corpus = WindowCorpus(load_clips(args.mocap))
         try:

@@ -21,7 +21,8 @@ from pathlib import Path
 from ..data.locomotion import load_clips
 from ..data.windows import WindowCorpus
 from ..onnx.compact import FORMATS
-from ..paths import MODELS_DIR, REPO_ROOT
+from ..paths import REPO_ROOT
+from ..runs import add_export_arguments
 from .exporting import export_vae_lstm, rewrite_vae_lstm
 from .training import load_vae_lstm
 
@@ -29,21 +30,19 @@ from .training import load_vae_lstm
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--checkpoint", default=str(REPO_ROOT / "runs" / "vae-lstm" / "best.pt"))
-    parser.add_argument("--out", default=str(MODELS_DIR))
     parser.add_argument("--sampling", choices=["z1", "steps"], default="z1")
     parser.add_argument("--rho", type=float, default=0.9, help="steps: lag-one correlation of the per-step latents")
     parser.add_argument("--z1-prior", choices=["posteriors", "normal"], default="posteriors",
                         help="z1: draw it from the posteriors of training starts (prior_bank.py) or N(0, I)")
     parser.add_argument("--mocap", default=None, help="the training corpus, for the z1 prior and the stride (default ../shared/mocap or MOCAP_DIR)")
-    parser.add_argument("--weights", choices=FORMATS, default="int8", help="how the files store their large weights")
-    parser.add_argument("--from-shipped", type=Path, nargs="?", const=MODELS_DIR, default=None, metavar="DIR",
-                        help="no checkpoint: read the network back from DIR's graphs (default the shipped ones) and keep its JSON")
+    add_export_arguments(parser, FORMATS, weights_help="how the files store their large weights",
+                         shipped_help="no checkpoint: read the network back from DIR's graphs (default the shipped ones) and keep its JSON")
     args = parser.parse_args(argv)
     if args.from_shipped is not None:
         if not (args.from_shipped / "vae-lstm.json").exists():
             raise SystemExit(f"error: no vae-lstm.json in {args.from_shipped}")
         try:
-            rewrite_vae_lstm(args.from_shipped, Path(args.out), args.weights)
+            rewrite_vae_lstm(args.from_shipped, args.out, args.weights)
         except ValueError as e:
             raise SystemExit(f"error: {e}")
         return
@@ -57,7 +56,7 @@ def main(argv: list[str] | None = None) -> None:
     free_mix = float(meta["args"].get("free_mix", 0.0))
     # A model trained with z1 in every step of its free mode (--free-mix) is run that way (generation.free_latents).
     sampling = ({"mode": "z1", "mix": free_mix} if free_mix > 0 else {"mode": "z1"}) if args.sampling == "z1" else {"mode": "steps", "rho": args.rho}
-    export_vae_lstm(model, meta, {}, sampling, Path(args.out), args.weights, corpus=WindowCorpus(load_clips(args.mocap)),
+    export_vae_lstm(model, meta, {}, sampling, args.out, args.weights, corpus=WindowCorpus(load_clips(args.mocap)),
                     z1_prior=args.z1_prior == "posteriors")
 
 
