@@ -8,7 +8,6 @@ Writes docs/models/refiner.{md,json,png}; what is measured and how is in trainin
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from ..paths import REPORTS_DIR
 from ..runs import add_report_arguments
