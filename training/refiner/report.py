@@ -381,9 +381,9 @@ def method_lines(r: dict) -> list[str]:
         "## How it was measured", "",
         "- **Foot skating**: the mean horizontal speed of the toe point (LeftToeBase / RightToeBase) over frame pairs in "
         "which that foot is planted in both frames (the rule of `metrics.foot_skating`), pooled over all streams or "
-        "clips, each sequence measured on its own. The generator report's real figure (0.393 m/s) comes from one "
-        "array of all held-out clips end to end, so its pairs across clip boundaries (jumps of metres) are counted as "
-        f"skating; measured per clip it is {real['foot_skating']:.3f} m/s, the figure used here. The contacts of the "
+        "clips, each sequence measured on its own. Reports before 2026-12-01 gave the real clips 0.393 m/s: they joined "
+        "the held-out clips end to end, so pairs across clip boundaries (jumps of metres) counted as skating; measured "
+        f"per clip it is {real['foot_skating']:.3f} m/s, the figure used here and in the generator report. The contacts of the "
         "foot-locked variants are the labels they were locked with, so this measure trusts them.",
         "- **Foot sliding, lowest point** (`metrics.low_foot_speeds`, the same as the page's `lowFootSliding`): per foot and "
         "frame pair, the lowest of its ankle, toe and toe tip, counted when it is within 4 cm of the floor in both frames; "
