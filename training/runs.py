@@ -12,7 +12,7 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-from .paths import MODELS_DIR, REPO_ROOT, add_mocap_argument
+from .paths import MODELS_DIR, REPO_ROOT, REPORTS_DIR, add_mocap_argument
 
 RUNS_DIR = REPO_ROOT / "runs"
 
@@ -31,10 +31,13 @@ def add_run_arguments(parser: argparse.ArgumentParser, run: str, minutes: float,
     parser.add_argument("--threads", type=int, default=1, help="torch CPU threads (1 is steadiest when the machine is shared)")
 
 
-def add_export_arguments(parser: argparse.ArgumentParser, weight_formats, weights_help: str, shipped_help: str) -> None:
-    """The flags the export commands share: where the files go, how they store their large weights
-    (`weight_formats`: onnx/compact.py FORMATS, passed in since runs.py sits below onnx/), and --from-shipped DIR
-    (default public/models) to rewrite an exported model without a checkpoint."""
+def add_export_arguments(parser: argparse.ArgumentParser, weight_formats, weights_help: str, shipped_help: str,
+                         run: str | None = None) -> None:
+    """The flags the export commands share: with `run`, --checkpoint (default runs/<run>/best.pt); where the files
+    go, how they store their large weights (`weight_formats`: onnx/compact.py FORMATS, passed in since runs.py sits
+    below onnx/), and --from-shipped DIR (default public/models) to rewrite an exported model without a checkpoint."""
+    if run is not None:
+        parser.add_argument("--checkpoint", type=Path, default=RUNS_DIR / run / "best.pt")
     parser.add_argument("--out", type=Path, default=MODELS_DIR)
     parser.add_argument("--weights", choices=weight_formats, default="int8", help=weights_help)
     parser.add_argument("--from-shipped", type=Path, nargs="?", const=MODELS_DIR, default=None, metavar="DIR",
@@ -48,6 +51,21 @@ def add_report_arguments(parser: argparse.ArgumentParser, frames: int, seeds: in
     parser.add_argument("--seeds", type=int, default=seeds, help=seeds_help)
     add_mocap_argument(parser)
     parser.add_argument("--models", type=Path, default=MODELS_DIR, help="directory with the exported models")
+
+
+def add_from_json_argument(parser: argparse.ArgumentParser, report: str) -> None:
+    """--from-json: the evaluate command of docs/models/<report>.md writes it again from <report>.json (rewrote_from_json)."""
+    parser.add_argument("--from-json", action="store_true", help=f"only write {report}.md from the stored {report}.json")
+
+
+def rewrote_from_json(args: argparse.Namespace, report: str, rewrite_markdown) -> bool:
+    """With --from-json, write docs/models/<report>.md again from the stored <report>.json, measuring nothing
+    (`rewrite_markdown` does it), and say so; whether it did, so the command can stop there."""
+    if not args.from_json:
+        return False
+    rewrite_markdown()
+    print(f"wrote {REPORTS_DIR / f'{report}.md'} from {report}.json")
+    return True
 
 
 class Run:

@@ -11,7 +11,7 @@ import argparse
 from pathlib import Path
 
 from ..paths import REPORTS_DIR
-from ..runs import add_report_arguments
+from ..runs import add_from_json_argument, add_report_arguments, rewrote_from_json
 from .report import rewrite_aclstm_markdown, write_dance_report
 
 
@@ -20,11 +20,9 @@ def main(argv: list[str] | None = None) -> None:
     add_report_arguments(parser, frames=20000, seeds=5, seeds_help="seeds per style")
     parser.add_argument("--also", action="append", default=[], metavar="LABEL=JSON",
                         help="another exported dance model to compare (not shipped), e.g. 'acLSTM v=20=/tmp/x/aclstm.json'")
-    parser.add_argument("--from-json", action="store_true", help="only write aclstm.md from the stored aclstm.json")
+    add_from_json_argument(parser, "aclstm")
     args = parser.parse_args(argv)
-    if args.from_json:
-        rewrite_aclstm_markdown()
-        print(f"wrote {REPORTS_DIR / 'aclstm.md'} from aclstm.json")
+    if rewrote_from_json(args, "aclstm", rewrite_aclstm_markdown):
         return
     extra = []
     for item in args.also:

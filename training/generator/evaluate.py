@@ -9,26 +9,21 @@ sweep (training/generator/report.py).
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
-from ..paths import MODELS_DIR, REPORTS_DIR
+from ..paths import REPORTS_DIR
+from ..runs import add_from_json_argument, add_report_arguments, rewrote_from_json
 from .report import rewrite_generator_markdown, write_generator_report
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--frames", type=int, default=10000, help="frames per seed")
-    parser.add_argument("--seeds", type=int, default=5)
+    add_report_arguments(parser, frames=10000, seeds=5)
     parser.add_argument("--temperature", type=float, default=0.5, help="the playground's default")
     parser.add_argument("--sweep", default="1.0,0.5,0.25", help="temperatures for the comparison table ('' to skip)")
     parser.add_argument("--sweep-frames", type=int, default=3000)
-    parser.add_argument("--mocap", default=None)
-    parser.add_argument("--models", type=Path, default=MODELS_DIR, help="directory with the exported model")
-    parser.add_argument("--from-json", action="store_true", help="only write generator.md from the stored generator.json")
+    add_from_json_argument(parser, "generator")
     args = parser.parse_args(argv)
-    if args.from_json:
-        rewrite_generator_markdown()
-        print(f"wrote {REPORTS_DIR / 'generator.md'} from generator.json")
+    if rewrote_from_json(args, "generator", rewrite_generator_markdown):
         return
     sweep = [float(t) for t in args.sweep.split(",") if t.strip()]
     report = write_generator_report(args.frames, args.seeds, args.temperature, sweep, args.sweep_frames, args.mocap,

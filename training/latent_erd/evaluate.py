@@ -13,6 +13,7 @@ import json
 from pathlib import Path
 
 from ..paths import REPO_ROOT, REPORTS_DIR, add_mocap_argument
+from ..runs import add_from_json_argument, rewrote_from_json
 from .report import rewrite_latent_erd_markdown, write_report
 
 NOTES = REPORTS_DIR / "latent-erd-notes.json"
@@ -25,11 +26,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--seeds", type=int, default=5)
     parser.add_argument("--pose-checkpoint", default=str(REPO_ROOT / "runs" / "pose-erd" / "last.pt"),
                         help="the pose-space baseline: its last checkpoint, after the input-noise ramp (its best next-step loss came before the noise)")
-    parser.add_argument("--from-json", action="store_true", help="only write latent-erd.md from the stored latent-erd.json")
+    add_from_json_argument(parser, "latent-erd")
     args = parser.parse_args(argv)
-    if args.from_json:
-        rewrite_latent_erd_markdown()
-        print(f"wrote {REPORTS_DIR / 'latent-erd.md'} from latent-erd.json")
+    if rewrote_from_json(args, "latent-erd", rewrite_latent_erd_markdown):
         return
     notes = json.loads(NOTES.read_text()) if NOTES.exists() else {}
     report = write_report(args.mocap, args.frames, args.seeds, Path(args.pose_checkpoint), notes)

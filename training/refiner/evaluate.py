@@ -10,18 +10,16 @@ from __future__ import annotations
 import argparse
 
 from ..paths import REPORTS_DIR
-from ..runs import add_report_arguments
+from ..runs import add_from_json_argument, add_report_arguments, rewrote_from_json
 from .report import rewrite_refiner_markdown, write_refiner_report
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_report_arguments(parser, frames=3000, seeds=8, seeds_help="seeds (8: all of the generator's)")
-    parser.add_argument("--from-json", action="store_true", help="only write refiner.md from the stored refiner.json")
+    add_from_json_argument(parser, "refiner")
     args = parser.parse_args(argv)
-    if args.from_json:
-        rewrite_refiner_markdown()
-        print(f"wrote {REPORTS_DIR / 'refiner.md'} from refiner.json")
+    if rewrote_from_json(args, "refiner", rewrite_refiner_markdown):
         return
     write_refiner_report(args.frames, args.seeds, args.mocap, args.models)
     print(f"wrote {REPORTS_DIR / 'refiner.md'}")

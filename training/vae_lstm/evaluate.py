@@ -17,6 +17,7 @@ from pathlib import Path
 from ..data.locomotion import load_clips
 from ..data.windows import WindowCorpus
 from ..paths import DEFAULT_CACHE, MODELS_DIR, REPORTS_DIR, add_mocap_argument
+from ..runs import add_from_json_argument, rewrote_from_json
 from .measures import map_follow_windows
 from .report import rewrite_vae_lstm_markdown, write_report
 
@@ -30,11 +31,9 @@ def main(argv: list[str] | None = None) -> None:
                         help=f"write only {MAP_WINDOWS}: the prediction windows' root paths for the MAP follower in the page")
     parser.add_argument("--models", type=Path, default=MODELS_DIR, help="the folder holding vae-lstm.json and its graphs")
     parser.add_argument("--out", type=Path, default=REPORTS_DIR, help="where to write vae-lstm.{md,json}")
-    parser.add_argument("--from-json", action="store_true", help="only write vae-lstm.md from the stored vae-lstm.json")
+    add_from_json_argument(parser, "vae-lstm")
     args = parser.parse_args(argv)
-    if args.from_json:
-        rewrite_vae_lstm_markdown()
-        print(f"wrote {REPORTS_DIR / 'vae-lstm.md'} from vae-lstm.json")
+    if rewrote_from_json(args, "vae-lstm", rewrite_vae_lstm_markdown):
         return
     if args.map_windows:
         MAP_WINDOWS.parent.mkdir(parents=True, exist_ok=True)
