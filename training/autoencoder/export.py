@@ -18,7 +18,7 @@ from pathlib import Path
 from ..data.locomotion import load_clips
 from ..data.windows import WindowCorpus
 from ..onnx.compact import FORMATS
-from ..paths import REPO_ROOT, add_mocap_argument
+from ..paths import add_mocap_argument
 from ..runs import add_export_arguments
 from .exporting import export_autoencoder, rewrite_autoencoder
 from .training import load_autoencoder
@@ -27,8 +27,7 @@ from .training import load_autoencoder
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_mocap_argument(parser)
-    parser.add_argument("--checkpoint", default=str(REPO_ROOT / "runs" / "autoencoder" / "best.pt"))
-    add_export_arguments(parser, FORMATS, weights_help="how the files store their large weights",
+    add_export_arguments(parser, FORMATS, run="autoencoder", weights_help="how the files store their large weights",
                          shipped_help="no checkpoint: read the network back from DIR's graphs and manifold.json")
     args = parser.parse_args(argv)
     corpus = WindowCorpus(load_clips(args.mocap))

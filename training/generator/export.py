@@ -14,16 +14,15 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..runs import RUNS_DIR, add_export_arguments
+from ..runs import add_export_arguments
 from ..onnx.compact import FORMATS
 from .exporting import export_generator, rewrite_generator
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--checkpoint", type=Path, default=RUNS_DIR / "generator" / "best.pt")
     parser.add_argument("--mocap", default=None)
-    add_export_arguments(parser, FORMATS,
+    add_export_arguments(parser, FORMATS, run="generator",
                          weights_help="how the file stores its weights (int8: the mixture head float16, training/generator/graph.py)",
                          shipped_help="no checkpoint: read the network back from DIR/generator.onnx (default the shipped one) and keep its JSON")
     args = parser.parse_args(argv)

@@ -17,13 +17,13 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_run_arguments(parser, run="generator", minutes=85.0)
     parser.add_argument("--epochs", type=int, default=150)
+    parser.add_argument("--iters-per-epoch", type=int, default=200,
+                        help="iterations between learning-rate decays; 150 x 200 matches the paper's ~30k iterations")
     parser.add_argument("--hidden", type=int, default=192)
     parser.add_argument("--batch", type=int, default=20)
     parser.add_argument("--window", type=int, default=50)
     parser.add_argument("--lr", type=float, default=1e-3)
     parser.add_argument("--dropout", type=float, default=0.25)
-    parser.add_argument("--iters-per-epoch", type=int, default=200,
-                        help="iterations between learning-rate decays; 150 x 200 matches the paper's ~30k iterations")
     args = parser.parse_args(argv)
     best, run_dir = train_generator(args)
     print(f"done: best validation NLL {best:.3f} per frame; checkpoints in {run_dir}")

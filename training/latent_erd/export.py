@@ -21,7 +21,7 @@ from ..autoencoder.training import load_autoencoder
 from ..data.locomotion import load_clips
 from ..data.windows import WindowCorpus
 from ..onnx.compact import FORMATS
-from ..paths import REPO_ROOT, add_mocap_argument
+from ..paths import add_mocap_argument
 from ..runs import add_export_arguments
 from .exporting import export_latent_erd, reseed, rewrite_latent_erd
 from .training import load_erd
@@ -30,20 +30,18 @@ from .training import load_erd
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_mocap_argument(parser)
-    parser.add_argument("--checkpoint", default=str(REPO_ROOT / "runs" / "latent-erd" / "best.pt"))
-    add_export_arguments(parser, FORMATS, weights_help="how the file stores its large weights",
+    add_export_arguments(parser, FORMATS, run="latent-erd", weights_help="how the file stores its large weights",
                          shipped_help="no checkpoint: read the network back from DIR/latent-erd.onnx and keep DIR/latent-erd.json")
     parser.add_argument("--seeds-only", action="store_true",
                         help="rewrite only the seeds of --out's latent-erd.json (and the fixture), for its ONNX as it is")
     args = parser.parse_args(argv)
-    out = args.out
     if args.seeds_only or args.from_shipped is not None:
         corpus = WindowCorpus(load_clips(args.mocap))
         try:
             if args.seeds_only:
-                reseed(out, corpus)
+                reseed(args.out, corpus)
             else:
-                rewrite_latent_erd(args.from_shipped, out, corpus, args.weights)
+                rewrite_latent_erd(args.from_shipped, args.out, corpus, args.weights)
         except (OSError, ValueError, KeyError) as error:
             raise SystemExit(f"error: cannot rewrite the exported latent ERD: {error}")
         return
@@ -52,7 +50,7 @@ def main(argv: list[str] | None = None) -> None:
         raise SystemExit(f"error: {args.checkpoint} is a {meta['space']}-space ERD; only the latent ERD ships")
     autoencoder, _ = load_autoencoder(Path(meta["autoencoder"]))
     corpus = WindowCorpus(load_clips(args.mocap))
-    export_latent_erd(erd, meta, autoencoder, corpus, {}, out, args.weights)
+    export_latent_erd(erd, meta, autoencoder, corpus, {}, args.out, args.weights)
 
 
 if __name__ == "__main__":

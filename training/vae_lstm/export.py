@@ -21,7 +21,6 @@ from pathlib import Path
 from ..data.locomotion import load_clips
 from ..data.windows import WindowCorpus
 from ..onnx.compact import FORMATS
-from ..paths import REPO_ROOT
 from ..runs import add_export_arguments
 from .exporting import export_vae_lstm, rewrite_vae_lstm
 from .training import load_vae_lstm
@@ -29,13 +28,12 @@ from .training import load_vae_lstm
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--checkpoint", default=str(REPO_ROOT / "runs" / "vae-lstm" / "best.pt"))
     parser.add_argument("--sampling", choices=["z1", "steps"], default="z1")
     parser.add_argument("--rho", type=float, default=0.9, help="steps: lag-one correlation of the per-step latents")
     parser.add_argument("--z1-prior", choices=["posteriors", "normal"], default="posteriors",
                         help="z1: draw it from the posteriors of training starts (prior_bank.py) or N(0, I)")
     parser.add_argument("--mocap", default=None, help="the training corpus, for the z1 prior and the stride (default ../shared/mocap or MOCAP_DIR)")
-    add_export_arguments(parser, FORMATS, weights_help="how the files store their large weights",
+    add_export_arguments(parser, FORMATS, run="vae-lstm", weights_help="how the files store their large weights",
                          shipped_help="no checkpoint: read the network back from DIR's graphs (default the shipped ones) and keep its JSON")
     args = parser.parse_args(argv)
     if args.from_shipped is not None:
