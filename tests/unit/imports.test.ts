@@ -140,11 +140,11 @@ describe('web/ import graph', () => {
   const graph = importGraph();
 
   it('reads the imports (static, type-only, side-effect and worker references)', () => {
-    expect(graph.get('main.ts')).toEqual(expect.arrayContaining(['api/element.ts', 'runtime/assetBase.ts']));
-    expect(graph.get('motion-playground.ts')).toEqual(expect.arrayContaining(['api/element.ts', 'runtime/assetBase.ts']));
+    expect(graph.get('main.ts')).toEqual(expect.arrayContaining(['api/element.ts', 'runtime/worker/assetBase.ts']));
+    expect(graph.get('motion-playground.ts')).toEqual(expect.arrayContaining(['api/element.ts', 'runtime/worker/assetBase.ts']));
     expect(graph.get('ui/app.ts')).toContain('ui/modes/host.ts'); // `import type`
     expect(graph.get('viewer/viewer.ts')).toContain('viewer/palette.ts'); // `import './palette'`
-    expect(graph.get('runtime/danceClient.ts')).toContain('runtime/dance.worker.ts'); // new URL(…, import.meta.url)
+    expect(graph.get('runtime/aclstm/danceClient.ts')).toContain('runtime/aclstm/dance.worker.ts'); // new URL(…, import.meta.url)
     expect(graph.get('motion/bvh.ts')?.length).toBeGreaterThan(0); // a multi-line import
   });
 

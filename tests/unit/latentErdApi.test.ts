@@ -15,7 +15,7 @@ describe('checkGenerate for the latent ERD', () => {
     expect(checkGenerate({ model: 'latent-erd', frames: 2, seed: 3 }, MODELS)).toEqual({ kind: 'latent-erd', model: 'latent-erd', frames: 2, seed: 3 });
     const o = checkGenerate({ model: 'latent-erd', frames: 2, seed: 0, control: [[1, 0, 0.5], [1.5, -0.1, 0], [0, 0, 0]] }, MODELS);
     expect(o.kind).toBe('latent-erd');
-    expect(Array.from((o as { control: Float64Array }).control)).toEqual([1, 0, 0.5, 1.5, -0.1, 0, 0, 0, 0]);
+    expect(Array.from(o.control as Float64Array)).toEqual([1, 0, 0.5, 1.5, -0.1, 0, 0, 0, 0]);
   });
 
   it('refuses options of the other models, bad control and the autoencoder as a model', () => {

@@ -1,5 +1,9 @@
 import { describe, expect, test } from 'vitest';
-import { embedSnippet, parseView, parseViewValue, viewQuery } from '../../web/ui/viewState';
+import { readFileSync } from 'node:fs';
+import { resolve } from 'node:path';
+import { parseManifest } from '../../web/model/manifest';
+import { Registry } from '../../web/runtime/registry';
+import { embedSnippet, modeModels, parseView, parseViewValue, viewQuery } from '../../web/ui/viewState';
 import { checkSourceUrl, fetchMotionSource, MAX_SOURCE_BYTES } from '../../web/runtime/import/motionSource';
 
 describe('view state (attributes and links)', () => {
@@ -25,8 +29,11 @@ describe('view state (attributes and links)', () => {
     expect(errors.join('\n')).toMatch(/path="1,2,3": must be x,z pairs/);
   });
 
-  test('a model the mode does not have is refused', () => {
-    const { view, errors } = parseView((k) => ({ mode: 'steer', model: 'vae-lstm' })[k as 'mode'] ?? null);
+  test('a model the mode does not have is refused (the shipped models, by what their descriptors say they do)', () => {
+    const manifest = parseManifest(JSON.parse(readFileSync(resolve(__dirname, '../../public/models/index.json'), 'utf8')));
+    const models = modeModels(new Registry(manifest));
+    expect(models).toEqual({ clip: [], walk: ['generator'], dance: ['aclstm', 'aclstm-vanilla'], path: ['generator', 'latent-erd', 'vae-lstm'], steer: ['generator', 'latent-erd'] });
+    const { view, errors } = parseView((k) => ({ mode: 'steer', model: 'vae-lstm' })[k as 'mode'] ?? null, models);
     expect(view).toEqual({ mode: 'steer' });
     expect(errors).toEqual(['model="vae-lstm": steer mode shows generator, latent-erd']);
   });

@@ -14,7 +14,6 @@ import { App } from '../ui/app';
 import { buildIn, errorMessage, type DomScope } from '../ui/dom';
 import { embedSnippet, FIRST_VIEW, formatViewValue, parseView, parseViewValue, viewQuery, VIEW_KEYS, type Mode, type ViewKey, type ViewState } from '../ui/viewState';
 import { fetchMotionSource } from '../runtime/import/motionSource';
-import { isControlModel } from '../ui/modes/modelChoice';
 
 const OTHER_ATTRIBUTES = ['src', 'autoplay', 'camera-controls', 'controls', 'poster', 'loading', 'link'] as const;
 const CONTROLS = ['full', 'minimal', 'none'] as const;
@@ -158,14 +157,18 @@ export class MotionPlaygroundElement extends HTMLElement {
     const quiet = (get: (k: ViewKey) => string | null) => parseView(get).view.mode;
     const params = new URLSearchParams(location.search || location.hash.replace(/^#/, ''));
     const mode = (this.hasAttribute('link') ? quiet((k) => params.get(k)) : undefined) ?? quiet((k) => this.getAttribute(k)) ?? FIRST_VIEW.mode;
-    if (mode === 'walk') app.generator.load().catch(() => undefined);
+    if (mode !== 'walk') return;
+    void app.whenModels().then((registry) => {
+      const walker = registry.defaultFor('walk');
+      if (walker) app.host(walker.info.id).load().catch(() => undefined);
+    });
   }
 
   // ---------- views: attributes, links, the UI ----------
 
   /** The view the attributes ask for (bad ones fire `error` and are left out). */
   private attributeView(): ViewState {
-    const { view, errors } = parseView((k) => (k === 'style' ? this.danceStyleAttribute() : this.getAttribute(k)));
+    const { view, errors } = parseView((k) => (k === 'style' ? this.danceStyleAttribute() : this.getAttribute(k)), this.app?.modeModels());
     for (const reason of errors) this.fire('error', { reason: `attribute ${reason}` });
     return view;
   }
@@ -184,7 +187,7 @@ export class MotionPlaygroundElement extends HTMLElement {
   /** The view in the page's URL (query or hash), when the element keeps the link. */
   private linkView(): ViewState {
     const params = new URLSearchParams(location.search || location.hash.replace(/^#/, ''));
-    const { view, errors } = parseView((k) => params.get(k));
+    const { view, errors } = parseView((k) => params.get(k), this.app?.modeModels());
     for (const reason of errors) {
       this.app?.reportError(`Link: ${reason}; using the default`);
     }
@@ -196,21 +199,11 @@ export class MotionPlaygroundElement extends HTMLElement {
     const app = this.app!;
     const models = this.api!.models();
     const mode: Mode = view.mode ?? (initial ? 'clip' : app.currentMode);
-    const control = <T extends HTMLElement>(id: string) => this.shadow.getElementById(id) as T;
-    const set = (id: string, value: string | boolean) => {
-      const el = control<HTMLInputElement | HTMLSelectElement>(id);
-      if (el instanceof HTMLInputElement && el.type === 'checkbox') el.checked = value as boolean;
-      else el.value = String(value);
-      el.dispatchEvent(new Event('input', { bubbles: true }));
-      el.dispatchEvent(new Event('change', { bubbles: true }));
-    };
     if (mode === 'walk') {
-      if (view.temperature !== undefined) set('walk-temperature', String(view.temperature));
-      if (view.seed !== undefined) set('walk-seed', String(view.seed));
-      if (view.refine !== undefined) set('walk-refine', view.refine);
+      app.walk.preset(view);
     } else if (mode === 'dance') {
-      if (view.model !== undefined) control<HTMLSelectElement>('dance-model').value = view.model;
-      const id = control<HTMLSelectElement>('dance-model').value;
+      if (view.model !== undefined) app.danceMode.selectModel(view.model);
+      const id = app.danceMode.choice.model;
       const styles = models.find((m) => m.id === id)?.styles ?? [];
       let style = view.style;
       if (style !== undefined && styles.length && !styles.includes(style)) {
@@ -219,8 +212,8 @@ export class MotionPlaygroundElement extends HTMLElement {
       }
       app.danceMode.preset(style, view.seed);
     } else if (mode === 'path' || mode === 'steer') {
-      if (view.model !== undefined && isControlModel(view.model)) app.controlModel.set(view.model);
-      if (mode === 'path' && view.seed !== undefined) set('path-seed', String(view.seed));
+      if (view.model !== undefined) app.controlModel.set(view.model);
+      if (mode === 'path' && view.seed !== undefined) app.pathMode.presetSeed(view.seed);
       if (mode === 'path' && view.path) app.pathMode.setPath(view.path);
     }
     if (view.mode !== undefined || initial) app.setMode(mode);
@@ -228,24 +221,19 @@ export class MotionPlaygroundElement extends HTMLElement {
     this.linkSoon();
   }
 
-  /** The view shown now, as a link or the attributes would say it. */
+  /** The view shown now, as a link or the attributes would say it: each mode says its own settings. */
   get view(): ViewState {
     const app = this.app;
     if (!app) return this.attributeView();
-    const value = (id: string) => (this.shadow.getElementById(id) as HTMLInputElement).value;
     const mode = app.currentMode;
     const view: ViewState = { mode };
     if (mode === 'walk') {
-      Object.assign(view, {
-        temperature: Number(value('walk-temperature')),
-        seed: Number(value('walk-seed')) || 0,
-        refine: (this.shadow.getElementById('walk-refine') as HTMLInputElement).checked,
-      });
+      Object.assign(view, app.walk.viewSettings);
     } else if (mode === 'dance') {
       const { model, style, seed } = app.danceMode.choice;
       Object.assign(view, { model, ...(style ? { style } : {}), seed });
     } else if (mode === 'path') {
-      Object.assign(view, { model: app.controlModel.value, seed: Number(value('path-seed')) || 0 });
+      Object.assign(view, { model: app.controlModel.value, seed: app.pathMode.seedValue });
       const path = app.pathMode.path;
       if (path.length >= 2) view.path = path;
     } else if (mode === 'steer') {
@@ -439,7 +427,9 @@ export class MotionPlaygroundElement extends HTMLElement {
     const frames = 300;
     if (view.mode === 'dance' && view.model) return this.playground.generate({ model: view.model, seed: view.seed ?? 0, frames, ...(view.style ? { style: view.style } : {}) });
     const walk: ViewState = view.mode === 'walk' ? view : {};
-    return this.playground.generate({ model: 'generator', seed: walk.seed ?? 0, refine: walk.refine ?? false, frames, ...(walk.temperature !== undefined ? { temperature: walk.temperature } : {}) });
+    const walker = this.app?.registry.defaultFor('walk');
+    if (!walker) return Promise.reject(new Error('generate: no model for Random walk is listed in models/index.json'));
+    return this.playground.generate({ model: walker.info.id, seed: walk.seed ?? 0, refine: walk.refine ?? false, frames, ...(walk.temperature !== undefined ? { temperature: walk.temperature } : {}) });
   }
 
   /** BVH text of `motion`, or of the shown motion when left out. */

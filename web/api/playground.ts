@@ -14,13 +14,13 @@ import { errorMessage } from '../ui/dom';
 import { CancelledError, isCancelled, unlessAborted } from '../runtime/worker/cancellation';
 import { checkSchedule } from '../optimizer/liveControl';
 import { checkPathPoints, GroundPath } from '../optimizer/path';
-import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed, optional } from '../optimizer/options';
+import { checkFootLock, checkGait, checkSeconds, checkSeed, optional } from '../optimizer/options';
 import { describeValue } from '../motion/describe';
 import { loadManifest, type ModelInfo } from '../model/manifest';
 import { assetUrl } from '../runtime/worker/assetBase';
-import { checkControlSignal } from '../model/latentErdInfo';
-import { checkPathSpeed, LATENT_PATH_SPEED } from '../runtime/latent_erd/latentErdRequests';
 import { checkCleanupOptions, type CleanupMethod, type CleanupStats } from '../runtime/cleanup/cleanup';
+import type { Capability, GenerateCall, ModelDescriptor } from '../runtime/descriptor';
+import { Registry, type RegisteredModel } from '../runtime/registry';
 import { mapSkeleton } from '../motion/skeletonMap';
 import { addNoise as addNoiseTo, checkNoiseOptions, type NoiseOptions } from '../motion/noise';
 
@@ -49,7 +49,7 @@ export interface CancellableOptions {
 }
 
 export interface GenerateOptions extends CancellableOptions {
-  /** A model id from `models()` of kind "lstm-gmm" ("generator"), "aclstm" ("aclstm", "aclstm-vanilla") or "latent-erd" ("latent-erd"). */
+  /** A model id from `models()` that generates: of kind "lstm-gmm" ("generator"), "aclstm" ("aclstm", "aclstm-vanilla"), "latent-erd" ("latent-erd") or "vae-lstm" ("vae-lstm"). */
   model: string;
   /** Number of frames, an integer 1…100000. */
   frames: number;
@@ -77,17 +77,12 @@ export interface GenerateOptions extends CancellableOptions {
   refine?: boolean;
 }
 
-/** The models that follow paths and take live control: the generator with the MAP optimiser (default), or the latent ERD. */
-export type ControlModel = 'generator' | 'latent-erd';
-/** The models that follow paths: those, and the VAE-LSTM (the whole walk in one pass; it takes no live control). */
-export type PathModel = ControlModel | 'vae-lstm';
-
 export interface FollowPathOptions extends CancellableOptions {
   /**
    * "generator" (default: the MAP optimiser over the generator), "latent-erd" (closed-loop control, no search)
    * or "vae-lstm" (the path becomes one control signal and the whole walk is made in one pass).
    */
-  model?: PathModel;
+  model?: string;
   /** The path on the ground: [x, z] pairs in metres, at least 2, each x and z within ±10000 m, 0.5–200 m long. The character starts at the first point facing along the path. */
   points: [number, number][];
   /** "walk" (default) or "run": picks the seed states and the pace. */
@@ -122,7 +117,7 @@ export type FollowedPathMotion = Motion & { contacts: Uint8Array; stats: FollowP
 
 export interface SimulateControlOptions extends CancellableOptions {
   /** "generator" (default: the MAP live controller) or "latent-erd" (controlTowardHeading every latent step). */
-  model?: ControlModel;
+  model?: string;
   /** Length of the simulated run, seconds (0 < seconds ≤ 600), rounded to whole frames (at least one). */
   seconds: number;
   /** Targets over time: [{ t: 0, speed, heading }, …] with t in seconds, increasing; speed 0–4 m/s; heading in radians (0 faces +z). */
@@ -158,7 +153,7 @@ export interface DenoiseOptions extends CancellableOptions {
 /** A cleaned motion: the input's own skeleton (joints, parents, fps, frames; one length per bone), with contacts. */
 export type DenoisedMotion = Motion & { contacts: Uint8Array; stats: CleanupStats };
 
-export const GENERATE_DEFAULT_TEMPERATURE = 0.5;
+export { GENERATE_DEFAULT_TEMPERATURE } from '../runtime/generator/descriptor';
 export const GENERATE_MAX_FRAMES = 100_000;
 
 export interface Playground {
@@ -231,31 +226,17 @@ declare global {
   }
 }
 
-type GeneratorCall = { kind: 'lstm-gmm'; model: string; frames: number; seed: number; temperature: number; refine: boolean };
-type DanceCall = { kind: 'aclstm'; model: string; frames: number; seed: number; style: string };
-type ControlledCall<K> = { kind: K; model: string; frames: number; seed: number; control?: Float64Array };
-type LatentCall = ControlledCall<'latent-erd'> | ControlledCall<'vae-lstm'>;
-
 /** Checks generate's options against the model they name (`models`: the manifest); the error says what is wrong. */
-export function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorCall | DanceCall | LatentCall {
+export function checkGenerate(options: unknown, models: ModelInfo[]): GenerateCall {
   if (typeof options !== 'object' || options === null || Array.isArray(options)) {
     throw new TypeError(`options must be an object: { model, frames, seed, temperature? } (acLSTM: { model, style, frames, seed }), got ${describeValue(options)}`);
   }
-  const o = options as Partial<Record<keyof GenerateOptions, unknown>>;
-  const usable = models.filter((m) => m.kind === 'lstm-gmm' || m.kind === 'aclstm' || m.kind === 'latent-erd' || m.kind === 'vae-lstm');
-  const available = usable.map((m) => m.id).join(', ');
-  if (typeof o.model !== 'string') throw new TypeError(`model must be a model id string (available: ${available || 'none'}), got ${describeValue(o.model)}`);
-  const entry = usable.find((m) => m.id === o.model);
-  if (!entry) throw new Error(`unknown model ${describeValue(o.model)} (available: ${available || 'none — the model list did not load'})`);
-  const dance = entry.kind === 'aclstm';
-  // The latent ERD and the VAE-LSTM take the same options: a seed and an optional control signal.
-  const latent = entry.kind === 'latent-erd' || entry.kind === 'vae-lstm';
-  if (dance) {
-    // Dance models have no sampling and no refiner: say so rather than silently ignoring the option.
-    if ('temperature' in o) throw new TypeError(`temperature is not meaningful for acLSTM models: they are deterministic (the seed only picks the seed motion); leave it out`);
-    if ('refine' in o) throw new TypeError(`refine is not available for acLSTM models (there is no refiner for dance); leave it out`);
-  }
-  const known = dance ? ['model', 'style', 'frames', 'seed', 'signal'] : latent ? ['model', 'frames', 'seed', 'control', 'signal'] : ['model', 'frames', 'seed', 'temperature', 'refine', 'signal'];
+  const o = options as Record<string, unknown>;
+  const registry = new Registry(models);
+  const { entry, descriptor } = pickModel(registry, 'generate', o.model, `a model id string (available: ${registry.ids('generate').join(', ') || 'none'})`);
+  const generate = descriptor.generate!;
+  for (const [key, reason] of Object.entries(generate.refused ?? {})) if (key in o) throw new TypeError(reason);
+  const known = [...generate.options, 'signal'];
   for (const k of Object.keys(options)) {
     if (!known.includes(k)) throw new TypeError(`unknown option ${describeValue(k)} for model "${entry.id}" (known: ${known.join(', ')})`);
   }
@@ -263,26 +244,24 @@ export function checkGenerate(options: unknown, models: ModelInfo[]): GeneratorC
     throw new RangeError(`frames must be an integer from 1 to ${GENERATE_MAX_FRAMES}, got ${describeValue(o.frames)}`);
   }
   const seed = checkSeed(o.seed);
-  if (latent) {
-    const control = o.control === undefined ? undefined : checkControlSignal(o.control, o.frames);
-    return { kind: entry.kind as 'latent-erd' | 'vae-lstm', model: entry.id, frames: o.frames, seed, ...(control ? { control } : {}) } as LatentCall;
+  return { kind: entry.kind, model: entry.id, frames: o.frames, seed, ...generate.check(o, entry, models) };
+}
+
+/**
+ * The model a call names (`value`) among those that can do `capability`: its manifest entry and
+ * descriptor. `what` says what a model must be, for the refusal of a non-string.
+ */
+function pickModel(registry: Registry, capability: Capability, value: unknown, what: string): { entry: ModelInfo; descriptor: ModelDescriptor } {
+  const usable = registry.with(capability);
+  const available = usable.map((m) => m.info.id).join(', ');
+  if (typeof value !== 'string') throw new TypeError(`model must be ${what}, got ${describeValue(value)}`);
+  const found = usable.find((m) => m.info.id === value);
+  if (!found) {
+    const refusal = capability === 'liveControl' ? registry.find(value)?.descriptor.noLiveControl : undefined;
+    if (refusal) throw new Error(refusal);
+    throw new Error(`unknown model ${describeValue(value)} (available: ${available || 'none — the model list did not load'})`);
   }
-  if (dance) {
-    const styles = entry.styles ?? [];
-    if (o.style === undefined) throw new TypeError(`style is required for model "${entry.id}" (styles: ${styles.join(', ')})`);
-    if (typeof o.style !== 'string' || !styles.includes(o.style)) {
-      throw new RangeError(`unknown style ${describeValue(o.style)} for model "${entry.id}" (styles: ${styles.join(', ')})`);
-    }
-    return { kind: 'aclstm', model: entry.id, frames: o.frames, seed, style: o.style };
-  }
-  const temperature = optional(o.temperature, GENERATE_DEFAULT_TEMPERATURE);
-  if (typeof temperature !== 'number' || !Number.isFinite(temperature) || temperature < 0 || temperature > 2) {
-    throw new RangeError(`temperature must be a number from 0 to 2, got ${describeValue(temperature)}`);
-  }
-  if (o.refine !== undefined && typeof o.refine !== 'boolean') throw new TypeError(`refine must be true or false, got ${describeValue(o.refine)}`);
-  const refine = o.refine === true;
-  if (refine && !models.some((m) => m.kind === 'refiner')) throw new Error('refine is not available: no refiner model is listed in models/index.json');
-  return { kind: 'lstm-gmm', model: entry.id, frames: o.frames, seed, temperature, refine };
+  return { entry: found.info, descriptor: found.descriptor };
 }
 
 /** Throws unless `options` is a plain object whose keys are all in `known`. */
@@ -329,45 +308,22 @@ function checkSignal(options: unknown): AbortSignal | undefined {
 }
 
 /**
- * The `model` option of followPath and simulateControl: "generator" when left out, else a listed model of
- * kind "lstm-gmm" or "latent-erd" (`models`: the manifest).
+ * The `model` option of followPath (`capability` "followPath") and simulateControl ("liveControl"): the
+ * default model for it when left out, else a listed model that can do it.
  */
-function checkControlModel(value: unknown, models: ModelInfo[], live = true): PathModel {
-  if (value === undefined) return 'generator';
-  const kinds: Record<PathModel, string> = { generator: 'lstm-gmm', 'latent-erd': 'latent-erd', 'vae-lstm': 'vae-lstm' };
-  const usable = models.filter((m) => kinds[m.id as PathModel] === m.kind).map((m) => m.id);
-  const available = usable.join(', ') || 'none — the model list did not load';
-  if (typeof value !== 'string') {
-    throw new TypeError(`model must be ${live ? '"generator" or "latent-erd"' : 'one of "generator", "latent-erd", "vae-lstm"'}, got ${describeValue(value)}`);
-  }
-  if (live && value === 'vae-lstm') {
-    throw new Error('the VAE-LSTM makes the whole motion for a whole control signal and takes no live control: use followPath or generate({ model: "vae-lstm", control })');
-  }
-  if (!usable.includes(value)) throw new Error(`unknown model ${describeValue(value)} (available: ${available})`);
-  return value as PathModel;
+function controlModel(registry: Registry, capability: 'followPath' | 'liveControl', value: unknown): RegisteredModel {
+  const fallback = registry.defaultFor(capability);
+  if (value === undefined && fallback) return fallback;
+  const ids = registry.ids(capability).map((id) => `"${id}"`);
+  const what = ids.length === 2 ? ids.join(' or ') : `one of ${ids.join(', ')}`;
+  const { entry } = pickModel(registry, capability, value, what);
+  return registry.find(entry.id)!;
 }
 
-const FOLLOW_PATH_OPTIONS: Record<PathModel, string[]> = {
-  generator: ['model', 'points', 'gait', 'seed', 'fitTolerance', 'footLock', 'signal'],
-  'latent-erd': ['model', 'points', 'gait', 'seed', 'speed', 'footLock', 'signal'],
-  'vae-lstm': ['model', 'points', 'gait', 'seed', 'speed', 'footLock', 'signal'],
-};
+/** followPath's options every model takes; each model adds its own (its descriptor's followPath.options). */
+const FOLLOW_PATH_COMMON = ['model', 'points', 'gait', 'seed', 'footLock', 'signal'];
 const FOLLOW_PATH_SHAPE = '{ points: [[x, z], …], model?, gait?, seed?, fitTolerance? (generator) or speed? (latent-erd, vae-lstm), footLock?, signal? }';
 const SIMULATE_OPTIONS = ['model', 'seconds', 'schedule', 'seed', 'gait', 'footLock', 'signal'];
-
-/** A latent ERD or VAE-LSTM motion as a Motion: the fitted, foot-locked positions and the contacts they were locked with. */
-async function generateLatent(app: App, o: LatentCall, signal: AbortSignal | undefined): Promise<Motion> {
-  const { client } = o.kind === 'vae-lstm' ? await app.vaeLstm.load() : await app.latentErd.load();
-  const m = await client.generate({ seed: o.seed, frames: o.frames, ...(o.control ? { control: o.control } : {}) }, { signal });
-  return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts };
-}
-
-/** A dance as a Motion: the fitted, foot-locked positions and the contacts they were locked with. */
-async function generateDance(app: App, o: DanceCall, signal: AbortSignal | undefined): Promise<Motion> {
-  const { client } = await app.dance(o.model).load();
-  const m = await client.generate({ style: o.style, seed: o.seed, frames: o.frames }, { signal });
-  return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts };
-}
 
 /**
  * How the API's calls fail: `guarded(context, fn)` runs `fn`, and a failure is shown on the page as
@@ -420,6 +376,7 @@ export function createPlayground(app: App): Playground {
   const ready = loadManifest(assetUrl('models/index.json')).then(
     (m) => {
       models = m;
+      app.useModels(m);
     },
     (e) => {
       // The page still works without models; say so rather than failing `ready`.
@@ -487,15 +444,8 @@ export function createPlayground(app: App): Playground {
     generate(options) {
       return cancellable('generate', options, async (signal) => {
         await ready;
-        const o = checkGenerate(options, models);
-        if (o.kind === 'aclstm') return generateDance(app, o, signal);
-        if (o.kind === 'latent-erd' || o.kind === 'vae-lstm') return generateLatent(app, o, signal);
-        const { client } = await app.generator.load();
-        const m = await client.generate({ frames: o.frames, seed: o.seed, temperature: o.temperature, ...(o.refine ? { refine: true } : {}) }, { signal });
-        const shown = o.refine ? m.refined : m;
-        if (!shown) throw new Error('the generator worker returned no refined frames');
-        const motion: Motion = { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: shown.positions, contacts: shown.contacts };
-        return motion;
+        const call = checkGenerate(options, models);
+        return app.withModel(call.model, (client, descriptor) => descriptor.generate!.run(client, call, { signal }));
       });
     },
 
@@ -503,26 +453,18 @@ export function createPlayground(app: App): Playground {
       return cancellable('followPath', options, async (signal) => {
         checkKeys(options, Object.keys(options ?? {}), FOLLOW_PATH_SHAPE); // an object; its keys are checked once the model is known
         await ready;
-        const model = checkControlModel((options as { model?: unknown }).model, models, false);
-        const o = checkKeys(options, FOLLOW_PATH_OPTIONS[model], FOLLOW_PATH_SHAPE);
+        const { info, descriptor } = controlModel(app.registry, 'followPath', (options as { model?: unknown }).model);
+        const follow = descriptor.followPath!;
+        const o = checkKeys(options, [...FOLLOW_PATH_COMMON.slice(0, 4), ...follow.options, ...FOLLOW_PATH_COMMON.slice(4)], FOLLOW_PATH_SHAPE);
         // Checked here too (the worker checks again), so bad input fails fast and without a worker prefix.
         const points = checkPathPoints(o.points);
         GroundPath.fromPoints(points);
         const gait = checkGait(optional(o.gait, 'walk'));
         const seed = checkSeed(optional(o.seed, 0));
-        const lockFeet = checkFootLock(o.footLock);
-        if (model === 'latent-erd' || model === 'vae-lstm') {
-          const speed = checkPathSpeed(optional(o.speed, LATENT_PATH_SPEED[gait]));
-          const { client } = model === 'vae-lstm' ? await app.vaeLstm.load() : await app.latentErd.load();
-          const m = await client.followPath({ points, gait, seed, speed, footLock: lockFeet }, { signal });
-          const { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock, sliding, slidingBeforeLock } = m.stats;
-          return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, stats: { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock, sliding, slidingBeforeLock } };
-        }
-        const fitSigma = checkFitSigma(optional(o.fitTolerance, 0.1), 'fitTolerance');
-        const { client } = await app.generator.load();
-        const m = await client.followPath({ points, gait, seed, fitSigma, footLock: lockFeet }, { signal });
-        const { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock, sliding, slidingBeforeLock } = m.stats;
-        return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, stats: { meanError, maxError, arcProgress, optimizeMs, skating, skatingBeforeLock, sliding, slidingBeforeLock } };
+        const footLock = checkFootLock(o.footLock);
+        const own = follow.check(o, gait);
+        const walk = await app.withModel(info.id, (client) => follow.run(client, { points, gait, seed, ...own, footLock }, { signal }));
+        return { ...walk.motion, stats: walk.stats };
       });
     },
 
@@ -534,8 +476,9 @@ export function createPlayground(app: App): Playground {
         const o = checkCleanupOptions(typeof options === 'object' && options !== null ? rest : options);
         if (o.method !== 'lowpass') mapSkeleton(input, 1); // an unmappable skeleton fails here, naming its missing joints
         await ready;
-        const { client } = o.method === 'manifold' ? await app.latentErd.load() : await app.generator.load();
-        const r = await client.denoise({ motion: input, options: o }, { signal });
+        const cleaner = app.registry.with('cleanup').find((m) => m.descriptor.cleanup!.methods.includes(o.method));
+        if (!cleaner) throw new Error(`no model that cleans up with "${o.method}" is listed in models/index.json`);
+        const r = await app.withModel(cleaner.info.id, (client, descriptor) => descriptor.cleanup!.run(client, { motion: input, options: o }, { signal }));
         return { ...r.motion, stats: r.stats };
       });
     },
@@ -553,14 +496,8 @@ export function createPlayground(app: App): Playground {
         const seed = checkSeed(optional(o.seed, 0));
         const gait = o.gait === undefined ? undefined : checkGait(o.gait);
         await ready;
-        if (checkControlModel(o.model, models) === 'latent-erd') {
-          const { client } = await app.latentErd.load();
-          const m = await client.simulateControl({ seconds, schedule, seed, footLock: lockFeet, ...(gait ? { gait } : {}) }, { signal });
-          return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, speed: m.speed, heading: m.heading, computeMs: m.computeMsPerFrame };
-        }
-        const { client } = await app.generator.load();
-        const m = await client.simulateControl({ seconds, schedule, seed, footLock: lockFeet, ...(gait ? { gait } : {}) }, { signal });
-        return { fps: m.fps, frames: m.frames, joints: [...m.joints], parents: [...m.parents], positions: m.positions, contacts: m.contacts, speed: m.speed, heading: m.heading, computeMs: m.computeMs };
+        const { info, descriptor } = controlModel(app.registry, 'liveControl', o.model);
+        return app.withModel(info.id, (client) => descriptor.liveControl!.simulate(client, { seconds, schedule, seed, footLock: lockFeet, ...(gait ? { gait } : {}) }, { signal }));
       });
     },
   };

@@ -9,11 +9,11 @@ import type { RestPose } from '../motion/restPose';
 import type { Motion } from '../motion/types';
 import type { PlaybackState } from '../viewer/playback';
 import { Viewer } from '../viewer/viewer';
-import { DanceClient, type DanceInitResult } from '../runtime/aclstm/danceClient';
-import { GeneratorClient, type InitResult } from '../runtime/generator/generatorClient';
-import { LatentErdClient, type LatentErdInitResult } from '../runtime/latent_erd/latentErdClient';
+import type { ModelInfo } from '../model/manifest';
+import type { ModelClientBase, ModelDescriptor } from '../runtime/descriptor';
+import { Registry } from '../runtime/registry';
+import { WorkerFailedError, type ModelSkeleton } from '../runtime/worker/workerClient';
 import { ImportClient } from '../runtime/import/importClient';
-import { VaeLstmClient, type VaeLstmInitResult } from '../runtime/vae_lstm/vaeLstmClient';
 import { baseName, type FileImportOutcome } from '../runtime/import/motionFiles';
 import { ImportIndicator } from './files';
 import { $, downloadBlob, errorMessage, type DomScope } from './dom';
@@ -24,14 +24,14 @@ import { CleanupPanel } from './cleanupPanel';
 import { DanceMode } from './modes/danceMode';
 import type { ModeHost } from './modes/host';
 import type { LiveChunk, LiveMode } from './modes/liveMode';
-import { CONTROL_MODEL_SHORT, ModelChoice } from './modes/modelChoice';
+import { ModelChoice } from './modes/modelChoice';
 import { PathMode } from './modes/pathMode';
 import { RandomWalk } from './modes/randomWalk';
 import { SteerMode } from './modes/steerMode';
 import { Panel } from './panel';
 import { Toasts } from './toast';
 
-import { MODES, type Mode } from './viewState';
+import { MODES, modeModels, type Mode } from './viewState';
 export type { Mode };
 
 /** What the page tells its element (which turns them into DOM events). */
@@ -47,13 +47,12 @@ export class App implements ModeHost {
   readonly panel: Panel;
   readonly toasts: Toasts;
   private readonly busy = new BusyIndicator($('model-status'));
-  /** The generator model, loaded on first use (playground.generate, Random walk). */
-  readonly generator = new ModelHost<GeneratorClient, InitResult>(() => new GeneratorClient({ threads: pageThreads() }), this.busy);
-  /** The latent ERD and its autoencoder's decoder (one worker), loaded on first use (playground.generate, followPath, simulateControl; Steer and Path modes). */
-  readonly latentErd = new ModelHost<LatentErdClient, LatentErdInitResult>(() => new LatentErdClient({ threads: pageThreads() }), this.busy);
-  /** The VAE-LSTM (four graphs in one worker), loaded on first use (playground.generate, followPath; Path mode). */
-  readonly vaeLstm = new ModelHost<VaeLstmClient, VaeLstmInitResult>(() => new VaeLstmClient({ threads: pageThreads() }), this.busy);
-  private readonly danceHosts = new Map<string, ModelHost<DanceClient, DanceInitResult>>();
+  /** The models the page runs (empty until the manifest is loaded: `useModels`). */
+  private models = new Registry();
+  private modelsArrived!: (registry: Registry) => void;
+  private readonly modelsReady = new Promise<Registry>((resolve) => (this.modelsArrived = resolve));
+  /** Each model's client, loaded on first use and shared by the API and the modes. */
+  private readonly hosts = new Map<string, ModelHost<ModelClientBase, ModelSkeleton>>();
   /** Parses imports off the page thread (dropped and picked files, playground.importMotion). */
   readonly importer = new ImportClient();
   private readonly importIndicator = new ImportIndicator();
@@ -71,7 +70,7 @@ export class App implements ModeHost {
   private readonly modeButtons = new Map(MODES.map((m) => [m, $(`mode-${m}`)]));
   private readonly dropOverlay = $('drop-overlay');
   /** The model Steer and Path modes run (one choice for both, kept across mode switches). */
-  readonly controlModel = new ModelChoice([$<HTMLSelectElement>('steer-model'), $<HTMLSelectElement>('path-model')]);
+  readonly controlModel = new ModelChoice($<HTMLSelectElement>('path-model'), $<HTMLSelectElement>('steer-model'));
   readonly walk: RandomWalk;
   readonly danceMode: DanceMode;
   readonly pathMode: PathMode;
@@ -127,14 +126,55 @@ export class App implements ModeHost {
     return this.mode;
   }
 
-  /** A dance model's client (`id` "aclstm" or "aclstm-vanilla"), loaded on first use. */
-  dance(id: string): ModelHost<DanceClient, DanceInitResult> {
-    let host = this.danceHosts.get(id);
+  /** The models the page runs, as listed so far. */
+  get registry(): Registry {
+    return this.models;
+  }
+
+  /** The models, once the manifest is loaded (or has failed to: then none). */
+  whenModels(): Promise<Registry> {
+    return this.modelsReady;
+  }
+
+  /** The manifest's models (public/models/index.json): the pickers list them by what they can do. */
+  useModels(models: readonly ModelInfo[]): void {
+    this.models = new Registry(models);
+    this.controlModel.list(this.models);
+    this.danceMode.list(this.models);
+    this.pathMode.list(this.models);
+    this.modelsArrived(this.models);
+  }
+
+  /** Which models each mode shows (links and attributes are checked against it). */
+  modeModels(): ReturnType<typeof modeModels> {
+    return modeModels(this.models);
+  }
+
+  /** Model `id`'s client, loaded on first use (a listed model; else it throws). */
+  host(id: string): ModelHost<ModelClientBase, ModelSkeleton> {
+    let host = this.hosts.get(id);
     if (!host) {
-      host = new ModelHost(() => new DanceClient({ model: id, threads: pageThreads() }), this.busy);
-      this.danceHosts.set(id, host);
+      const model = this.models.find(id);
+      if (!model) throw new Error(`model "${id}" is not listed in models/index.json`);
+      host = new ModelHost(() => model.descriptor.createClient(model.info, pageThreads()), this.busy);
+      this.hosts.set(id, host);
     }
     return host;
+  }
+
+  /**
+   * Runs `use` with model `id`'s client (loaded on first use) and descriptor. A worker that failed (not a
+   * request it refused) is forgotten, so the next call starts a new one.
+   */
+  async withModel<T>(id: string, use: (client: ModelClientBase, descriptor: ModelDescriptor) => Promise<T>): Promise<T> {
+    const host = this.host(id);
+    const { client } = await host.load();
+    try {
+      return await use(client, this.models.find(id)!.descriptor);
+    } catch (e) {
+      if (e instanceof WorkerFailedError) host.reset(client);
+      throw e;
+    }
   }
 
   /**
@@ -187,10 +227,11 @@ export class App implements ModeHost {
       return;
     }
     if (mode === 'walk') {
-      this.setLiveLabel('Random walk', 'generator · 30 fps · live');
+      const walker = this.models.defaultFor('walk');
+      this.setLiveLabel('Random walk', walker ? `${walker.descriptor.shortName} · 30 fps · live` : 'loading…');
       this.exportBtn.title = 'Download the last 20 s of the walk as BVH';
     } else if (mode === 'steer') {
-      this.setLiveLabel('Steer', `${CONTROL_MODEL_SHORT[this.controlModel.steerable]} · 30 fps · live control`);
+      this.setLiveLabel('Steer', `${this.models.shortName(this.controlModel.steerable)} · 30 fps · live control`);
       this.exportBtn.title = 'Download the last 20 s of steering as BVH';
     } else {
       this.setLiveLabel('Dance', 'loading…');

@@ -18,8 +18,6 @@ import { CANONICAL_JOINTS, mapSkeleton, type CanonicalJoint } from '../motion/sk
 import type { Motion } from '../motion/types';
 import { isCancelled } from '../runtime/worker/cancellation';
 import type { CleanupMethod, CleanupStats } from '../runtime/cleanup/cleanup';
-import type { GeneratorClient } from '../runtime/generator/generatorClient';
-import type { LatentErdClient } from '../runtime/latent_erd/latentErdClient';
 import { baseName } from '../runtime/import/motionFiles';
 import type { PlaybackState } from '../viewer/playback';
 import { AnglePlot } from './anglePlot';
@@ -282,25 +280,26 @@ export class CleanupPanel {
       }
     }
     const run = (this.running = { abort: new AbortController(), session: s, text: 'starting…' });
-    const label = method === 'manifold' ? 'latent-erd' : 'generator';
     this.progress.value = 0;
     this.render();
-    let client: GeneratorClient | LatentErdClient | undefined;
     try {
-      run.text = `loading the ${method === 'manifold' ? 'motion autoencoder' : 'generator'}…`;
+      const cleaner = (await this.host.whenModels()).with('cleanup').find((m) => m.descriptor.cleanup!.methods.includes(method));
+      if (!cleaner) throw new Error(`no model that cleans up with ${METHOD_NAMES[method]} is listed in models/index.json`);
+      const id = cleaner.info.id;
+      run.text = `loading the ${cleaner.descriptor.cleanup!.loading}…`;
       this.render();
-      client = method === 'manifold' ? (await this.host.latentErd.load()).client : (await this.host.generator.load()).client;
+      await this.host.host(id).load();
       if (run.abort.signal.aborted) return;
       run.text = `cleaning with ${METHOD_NAMES[method]}…`;
       this.render();
-      const r = await client.denoise({ motion: input, options: { method } }, {
+      const r = await this.host.withModel(id, (client, descriptor) => descriptor.cleanup!.run(client, { motion: input, options: { method } }, {
         signal: run.abort.signal,
         onProgress: (fraction) => {
           if (this.running !== run) return;
           this.progress.value = fraction;
           this.status.textContent = `cleaning with ${METHOD_NAMES[method]}… ${Math.round(fraction * 100)} %`;
         },
-      });
+      }));
       if (this.running !== run || this.session !== s) return;
       this.running = null;
       s.cleaned = { motion: { ...r.motion, joints: [...r.motion.joints], parents: [...r.motion.parents] }, method, stats: r.stats, angles: new Map() };
@@ -313,12 +312,8 @@ export class CleanupPanel {
         this.render();
         return;
       }
-      // A request the worker refused leaves the worker fine; anything else (a crash) needs a new one.
-      if (client && !errorMessage(e).startsWith(`${label} denoise:`)) {
-        if (method === 'manifold') this.host.latentErd.reset(client as LatentErdClient);
-        else this.host.generator.reset(client as GeneratorClient);
-      }
-      this.host.reportError(`Clean up: ${errorMessage(e).replace(/^(generator|latent-erd) denoise: (denoise: )?/, '')}`);
+      // A worker that failed is started afresh next time (withModel); the worker's "<model> denoise: " prefix is dropped.
+      this.host.reportError(`Clean up: ${errorMessage(e).replace(/^\S+ denoise: (denoise: )?/, '')}`);
     }
     this.render();
   }

@@ -88,3 +88,11 @@ export function downloadBlob(fileName: string, blob: Blob): void {
   a.remove();
   setTimeout(() => URL.revokeObjectURL(url), 10_000);
 }
+
+/** Sets a form field as the user would: its value (a checkbox: checked), then its input and change events. */
+export function changeTo(field: HTMLInputElement | HTMLSelectElement, value: string | boolean): void {
+  if (field instanceof HTMLInputElement && field.type === 'checkbox') field.checked = value as boolean;
+  else field.value = String(value);
+  field.dispatchEvent(new Event('input', { bubbles: true }));
+  field.dispatchEvent(new Event('change', { bubbles: true }));
+}

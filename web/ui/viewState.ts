@@ -3,19 +3,26 @@
 // setting keeps its default; nothing here ever becomes HTML.
 
 import { checkPathPoints } from '../optimizer/path';
+import type { Capability } from '../runtime/descriptor';
+import type { Registry } from '../runtime/registry';
 import { errorMessage } from './dom';
 
 export type Mode = 'clip' | 'walk' | 'dance' | 'path' | 'steer';
 export const MODES: readonly Mode[] = ['clip', 'walk', 'dance', 'path', 'steer'];
 
-/** The models each mode can show (`model` is checked against the mode). */
-export const MODE_MODELS: Record<Mode, readonly string[]> = {
-  clip: [],
-  walk: ['generator'],
-  dance: ['aclstm', 'aclstm-vanilla'],
-  path: ['generator', 'latent-erd', 'vae-lstm'],
-  steer: ['generator', 'latent-erd'],
-};
+/** What a model must be able to do to be shown in each mode (Clip mode shows no model). */
+const MODE_CAPABILITY: Record<Mode, Capability | null> = { clip: null, walk: 'walk', dance: 'dance', path: 'followPath', steer: 'liveControl' };
+
+/** The models each mode can show (`model` is checked against the mode), from the registry. */
+export type ModeModels = Record<Mode, readonly string[]>;
+
+export function modeModels(registry: Registry): ModeModels {
+  const ids = (mode: Mode) => {
+    const capability = MODE_CAPABILITY[mode];
+    return capability ? registry.ids(capability) : [];
+  };
+  return { clip: ids('clip'), walk: ids('walk'), dance: ids('dance'), path: ids('path'), steer: ids('steer') };
+}
 
 /** The settings a link or the attributes carry; a missing one is the mode's default. */
 export interface ViewState {
@@ -47,10 +54,8 @@ export function parseViewValue(key: ViewKey, text: string): { value: ViewState[V
   switch (key) {
     case 'mode':
       return (MODES as readonly string[]).includes(text) ? { value: text as Mode } : refuse(`must be one of ${MODES.join(', ')}`);
-    case 'model': {
-      const all = [...new Set(Object.values(MODE_MODELS).flat())];
-      return all.includes(text) ? { value: text } : refuse(`must be one of ${all.join(', ')}`);
-    }
+    case 'model':
+      return /^[a-z0-9][a-z0-9._-]{0,63}$/.test(text) ? { value: text } : refuse('must be a model id such as generator');
     case 'style':
       return /^[a-z][a-z0-9_-]{0,31}$/.test(text) ? { value: text } : refuse('must be a dance style name such as salsa');
     case 'seed': {
@@ -82,7 +87,7 @@ export function parseViewValue(key: ViewKey, text: string): { value: ViewState[V
  * A whole view from named text values (attributes or query parameters): the settings that read, and a
  * reason for each that did not. A model that the mode does not have is refused too.
  */
-export function parseView(get: (key: ViewKey) => string | null): { view: ViewState; errors: string[] } {
+export function parseView(get: (key: ViewKey) => string | null, models?: ModeModels): { view: ViewState; errors: string[] } {
   const view: ViewState = {};
   const errors: string[] = [];
   for (const key of VIEW_KEYS) {
@@ -92,10 +97,10 @@ export function parseView(get: (key: ViewKey) => string | null): { view: ViewSta
     if ('error' in r) errors.push(r.error);
     else (view as Record<ViewKey, unknown>)[key] = r.value;
   }
-  if (view.model !== undefined) {
+  if (view.model !== undefined && models) {
     const mode = view.mode ?? 'clip';
-    if (!MODE_MODELS[mode].includes(view.model)) {
-      errors.push(`model=${JSON.stringify(view.model)}: ${mode} mode ${MODE_MODELS[mode].length ? `shows ${MODE_MODELS[mode].join(', ')}` : 'has no model'}`);
+    if (!models[mode].includes(view.model)) {
+      errors.push(`model=${JSON.stringify(view.model)}: ${mode} mode ${models[mode].length ? `shows ${models[mode].join(', ')}` : 'has no model'}`);
       delete view.model;
     }
   }

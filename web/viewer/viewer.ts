@@ -11,6 +11,9 @@ import { COMPANION_PALETTE } from './palette';
 import { Playback, type PlaybackState } from './playback';
 import { chooseQuality, DynamicResolution, fixedResolution, probeGL, type GLInfo, type Quality } from './quality';
 
+/** The ground, y = 0 (pointer picks land on it). */
+const GROUND_PLANE = new THREE.Plane(new THREE.Vector3(0, 1, 0), 0);
+
 export interface ViewerLayers {
   follow: boolean;
   trail: boolean;
@@ -72,6 +75,7 @@ export class Viewer {
   private dirty = true;
   private renderedLast = false;
   private readonly tmp = new THREE.Vector3();
+  private readonly raycaster = new THREE.Raycaster();
   private readonly gl: GLInfo;
   private readonly quality: Quality;
   private readonly basePixelRatio: number;
@@ -370,6 +374,85 @@ export class Viewer {
     this.camera.position.copy(this.controls.target).addScaledVector(dir, dist);
     this.controls.update();
     this.dirty = true;
+  }
+
+  // ---------- a mode's camera work (the modes hold no three.js objects of their own) ----------
+
+  /**
+   * The ground point (x, z) under a pointer at client coordinates, or null: the sky, or a hit further than
+   * `maxReach` metres from the view's centre (rays grazing the horizon).
+   */
+  groundAt(clientX: number, clientY: number, maxReach = 80): [number, number] | null {
+    const rect = this.renderer.domElement.getBoundingClientRect();
+    const ndc = new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1, -((clientY - rect.top) / rect.height) * 2 + 1);
+    this.raycaster.setFromCamera(ndc, this.camera);
+    const hit = this.raycaster.ray.intersectPlane(GROUND_PLANE, new THREE.Vector3());
+    if (!hit) return null;
+    const t = this.controls.target;
+    if (Math.hypot(hit.x - t.x, hit.z - t.z) > maxReach) return null;
+    return [hit.x, hit.z];
+  }
+
+  /** Whether a right-button drag turns the view (a mode that draws with the left button) or pans it (the default). */
+  setRightDragRotates(rotates: boolean): void {
+    this.controls.mouseButtons.RIGHT = rotates ? THREE.MOUSE.ROTATE : THREE.MOUSE.PAN;
+  }
+
+  /**
+   * Looks down at ground point (x, z) from `distance` metres, `rise` the view direction's y before
+   * normalising, keeping the camera's compass direction; stops following the root.
+   */
+  lookAtGround(x: number, z: number, distance: number, rise: number): void {
+    const dir = this.camera.position.clone().sub(this.controls.target).setY(0);
+    if (dir.lengthSq() < 1e-6) dir.set(0.6, 0, 0.8);
+    dir.normalize().setY(rise).normalize();
+    this.setLayers({ follow: false });
+    this.controls.target.set(x, 0, z);
+    this.camera.position.copy(this.controls.target).addScaledVector(dir, distance);
+    this.controls.update();
+    this.dirty = true;
+  }
+
+  /** Moves the view down by `share` of the camera's distance (the framed content then sits higher on screen). */
+  lowerView(share: number): void {
+    const drop = this.camera.position.distanceTo(this.controls.target) * share;
+    this.controls.target.y -= drop;
+    this.camera.position.y -= drop;
+    this.controls.update();
+    this.dirty = true;
+  }
+
+  /** Puts the camera `distance` metres behind a character facing `heading` (rad), turned `side` rad toward its side, `rise` up. */
+  placeBehind(heading: number, side: number, distance: number, rise: number): void {
+    const a = heading + Math.PI + side;
+    const l = Math.hypot(1, rise);
+    const t = this.controls.target;
+    this.camera.position.set(t.x + (Math.sin(a) / l) * distance, t.y + (rise / l) * distance, t.z + (Math.cos(a) / l) * distance);
+    this.controls.update();
+    this.dirty = true;
+  }
+
+  /** Swings the camera's compass direction a `share` (0…1) of the way toward behind `heading` (turned `side` rad), about the view's centre. */
+  swingBehind(heading: number, side: number, share: number): void {
+    const t = this.controls.target;
+    const ox = this.camera.position.x - t.x, oz = this.camera.position.z - t.z;
+    const current = Math.atan2(ox, oz);
+    let diff = heading + Math.PI + side - current;
+    diff = Math.atan2(Math.sin(diff), Math.cos(diff)); // wrapped to (−π, π]
+    const turn = diff * share;
+    if (Math.abs(turn) < 1e-5) return;
+    const c = Math.cos(turn), sn = Math.sin(turn);
+    // A turn about +y by `turn`: (x, z) → (x cos + z sin, −x sin + z cos).
+    this.camera.position.x = t.x + ox * c + oz * sn;
+    this.camera.position.z = t.z - ox * sn + oz * c;
+    this.camera.lookAt(t);
+    this.dirty = true;
+  }
+
+  /** The compass direction the camera looks along on the ground (rad, 0 faces +z). */
+  viewHeading(): number {
+    const t = this.controls.target, cam = this.camera.position;
+    return Math.atan2(t.x - cam.x, t.z - cam.z);
   }
 
   /** The root's ground position at the playhead, or null with nothing shown. */

@@ -10,6 +10,17 @@ import { assetUrl } from './assetBase';
 import { answerDownload, sharedDownload, type DownloadRequest } from './sharedDownloads';
 import { ortWasmHref } from './ortFiles';
 
+/**
+ * The worker itself failed (it crashed, could not load, stalled past a timeout, or was disposed): this
+ * client is done, and a new one is needed. A request the worker refused rejects with RequestRefusedError
+ * instead, and the client goes on working. Both keep the name "Error" that the public API's errors have
+ * (docs/api.md): tell them apart with instanceof.
+ */
+export class WorkerFailedError extends Error {}
+
+/** The worker answered a request with an error (bad input, a model that cannot do it): the worker is fine. */
+export class RequestRefusedError extends Error {}
+
 /** Options of any request: `signal` cancels it (cancellation.ts). */
 export interface RequestOptions {
   signal?: AbortSignal;
@@ -41,14 +52,14 @@ export class WorkerClient {
     worker.addEventListener('message', (event: MessageEvent<WorkerMessage | DownloadRequest>) => this.onReply(event.data));
     worker.addEventListener('error', (event) => {
       event.preventDefault();
-      this.fail(new Error(`${label} worker failed: ${event.message || 'could not load or run the worker script'}`));
+      this.fail(new WorkerFailedError(`${label} worker failed: ${event.message || 'could not load or run the worker script'}`));
     });
-    worker.addEventListener('messageerror', () => this.fail(new Error(`${label} worker sent a message that could not be read`)));
+    worker.addEventListener('messageerror', () => this.fail(new WorkerFailedError(`${label} worker sent a message that could not be read`)));
   }
 
   /** Stops the worker; pending and later calls reject. */
   dispose(): void {
-    this.fail(new Error(`the ${this.label} client was disposed`));
+    this.fail(new WorkerFailedError(`the ${this.label} client was disposed`));
   }
 
   /**
@@ -58,14 +69,14 @@ export class WorkerClient {
    * to cancel it; its reply, if one still comes, is dropped.
    */
   protected request<T>(type: string, body: object, options: ProgressOptions & { timeoutMs?: number } = {}): Promise<T> {
-    if (this.failure || !this.worker) return Promise.reject(this.failure ?? new Error(`${this.label} worker is not running`));
+    if (this.failure || !this.worker) return Promise.reject(this.failure ?? new WorkerFailedError(`${this.label} worker is not running`));
     const { signal, onProgress, timeoutMs } = options;
     const cancelled = () => new CancelledError(`${this.label} ${type}: cancelled`, { cause: signal?.reason });
     if (signal?.aborted) return Promise.reject(cancelled());
     const id = this.nextId++;
     return new Promise<T>((resolve, reject) => {
       // A worker that stalls would hold every later request in its queue too: give up on it entirely.
-      const timer = timeoutMs === undefined ? undefined : setTimeout(() => this.fail(new Error(`${this.label} ${type}: no answer from the worker within ${timeoutMs / 1000} s`)), timeoutMs);
+      const timer = timeoutMs === undefined ? undefined : setTimeout(() => this.fail(new WorkerFailedError(`${this.label} ${type}: no answer from the worker within ${timeoutMs / 1000} s`)), timeoutMs);
       const onAbort = () => {
         if (!this.pending.delete(id)) return;
         entry.settle();
@@ -98,7 +109,7 @@ export class WorkerClient {
       return;
     }
     if (message.id === WORKER_ERROR_ID) {
-      if (!message.ok) this.fail(new Error(message.error));
+      if (!message.ok) this.fail(new WorkerFailedError(message.error));
       return;
     }
     const entry = this.pending.get(message.id);
@@ -106,7 +117,7 @@ export class WorkerClient {
     this.pending.delete(message.id);
     entry.settle();
     if (message.ok) entry.resolve(message.result);
-    else entry.reject(message.name === CANCELLED_ERROR_NAME ? new CancelledError(`${this.label} ${message.error}`) : new Error(`${this.label} ${message.error}`));
+    else entry.reject(message.name === CANCELLED_ERROR_NAME ? new CancelledError(`${this.label} ${message.error}`) : new RequestRefusedError(`${this.label} ${message.error}`));
   }
 
   /** Rejects everything pending, stops the worker and makes later calls reject with the same error. */
@@ -155,6 +166,12 @@ export abstract class ModelClient<P extends object, Init extends ModelSkeleton, 
     this.urls = { modelUrl: pageUrl(options.modelUrl), infoUrl: pageUrl(options.infoUrl) };
     this.initTimeoutMs = options.initTimeoutMs ?? 60_000;
     this.threads = options.threads;
+  }
+
+  /** What `init` resolved with (it throws before `init` has completed). */
+  get initResult(): Init {
+    if (!this.loaded) throw new Error(`${this.label}: init has not completed`);
+    return this.loaded;
   }
 
   /** Loads the model; resolves with what the worker reports about it. Call before anything else. */

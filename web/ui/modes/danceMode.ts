@@ -4,9 +4,11 @@
 // line within seconds: it stops moving).
 
 import { PoseChangeMeter } from '../../motion/poseChange';
-import type { DanceClient, DanceInitResult, DanceMotion } from '../../runtime/aclstm/danceClient';
+import { DanceClient, type DanceInitResult, type DanceMotion } from '../../runtime/aclstm/danceClient';
+import type { Registry } from '../../runtime/registry';
 import { $ } from '../dom';
 import { PoseChangePlot } from '../poseChangePlot';
+import { fillSelect } from './modelChoice';
 import type { ModeHost } from './host';
 import { LiveMode, type LiveStream } from './liveMode';
 
@@ -32,6 +34,16 @@ export class DanceMode extends LiveMode<DanceMotion> {
     });
     this.seed.addEventListener('change', () => this.restartIfActive());
     $('dance-restart').addEventListener('click', () => this.restartIfActive());
+  }
+
+  /** Lists the registry's dance models in the model picker. */
+  list(registry: Registry): void {
+    fillSelect(this.model, registry, registry.ids('dance'));
+  }
+
+  /** Picks the dance model a view names (the stream restarts with it once the mode is on). */
+  selectModel(id: string): void {
+    this.model.value = id;
   }
 
   private get modelLabel(): string {
@@ -74,8 +86,12 @@ export class DanceMode extends LiveMode<DanceMotion> {
   }
 
   protected async open(signal: AbortSignal): Promise<LiveStream<DanceMotion>> {
+    await this.app.whenModels(); // the picker lists the dance models once they are known
     const id = this.model.value;
-    const { client, info } = await this.app.dance(id).load();
+    if (!id) throw new Error('no dance model is listed in models/index.json');
+    const { client } = await this.app.host(id).load();
+    if (!(client instanceof DanceClient)) throw new Error(`model "${id}" cannot dance`);
+    const info = client.initResult;
     this.client = { id, client };
     this.info = info;
     this.listStyles(info);
@@ -91,7 +107,7 @@ export class DanceMode extends LiveMode<DanceMotion> {
   }
 
   protected forget(): void {
-    if (this.client) this.app.dance(this.client.id).reset(this.client.client);
+    if (this.client) this.app.host(this.client.id).reset(this.client.client);
   }
 
   /** Measures the network's own points (as the evaluation does), not the fitted ones. */

@@ -3,10 +3,9 @@
 // never sees the rest of the page (the import, export and mode switching).
 
 import type { Motion } from '../../motion/types';
-import type { DanceClient, DanceInitResult } from '../../runtime/aclstm/danceClient';
-import type { GeneratorClient, InitResult } from '../../runtime/generator/generatorClient';
-import type { LatentErdClient, LatentErdInitResult } from '../../runtime/latent_erd/latentErdClient';
-import type { VaeLstmClient, VaeLstmInitResult } from '../../runtime/vae_lstm/vaeLstmClient';
+import type { ModelClientBase, ModelDescriptor } from '../../runtime/descriptor';
+import type { Registry } from '../../runtime/registry';
+import type { ModelSkeleton } from '../../runtime/worker/workerClient';
 import type { Viewer } from '../../viewer/viewer';
 import type { ModelHost } from '../modelHost';
 import type { ModelChoice } from './modelChoice';
@@ -19,23 +18,24 @@ import type { ModelChoice } from './modelChoice';
  */
 export type ModeViewer = Pick<
   Viewer,
-  | 'camera' | 'controls' | 'frameGround' | 'invalidate'
+  | 'controls' | 'frameGround' | 'invalidate' | 'groundAt' | 'setRightDragRotates' | 'lookAtGround' | 'lowerView'
+  | 'placeBehind' | 'swingBehind' | 'viewHeading'
   | 'scene' | 'renderer' | 'playback' | 'current' | 'footprintCount' | 'rootPosition' | 'setCompanion'
   | 'layers' | 'setLayers'
 >;
 
 export interface ModeHost {
   readonly viewer: ModeViewer;
-  /** The generator model (Random walk, Steer, Path), loaded on first use and shared with the API. */
-  readonly generator: ModelHost<GeneratorClient, InitResult>;
-  /** The latent ERD (Steer and Path modes' other model), loaded on first use and shared with the API. */
-  readonly latentErd: ModelHost<LatentErdClient, LatentErdInitResult>;
-  /** The VAE-LSTM (Path mode's third model), loaded on first use and shared with the API. */
-  readonly vaeLstm: ModelHost<VaeLstmClient, VaeLstmInitResult>;
-  /** Which model Steer and Path modes run (the generator, the latent ERD, or in Path the VAE-LSTM). */
+  /** The models the page runs, by what they can do. */
+  readonly registry: Registry;
+  /** The registry once the model list has loaded. */
+  whenModels(): Promise<Registry>;
+  /** Model `id`'s client, loaded on first use and shared with the API. */
+  host(id: string): ModelHost<ModelClientBase, ModelSkeleton>;
+  /** Runs `use` with model `id`'s client and descriptor; a failed worker is forgotten (the next use starts a new one). */
+  withModel<T>(id: string, use: (client: ModelClientBase, descriptor: ModelDescriptor) => Promise<T>): Promise<T>;
+  /** Which model Steer and Path modes run (one choice for both). */
   readonly controlModel: ModelChoice;
-  /** A dance model (`id` "aclstm" or "aclstm-vanilla"), loaded on first use. */
-  dance(id: string): ModelHost<DanceClient, DanceInitResult>;
   /** Shows a live mode's window of streamed frames (`dropped` < 0: a new stream); `name` names exports. */
   showLive(motion: Motion, dropped: number, name: string): void;
   /** Shows a finished motion (Path mode's walk) without leaving the mode; `name` names exports. */

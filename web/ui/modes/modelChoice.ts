@@ -1,59 +1,65 @@
-// Which model Steer and Path modes run: the generator with the MAP optimiser (the default), the latent ERD,
-// or (Path only) the VAE-LSTM. One choice for both modes, shown by a select in each mode's controls
-// (#steer-model and #path-model in index.html): changing either changes both, and it stays as set across
-// mode switches. A model one mode cannot run (the VAE-LSTM makes whole paths, it cannot be steered live) is
-// missing from that mode's select; while it is chosen, that mode runs the last model it can (`steerable`).
+// Which model Steer and Path modes run: one choice for both, shown by a select in each mode's controls
+// (#path-model lists the models that follow paths, #steer-model those that take live control; both filled
+// from the registry): changing either changes both, and it stays as set across mode switches. A model one
+// mode cannot run (the VAE-LSTM makes whole paths, it cannot be steered live) is missing from that mode's
+// select; while it is chosen, that mode runs the last model it can (`steerable`).
 
-export type ControlModelId = 'generator' | 'latent-erd' | 'vae-lstm';
-/** The models that take live control. */
-export type SteerModelId = Exclude<ControlModelId, 'vae-lstm'>;
-
-export const CONTROL_MODELS: readonly ControlModelId[] = ['generator', 'latent-erd', 'vae-lstm'];
-
-/** How a mode's title line names the model (lower case, short). */
-export const CONTROL_MODEL_SHORT: Record<ControlModelId, string> = {
-  generator: 'generator',
-  'latent-erd': 'latent ERD',
-  'vae-lstm': 'VAE-LSTM',
-};
-
-export function isControlModel(value: string): value is ControlModelId {
-  return (CONTROL_MODELS as readonly string[]).includes(value);
-}
+import type { Registry } from '../../runtime/registry';
 
 export class ModelChoice {
-  private current: ControlModelId = 'generator';
-  private lastSteerable: SteerModelId = 'generator';
-  private readonly listeners: ((model: ControlModelId) => void)[] = [];
+  /** The chosen model ('' until the models are listed). */
+  private current = '';
+  private lastSteerable = '';
+  private steerIds: string[] = [];
+  private readonly listeners: ((model: string) => void)[] = [];
+  private readonly selects: HTMLSelectElement[];
 
-  constructor(private readonly selects: HTMLSelectElement[]) {
-    for (const select of selects) {
-      select.value = this.current;
-      select.addEventListener('change', () => this.set(isControlModel(select.value) ? select.value : 'generator'));
-    }
+  constructor(
+    private readonly pathSelect: HTMLSelectElement,
+    private readonly steerSelect: HTMLSelectElement,
+  ) {
+    this.selects = [pathSelect, steerSelect];
+    for (const select of this.selects) select.addEventListener('change', () => this.set(select.value));
   }
 
-  get value(): ControlModelId {
+  /** Lists the registry's models in both selects; the choice starts at the default path follower. */
+  list(registry: Registry): void {
+    fillSelect(this.pathSelect, registry, registry.ids('followPath'));
+    this.steerIds = registry.ids('liveControl');
+    fillSelect(this.steerSelect, registry, this.steerIds);
+    this.lastSteerable = this.steerIds[0] ?? '';
+    this.current = '';
+    this.set(registry.ids('followPath')[0] ?? this.lastSteerable);
+  }
+
+  get value(): string {
     return this.current;
   }
 
-  /** The model Steer runs: the choice, or while that is the VAE-LSTM the last steerable one. */
-  get steerable(): SteerModelId {
+  /** The model Steer runs: the choice, or while that takes no live control the last one that does. */
+  get steerable(): string {
     return this.lastSteerable;
   }
 
-  set(model: ControlModelId): void {
+  set(model: string): void {
     // A select without this model keeps showing the model its mode runs.
-    const shown = model === 'vae-lstm' ? this.lastSteerable : model;
-    for (const select of this.selects) select.value = [...select.options].some((o) => o.value === model) ? model : shown;
+    for (const select of this.selects) select.value = [...select.options].some((o) => o.value === model) ? model : this.lastSteerable;
     if (model === this.current) return;
     this.current = model;
-    if (model !== 'vae-lstm') this.lastSteerable = model;
+    if (this.steerIds.includes(model)) this.lastSteerable = model;
     for (const listener of this.listeners) listener(model);
   }
 
   /** Called after every change. */
-  onChange(listener: (model: ControlModelId) => void): void {
+  onChange(listener: (model: string) => void): void {
     this.listeners.push(listener);
   }
+}
+
+/** Replaces a select's options with models `ids` (labelled by the registry), after its fixed options (value ""). */
+export function fillSelect(select: HTMLSelectElement, registry: Registry, ids: readonly string[]): void {
+  const fixed = [...select.options].filter((o) => o.value === '');
+  const kept = select.value;
+  select.replaceChildren(...fixed, ...ids.map((id) => new Option(registry.label(id), id)));
+  if ([...select.options].some((o) => o.value === kept)) select.value = kept;
 }

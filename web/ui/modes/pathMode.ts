@@ -9,17 +9,15 @@
 // Redrawing replaces the path; a stroke that is too short, or a failed optimisation, keeps what was there.
 // A new path drawn while the last one is being walked, or leaving the mode, cancels that optimisation.
 
-import * as THREE from 'three';
 import { MAX_PATH_LENGTH, MIN_PATH_LENGTH } from '../../optimizer/path';
 import type { Motion } from '../../motion/types';
-import type { FollowedPath, GeneratorClient } from '../../runtime/generator/generatorClient';
-import type { LatentErdClient } from '../../runtime/latent_erd/latentErdClient';
-import type { VaeLstmClient } from '../../runtime/vae_lstm/vaeLstmClient';
+import type { ModelDescriptor, PathStats } from '../../runtime/descriptor';
+import type { Registry } from '../../runtime/registry';
 import { LATENT_PATH_SPEED } from '../../runtime/latent_erd/latentErdRequests';
 import { GroundLine, TARGET_COLOR } from '../../viewer/groundPath';
-import { $, element, errorMessage, readSeed, setSliderFill } from '../dom';
+import { $, changeTo, element, errorMessage, readSeed, setSliderFill } from '../dom';
 import type { ModeHost } from './host';
-import { CONTROL_MODEL_SHORT, isControlModel, type ControlModelId } from './modelChoice';
+import { fillSelect } from './modelChoice';
 import type { Gait } from '../../optimizer/pathFollower';
 
 type Point = [number, number];
@@ -42,9 +40,9 @@ interface Walk {
   motion: Motion;
   /** The path as followed (x, z pairs), drawn on the ground with the result. */
   path: Float32Array;
-  stats: FollowedPath['stats'];
+  stats: PathStats;
   /** The model that walked it. */
-  model: ControlModelId;
+  model: string;
 }
 
 interface Result extends Walk {
@@ -72,17 +70,14 @@ function holdTo(motion: Motion, frames: number): Motion {
   return { ...motion, frames, positions, ...(contacts ? { contacts } : {}) };
 }
 
-/** A VAE-LSTM run stops stepping after about this long (docs/models/vae-lstm.md: the corpus's runs are no longer). */
-const VAE_LSTM_RUN_SECONDS = 2;
-
-/** A walk's numbers in one line: error, progress, time to compute, foot sliding; and a VAE-LSTM run's limit. */
-function statsLine(w: Walk, gait: Gait): string {
+/** A walk's numbers in one line: error, progress, time to compute, foot sliding; and a limit its model states. */
+function statsLine(w: Walk, gait: Gait, registry: Registry): string {
   const s = w.stats;
   const secs = (w.motion.frames - 1) / w.motion.fps;
   const sliding = Number.isFinite(s.sliding) ? ` · sliding ${s.sliding.toFixed(2)} m/s` : '';
-  const limit = w.model === 'vae-lstm' && gait === 'run' && secs > VAE_LSTM_RUN_SECONDS
-    ? ` · its runs stop stepping after about ${VAE_LSTM_RUN_SECONDS} s (the captured runs it learned from are that short)` : '';
-  return `${CONTROL_MODEL_SHORT[w.model]}: error mean ${(s.meanError * 100).toFixed(1)} cm · max ${(s.maxError * 100).toFixed(1)} cm · ${Math.round(s.arcProgress * 100)} % of the path · ` +
+  const stated = registry.find(w.model)?.descriptor.followPath?.limit?.(gait, secs);
+  const limit = stated ? ` · ${stated}` : '';
+  return `${registry.shortName(w.model)}: error mean ${(s.meanError * 100).toFixed(1)} cm · max ${(s.maxError * 100).toFixed(1)} cm · ${Math.round(s.arcProgress * 100)} % of the path · ` +
     `${(s.optimizeMs / 1000).toFixed(1)} s for ${secs.toFixed(1)} s of motion${sliding}${limit}`;
 }
 
@@ -121,9 +116,6 @@ export class PathMode {
   private followBefore = true;
   /** A path was given (setPath) and is walked when the mode is entered. */
   private walkPending = false;
-  private readonly raycaster = new THREE.Raycaster();
-  private readonly plane = new THREE.Plane(new THREE.Vector3(0, 1, 0), 0);
-  private readonly hit = new THREE.Vector3();
 
   constructor(private readonly app: ModeHost) {
     app.viewer.scene.add(this.line.mesh);
@@ -140,7 +132,7 @@ export class PathMode {
     // other kind is off while a model is chosen. The VAE-LSTM walks a drawn path at once.
     app.controlModel.onChange(() => {
       this.showState();
-      if (app.controlModel.value === 'vae-lstm' && this.points.length && !this.current()) void this.go();
+      if (this.follower()?.immediate && this.points.length && !this.current()) void this.go();
     });
     this.compare.addEventListener('change', () => this.showState());
     this.varyBtn.addEventListener('click', () => this.vary());
@@ -161,7 +153,7 @@ export class PathMode {
     const viewer = this.app.viewer;
     this.followBefore = viewer.layers().follow;
     // Left drag draws; the right button turns the view instead of panning.
-    viewer.controls.mouseButtons.RIGHT = THREE.MOUSE.ROTATE;
+    viewer.setRightDragRotates(true);
     if (this.result) {
       this.display(this.result);
     } else {
@@ -182,7 +174,7 @@ export class PathMode {
     this.cancelStroke();
     this.line.clear();
     const viewer = this.app.viewer;
-    viewer.controls.mouseButtons.RIGHT = THREE.MOUSE.PAN;
+    viewer.setRightDragRotates(false);
     viewer.setLayers({ follow: this.followBefore });
     this.app.syncLayers();
     viewer.invalidate();
@@ -190,15 +182,7 @@ export class PathMode {
 
   /** Looks down at the ground ahead of the origin (the camera's compass direction kept), not following. */
   private drawingView(): void {
-    const { camera, controls } = this.app.viewer;
-    const dir = camera.position.clone().sub(controls.target).setY(0);
-    if (dir.lengthSq() < 1e-6) dir.set(0.6, 0, 0.8);
-    dir.normalize().setY(RISE).normalize();
-    this.app.viewer.setLayers({ follow: false });
-    controls.target.set(0, 0, DRAWING_AHEAD);
-    camera.position.copy(controls.target).addScaledVector(dir, DRAWING_DISTANCE);
-    controls.update();
-    this.app.viewer.invalidate();
+    this.app.viewer.lookAtGround(0, DRAWING_AHEAD, DRAWING_DISTANCE, RISE);
   }
 
   private showFit(): void {
@@ -220,10 +204,21 @@ export class PathMode {
     return { gait: this.gait.value === 'run' ? 'run' : 'walk', seed, fitSigma, speed };
   }
 
+  /** Lists the registry's path followers in Compare's picker (the model picker is the shared ModelChoice). */
+  list(registry: Registry): void {
+    fillSelect(this.compare, registry, registry.ids('followPath'));
+    this.showState();
+  }
+
+  /** How the chosen model (or `model`) follows paths, or undefined before the models are listed. */
+  private follower(model = this.app.controlModel.value): NonNullable<ModelDescriptor['followPath']> | undefined {
+    return this.app.registry.find(model)?.descriptor.followPath;
+  }
+
   /** The model Compare adds beside the chosen one, or null (off, or the same model). */
-  private compareModel(): ControlModelId | null {
+  private compareModel(): string | null {
     const v = this.compare.value;
-    return isControlModel(v) && v !== this.app.controlModel.value ? v : null;
+    return v && v !== this.app.controlModel.value && this.app.registry.can(v, 'followPath') ? v : null;
   }
 
   /** Whether the shown walk is of the drawn path. */
@@ -235,14 +230,7 @@ export class PathMode {
 
   /** The ground point under a pointer, or null (sky, or too far away). */
   private groundAt(e: PointerEvent): Point | null {
-    const viewer = this.app.viewer;
-    const rect = viewer.renderer.domElement.getBoundingClientRect();
-    const ndc = new THREE.Vector2(((e.clientX - rect.left) / rect.width) * 2 - 1, -((e.clientY - rect.top) / rect.height) * 2 + 1);
-    this.raycaster.setFromCamera(ndc, viewer.camera);
-    if (!this.raycaster.ray.intersectPlane(this.plane, this.hit)) return null;
-    const t = viewer.controls.target;
-    if (Math.hypot(this.hit.x - t.x, this.hit.z - t.z) > MAX_REACH) return null;
-    return [this.hit.x, this.hit.z];
+    return this.app.viewer.groundAt(e.clientX, e.clientY, MAX_REACH);
   }
 
   private onDown(e: PointerEvent): void {
@@ -310,8 +298,8 @@ export class PathMode {
     // The walk being optimised is for the path just replaced.
     this.cancelOptimisation();
     this.showState();
-    // The VAE-LSTM's walk takes a fraction of a second: it appears as soon as the path is drawn.
-    if (this.app.controlModel.value === 'vae-lstm') void this.go();
+    // A model whose walk takes a fraction of a second (the VAE-LSTM) walks it as soon as it is drawn.
+    if (this.follower()?.immediate) void this.go();
   }
 
   private endStroke(s: NonNullable<PathMode['stroke']>): void {
@@ -335,6 +323,16 @@ export class PathMode {
     this.line.set(r && r.points === this.points ? r.path : flat(this.points));
     this.hint.hidden = this.points.length > 0 || r !== null;
     this.app.viewer.invalidate();
+  }
+
+  /** The seed of the next walk (Vary counts it up). */
+  get seedValue(): number {
+    return Number(this.seed.value) || 0;
+  }
+
+  /** Sets the seed a view gives, as if the user had. */
+  presetSeed(seed: number): void {
+    changeTo(this.seed, String(seed));
   }
 
   /** The drawn path, [x, z] per point (empty: none). */
@@ -397,33 +395,15 @@ export class PathMode {
     void this.go();
   }
 
-  /** One model's walk along `points` (loading it on first use). */
-  private async walk(model: ControlModelId, points: Point[], signal: AbortSignal, onProgress: (fraction: number) => void): Promise<Walk> {
+  /** One model's walk along `points` (loading it on first use; a worker that failed is started afresh next time). */
+  private async walk(model: string, points: Point[], signal: AbortSignal, onProgress: (fraction: number) => void): Promise<Walk> {
     const { gait, seed, fitSigma, speed } = this.params();
-    let client: GeneratorClient | LatentErdClient | VaeLstmClient | undefined;
-    try {
-      let r: Pick<FollowedPath, 'fps' | 'frames' | 'joints' | 'parents' | 'positions' | 'contacts' | 'path' | 'stats'>;
-      if (model === 'latent-erd') {
-        const erd = (client = (await this.app.latentErd.load()).client);
-        r = await erd.followPath({ points, gait, seed, speed, stroke: true }, { signal, onProgress });
-      } else if (model === 'vae-lstm') {
-        const vae = (client = (await this.app.vaeLstm.load()).client);
-        r = await vae.followPath({ points, gait, seed, speed, stroke: true }, { signal, onProgress });
-      } else {
-        const generator = (client = (await this.app.generator.load()).client);
-        r = await generator.followPath({ points, gait, seed, fitSigma, stroke: true }, { signal, onProgress });
-      }
-      const motion: Motion = { fps: r.fps, frames: r.frames, joints: r.joints, parents: r.parents, positions: r.positions, contacts: r.contacts };
-      return { motion, path: r.path, stats: r.stats, model };
-    } catch (e) {
-      // A request the worker refused leaves the worker fine; anything else (a crash) needs a new one.
-      if (client && !signal.aborted && !errorMessage(e).startsWith(`${model} followPath:`)) {
-        if (model === 'latent-erd') this.app.latentErd.reset(client as LatentErdClient);
-        else if (model === 'vae-lstm') this.app.vaeLstm.reset(client as VaeLstmClient);
-        else this.app.generator.reset(client as GeneratorClient);
-      }
-      throw e;
-    }
+    const follow = this.follower(model);
+    if (!follow) throw new Error(`model "${model}" does not follow paths`);
+    // Each model reads the setting it has: the optimiser's fit tolerance, or the speed asked for.
+    const own = { ...(follow.options.includes('fitTolerance') ? { fitSigma } : {}), ...(follow.options.includes('speed') ? { speed } : {}) };
+    const r = await this.app.withModel(model, (client) => follow.run(client, { points, gait, seed, ...own, stroke: true }, { signal, onProgress }));
+    return { motion: r.motion, path: r.path, stats: r.stats, model };
   }
 
   private async go(): Promise<void> {
@@ -440,9 +420,9 @@ export class PathMode {
     this.progress.value = 0;
     this.showState();
     try {
-      const progressOf = (m: ControlModelId, part: number, parts: number) => (fraction: number) => {
+      const progressOf = (m: string, part: number, parts: number) => (fraction: number) => {
         this.progress.value = (part + fraction) / parts;
-        const what = m === 'generator' ? `finding a ${gait} along the path` : `the ${CONTROL_MODEL_SHORT[m]} walks the path`;
+        const what = this.follower(m)?.working(gait) ?? 'walking the path';
         this.status.textContent = `${what}… ${Math.round(fraction * 100)} %`;
       };
       const parts = other ? 2 : 1;
@@ -465,22 +445,18 @@ export class PathMode {
 
   private display(r: Result): void {
     const viewer = this.app.viewer;
+    const registry = this.app.registry;
     const frames = Math.max(r.motion.frames, r.other?.motion.frames ?? 0);
     this.app.showInMode(holdTo(r.motion, frames), `path-${r.gait}`);
     if (r.other) {
-      viewer.setCompanion({ motion: holdTo(r.other.motion, frames), labels: { main: CONTROL_MODEL_SHORT[r.model], companion: CONTROL_MODEL_SHORT[r.other.model] } });
+      viewer.setCompanion({ motion: holdTo(r.other.motion, frames), labels: { main: registry.shortName(r.model), companion: registry.shortName(r.other.model) } });
     }
     const secs = (r.motion.frames - 1) / r.motion.fps;
-    const vs = r.other ? ` vs ${CONTROL_MODEL_SHORT[r.other.model]}` : '';
-    this.app.setLiveLabel('Path', `${CONTROL_MODEL_SHORT[r.model]}${vs} · ${r.gait} · ${r.motion.frames} frames · ${secs.toFixed(1)} s · ${viewer.footprintCount} steps`);
+    const vs = r.other ? ` vs ${registry.shortName(r.other.model)}` : '';
+    this.app.setLiveLabel('Path', `${registry.shortName(r.model)}${vs} · ${r.gait} · ${r.motion.frames} frames · ${secs.toFixed(1)} s · ${viewer.footprintCount} steps`);
     this.line.set(r.points === this.points ? r.path : flat(this.points));
     viewer.frameGround(r.path, RISE);
-    // Look a little lower, so the walk sits above the control bar.
-    const { camera, controls } = viewer;
-    const drop = camera.position.distanceTo(controls.target) * 0.08;
-    controls.target.y -= drop;
-    camera.position.y -= drop;
-    controls.update();
+    viewer.lowerView(0.08); // so the walk sits above the control bar
     this.app.syncLayers();
   }
 
@@ -501,11 +477,13 @@ export class PathMode {
     else delete this.status.dataset.walkedBy;
     if (current && r.other) this.status.dataset.comparedWith = r.other.model;
     else delete this.status.dataset.comparedWith;
-    this.fit.disabled = model !== 'generator';
-    if (model !== 'generator') this.fit.title = `The ${CONTROL_MODEL_SHORT[model]} has no optimiser: it has no fit tolerance`;
+    const follow = this.follower();
+    const options = follow?.options ?? [];
+    this.fit.disabled = !options.includes('fitTolerance');
+    if (this.fit.disabled) this.fit.title = `The ${this.app.registry.shortName(model)} has no optimiser: it has no fit tolerance`;
     else this.fit.removeAttribute('title');
-    this.speed.disabled = model === 'generator';
-    this.varyBtn.hidden = model !== 'vae-lstm';
+    this.speed.disabled = !options.includes('speed');
+    this.varyBtn.hidden = !follow?.varies;
     this.varyBtn.disabled = this.busy || !this.points.length;
     this.hint.hidden = this.points.length > 0 || r !== null || this.stroke !== null;
     this.status.replaceChildren();
@@ -513,7 +491,7 @@ export class PathMode {
       this.status.textContent = 'starting…';
     } else if (current) {
       for (const w of r.other ? [r, r.other] : [r]) {
-        const line = element('span', 'path-stats', statsLine(w, r.gait));
+        const line = element('span', 'path-stats', statsLine(w, r.gait, this.app.registry));
         line.dataset.model = w.model;
         this.status.append(line);
       }

@@ -5,9 +5,9 @@
 
 import { lowFootSample } from '../../motion/footSkating';
 import type { Motion } from '../../motion/types';
-import type { GeneratedMotion, GeneratorClient } from '../../runtime/generator/generatorClient';
+import { GeneratorClient, type GeneratedMotion } from '../../runtime/generator/generatorClient';
 import { CompanionAligner } from '../../viewer/sideBySide';
-import { $, readSeed } from '../dom';
+import { $, changeTo, readSeed } from '../dom';
 import type { ModeHost } from './host';
 import { LiveMode, type LiveStream } from './liveMode';
 
@@ -30,7 +30,7 @@ interface RawWindow {
 export class RandomWalk extends LiveMode<WalkChunk> {
   private seedName = '';
   private seedsListed = false;
-  private client: GeneratorClient | undefined;
+  private client: { id: string; client: GeneratorClient } | undefined;
   /** The running stream refines (fixed per stream, like the other settings). */
   private refining = false;
   private raw: RawWindow | null = null;
@@ -76,6 +76,18 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     });
   }
 
+  /** The walk's settings, as a view (link, attributes) carries them. */
+  get viewSettings(): { temperature: number; seed: number; refine: boolean } {
+    return { temperature: Number(this.temperature.value), seed: Number(this.seed.value) || 0, refine: this.refine.checked };
+  }
+
+  /** Sets what a view gives (left out: kept), as if the user had: the stream restarts with them. */
+  preset(view: { temperature?: number; seed?: number; refine?: boolean }): void {
+    if (view.temperature !== undefined) changeTo(this.temperature, String(view.temperature));
+    if (view.seed !== undefined) changeTo(this.seed, String(view.seed));
+    if (view.refine !== undefined) changeTo(this.refine, view.refine);
+  }
+
   private showTemperature(): void {
     this.temperatureOut.textContent = Number(this.temperature.value).toFixed(2);
   }
@@ -88,8 +100,14 @@ export class RandomWalk extends LiveMode<WalkChunk> {
   }
 
   protected async open(signal: AbortSignal): Promise<LiveStream<WalkChunk>> {
-    const { client, info } = await this.app.generator.load();
-    this.client = client;
+    // The first listed model that walks (the generator: a stream with the refiner behind it on request).
+    const walker = (await this.app.whenModels()).defaultFor('walk');
+    if (!walker) throw new Error('no model for Random walk is listed in models/index.json');
+    const id = walker.info.id;
+    const { client } = await this.app.host(id).load();
+    if (!(client instanceof GeneratorClient)) throw new Error(`model "${id}" cannot stream a random walk`);
+    const info = client.initResult;
+    this.client = { id, client };
     if (!this.seedsListed) {
       for (const [i, name] of info.seeds.entries()) this.seedState.add(new Option(name, String(i)));
       this.seedsListed = true;
@@ -101,7 +119,8 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     this.walkSkeleton = info;
     this.raw = null;
     this.aligner = params.refine ? new CompanionAligner(info.joints.length, info.fps) : null;
-    this.app.setLiveLabel('Random walk', params.refine ? 'generator + refiner · 30 fps · live' : 'generator · 30 fps · live');
+    const name = walker.descriptor.shortName;
+    this.app.setLiveLabel('Random walk', params.refine ? `${name} + refiner · 30 fps · live` : `${name} · 30 fps · live`);
     const pull = async (frames: number): Promise<WalkChunk> => {
       const m = await client.pull(frames, { signal });
       if (!params.refine) return m;
@@ -112,7 +131,7 @@ export class RandomWalk extends LiveMode<WalkChunk> {
   }
 
   protected forget(): void {
-    this.app.generator.reset(this.client);
+    if (this.client) this.app.host(this.client.id).reset(this.client.client);
   }
 
   /** Keeps the raw window in step with the shown (refined) one and draws it beside it when asked. */

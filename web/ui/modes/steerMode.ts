@@ -9,13 +9,11 @@
 // compares target and achieved speed.
 
 import { angleDifference } from '../../optimizer/path';
-import type { GeneratorClient } from '../../runtime/generator/generatorClient';
-import type { LatentErdClient } from '../../runtime/latent_erd/latentErdClient';
+import type { ModelClientBase, ModelDescriptor } from '../../runtime/descriptor';
 import { GroundArrow, TARGET_COLOR } from '../../viewer/groundPath';
 import { $, currentScope, setSliderFill } from '../dom';
 import type { ModeHost } from './host';
 import { LiveMode, type LiveChunk, type LiveStream } from './liveMode';
-import { CONTROL_MODEL_SHORT, type ControlModelId } from './modelChoice';
 import type { Gait } from '../../optimizer/pathFollower';
 
 /** What a live batch of either model carries: frames, achieved speed and heading per frame, compute time. */
@@ -25,12 +23,6 @@ type SteerChunk = LiveChunk & { startFrame: number; speed: Float32Array; heading
 /** Frames per optimised batch, and frames kept ready beyond the playhead (0.4 s at 30 fps). */
 const BATCH = 6;
 const AHEAD = 12;
-/**
- * The latent ERD: one latent step (4 frames) per pull, and 8 frames (0.27 s) kept ready. A step takes a few
- * milliseconds in the worker, so less is kept ready than for the generator: the input shows sooner.
- */
-const ERD_BATCH = 4;
-const ERD_AHEAD = 8;
 /** Turn rate of the left / right keys (rad/s) and speed change of up / down (m/s per second). */
 const TURN_RATE = Math.PI / 2;
 const SPEED_RATE = 1;
@@ -83,9 +75,10 @@ export class SteerMode extends LiveMode<SteerChunk> {
   private readonly statusLine = $('steer-status');
   private readonly scope = currentScope();
   private readonly arrow = new GroundArrow(TARGET_COLOR, 0.85);
-  private client: GeneratorClient | LatentErdClient | undefined;
-  /** The model of the stream running (the choice when it started). */
-  private model: ControlModelId = 'generator';
+  private client: ModelClientBase | undefined;
+  /** The model of the stream running (the choice when it started), and how it is steered. */
+  private model = '';
+  private live: NonNullable<ModelDescriptor['liveControl']> | undefined;
   private seedName = '';
 
   /**
@@ -182,38 +175,33 @@ export class SteerMode extends LiveMode<SteerChunk> {
   }
 
   protected async open(signal: AbortSignal): Promise<LiveStream<SteerChunk>> {
+    await this.app.whenModels();
     const model = (this.model = this.app.controlModel.steerable);
+    const live = (this.live = this.app.registry.find(model)?.descriptor.liveControl);
+    if (!live) throw new Error('no model that takes live control is listed in models/index.json');
     this.statusLine.dataset.model = model;
-    const started = model === 'latent-erd' ? await this.openLatent(signal) : await this.openGenerator(signal);
+    const { client, info } = await this.app.host(model).load();
+    this.client = client;
+    const stream = await live.start(client, { seed: 0, gait: this.gaitValue }, { signal });
+    this.seedName = stream.seedName;
     // The stream starts at the origin facing +z, at the slider's speed.
     this.heading = 0;
     this.throttle = 1;
     this.history = { start: 0, speed: [], heading: [] };
     this.computeMs = 0;
     this.particles = PARTICLES_MAX;
-    this.app.setLiveLabel('Steer', `${CONTROL_MODEL_SHORT[model]} · ${started.skeleton.fps} fps · live control · ${this.gaitValue}`);
-    return started;
-  }
-
-  private async openGenerator(signal: AbortSignal): Promise<LiveStream<SteerChunk>> {
-    const { client, info } = await this.app.generator.load();
-    this.client = client;
-    const stream = await client.controlStart({ seed: 0, gait: this.gaitValue }, { signal });
-    this.seedName = stream.seedName;
-    return { skeleton: info, pull: (frames) => client.controlPull(frames, { speed: this.targetSpeed, heading: this.heading, particles: this.particles }, { signal }) };
-  }
-
-  private async openLatent(signal: AbortSignal): Promise<LiveStream<SteerChunk>> {
-    const { client, info } = await this.app.latentErd.load();
-    this.client = client;
-    const stream = await client.controlStart({ seed: 0, gait: this.gaitValue }, { signal });
-    this.seedName = stream.seedName;
-    return { skeleton: info, chunk: ERD_BATCH, ahead: ERD_AHEAD, pull: (frames) => client.controlPull(frames, { speed: this.targetSpeed, heading: this.heading }, { signal }) };
+    this.app.setLiveLabel('Steer', `${this.app.registry.shortName(model)} · ${info.fps} fps · live control · ${this.gaitValue}`);
+    const target = () => ({ speed: this.targetSpeed, heading: this.heading, ...(live.particles ? { particles: this.particles } : {}) });
+    return {
+      skeleton: info,
+      ...(live.chunk ? { chunk: live.chunk } : {}),
+      ...(live.ahead ? { ahead: live.ahead } : {}),
+      pull: (frames) => live.pull(client, frames, target(), { signal }),
+    };
   }
 
   protected forget(): void {
-    if (this.model === 'latent-erd') this.app.latentErd.reset(this.client as LatentErdClient);
-    else this.app.generator.reset(this.client as GeneratorClient);
+    if (this.client) this.app.host(this.model).reset(this.client);
   }
 
   protected received(chunk: SteerChunk, first: boolean): void {
@@ -229,7 +217,7 @@ export class SteerMode extends LiveMode<SteerChunk> {
       h.start += 300;
     }
     this.computeMs = this.computeMs ? this.computeMs * 0.8 + chunk.computeMs * 0.2 : chunk.computeMs;
-    if (this.model !== 'generator') return; // the particle budget is the optimiser's
+    if (!this.live?.particles) return; // the particle budget is a searching controller's
     const budget = (chunk.frames / 30) * 1000;
     if (chunk.computeMs > 0.7 * budget) this.particles = Math.max(PARTICLES_MIN, Math.round(this.particles * 0.75));
     else if (chunk.computeMs < 0.35 * budget) this.particles = Math.min(PARTICLES_MAX, Math.round(this.particles * 1.25));
@@ -237,7 +225,7 @@ export class SteerMode extends LiveMode<SteerChunk> {
 
   protected describe(frame: number, fps: number): string {
     const time = `frame ${frame} · ${(frame / fps).toFixed(1)} s · ${this.seedName}`;
-    if (this.model === 'latent-erd') return `${time} · latent ERD · ${this.computeMs.toFixed(1)} ms per ${ERD_BATCH} frames`;
+    if (!this.live?.particles) return `${time} · ${this.app.registry.shortName(this.model)} · ${this.computeMs.toFixed(1)} ms per ${this.live?.chunk ?? BATCH} frames`;
     return `${time} · ${Math.round(this.computeMs)} ms per ${BATCH} frames · ${this.particles} particles`;
   }
 
@@ -245,34 +233,14 @@ export class SteerMode extends LiveMode<SteerChunk> {
 
   /** A new stream: the camera behind the character (facing +z), a little to its side, a little further back than for a clip. */
   private placeCamera(): void {
-    const { camera, controls } = this.app.viewer;
-    const a = Math.PI + CHASE_SIDE; // behind a +z facing, turned toward its side
-    const dir = { x: Math.sin(a), z: Math.cos(a) };
-    const l = Math.hypot(1, CHASE_RISE);
-    camera.position.set(
-      controls.target.x + (dir.x / l) * CHASE_DISTANCE,
-      controls.target.y + (CHASE_RISE / l) * CHASE_DISTANCE,
-      controls.target.z + (dir.z / l) * CHASE_DISTANCE,
-    );
-    controls.update();
+    this.app.viewer.placeBehind(0, CHASE_SIDE, CHASE_DISTANCE, CHASE_RISE);
     this.chasePausedUntil = 0;
   }
 
   /** Swings the camera's compass direction toward behind the character's facing. */
   private chase(dt: number, facing: number, now: number): void {
     if (!Number.isFinite(facing) || now < this.chasePausedUntil || !this.app.viewer.layers().follow) return;
-    const { camera, controls } = this.app.viewer;
-    const ox = camera.position.x - controls.target.x, oz = camera.position.z - controls.target.z;
-    const current = Math.atan2(ox, oz);
-    const wanted = facing + Math.PI + CHASE_SIDE;
-    const turn = angleDifference(wanted, current) * (1 - Math.exp(-dt * CHASE_RATE));
-    if (Math.abs(turn) < 1e-5) return;
-    const c = Math.cos(turn), s = Math.sin(turn);
-    // A turn about +y by `turn`: (x, z) → (x cos + z sin, −x sin + z cos).
-    camera.position.x = controls.target.x + ox * c + oz * s;
-    camera.position.z = controls.target.z - ox * s + oz * c;
-    camera.lookAt(controls.target);
-    this.app.viewer.invalidate();
+    this.app.viewer.swingBehind(facing, CHASE_SIDE, 1 - Math.exp(-dt * CHASE_RATE));
   }
 
   // ---------- inputs ----------
@@ -330,11 +298,8 @@ export class SteerMode extends LiveMode<SteerChunk> {
   private applyStick(x: number, y: number): void {
     const l = Math.hypot(x, y);
     if (l < STICK_DEAD_ZONE) return;
-    const cam = this.app.viewer.camera.position, target = this.app.viewer.controls.target;
-    let fx = target.x - cam.x, fz = target.z - cam.z;
-    const fl = Math.hypot(fx, fz) || 1;
-    fx /= fl;
-    fz /= fl;
+    const view = this.app.viewer.viewHeading();
+    const fx = Math.sin(view), fz = Math.cos(view);
     // Screen right on the ground is forward × up = (−fz, fx).
     const dx = fx * -y + -fz * x, dz = fz * -y + fx * x;
     this.heading = Math.atan2(dx, dz);

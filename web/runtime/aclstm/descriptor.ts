@@ -1,0 +1,35 @@
+// The acLSTM (Zhou et al.: an auto-conditioned LSTM for endless dance) and its vanilla-LSTM baseline as
+// the page offers them: generate in a style, and Dance mode's endless stream. Deterministic: the seed picks
+// the seed motion.
+
+import { describeValue } from '../../motion/describe';
+import { motionOf, type ModelDescriptor } from '../descriptor';
+import { DanceClient } from './danceClient';
+
+export const descriptor: ModelDescriptor<DanceClient> = {
+  kind: 'aclstm',
+  shortName: 'acLSTM',
+  labels: { aclstm: 'acLSTM', 'aclstm-vanilla': 'vanilla LSTM (baseline)' },
+  capabilities: ['generate', 'dance'],
+  createClient: (entry, threads) => new DanceClient({ model: entry.id, threads }),
+
+  generate: {
+    options: ['model', 'style', 'frames', 'seed'],
+    // Dance models have no sampling and no refiner: say so rather than silently ignoring the option.
+    refused: {
+      temperature: 'temperature is not meaningful for acLSTM models: they are deterministic (the seed only picks the seed motion); leave it out',
+      refine: 'refine is not available for acLSTM models (there is no refiner for dance); leave it out',
+    },
+    check(o, entry) {
+      const styles = entry.styles ?? [];
+      if (o.style === undefined) throw new TypeError(`style is required for model "${entry.id}" (styles: ${styles.join(', ')})`);
+      if (typeof o.style !== 'string' || !styles.includes(o.style)) {
+        throw new RangeError(`unknown style ${describeValue(o.style)} for model "${entry.id}" (styles: ${styles.join(', ')})`);
+      }
+      return { style: o.style };
+    },
+    async run(client, { style, seed, frames }, { signal }) {
+      return motionOf(await client.generate({ style: style as string, seed, frames }, { signal }));
+    },
+  },
+};
