@@ -19,7 +19,7 @@ import { describeValue } from '../motion/describe';
 import { loadManifest, type ModelInfo } from '../model/manifest';
 import { assetUrl } from '../runtime/worker/assetBase';
 import { checkCleanupOptions, type CleanupMethod, type CleanupStats } from '../runtime/cleanup/cleanup';
-import type { Capability, GenerateCall, ModelDescriptor } from '../runtime/descriptor';
+import type { Capability, GenerateCall, ModelDescriptor, PathStats } from '../runtime/descriptor';
 import { Registry, type RegisteredModel } from '../runtime/registry';
 import { mapSkeleton } from '../motion/skeletonMap';
 import { addNoise as addNoiseTo, checkNoiseOptions, type NoiseOptions } from '../motion/noise';
@@ -97,21 +97,8 @@ export interface FollowPathOptions extends CancellableOptions {
   footLock?: boolean;
 }
 
-export interface FollowPathStats {
-  /** Mean and largest distance from the root (on the ground) to the path over all frames, metres. */
-  meanError: number;
-  maxError: number;
-  /** Share of the path's length the character covered (0…1). */
-  arcProgress: number;
-  /** Wall-clock milliseconds the optimisation took. */
-  optimizeMs: number;
-  /** Foot skating (m/s, mean planted-toe speed by the returned contacts) of the motion, and of the motion before the foot lock (by the model's own contact bits). */
-  skating: number;
-  skatingBeforeLock: number;
-  /** Foot sliding (m/s): the lowest foot point's horizontal speed while within 4 cm of the floor (no contacts needed), the same two. */
-  sliding: number;
-  slidingBeforeLock: number;
-}
+/** How well a walk follows its path, and its foot skating and sliding (web/runtime/descriptor.ts PathStats). */
+export type FollowPathStats = PathStats;
 
 export type FollowedPathMotion = Motion & { contacts: Uint8Array; stats: FollowPathStats };
 

@@ -55,6 +55,16 @@ export interface LatentErdInfo {
   report?: Record<string, unknown>;
 }
 
+/** How a manifold row is laid out (the autoencoder's and the VAE-LSTM's files alike). */
+export interface ManifoldRowsInfo {
+  dim: number;
+  /** [start, end) of the joint positions (root facing frame: x left, y up, z forward), the control and the contacts. */
+  positions: [number, number];
+  control: [number, number];
+  contacts: [number, number];
+  joints: string[];
+}
+
 export interface ManifoldInfo {
   id: string;
   kind: string;
@@ -70,14 +80,7 @@ export interface ManifoldInfo {
     /** Rest offsets, joints × [x, y, z] (metres). */
     offsets: number[][];
   };
-  rows: {
-    dim: number;
-    /** [start, end) of the joint positions (root facing frame: x left, y up, z forward), the control and the contacts. */
-    positions: [number, number];
-    control: [number, number];
-    contacts: [number, number];
-    joints: string[];
-  };
+  rows: ManifoldRowsInfo;
   normalisation: { mean: number[]; std: number[] };
   report?: Record<string, unknown>;
 }

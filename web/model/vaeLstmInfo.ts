@@ -2,7 +2,7 @@
 // its four ONNX graphs (the cell over one chunk of steps, the control encoder, the canvas decoder, the
 // inference network) and their input and output names, the skeleton, the 80-value row layout and its
 // normalisation. The parse checks what the runtime relies on and names the file and the first bad field.
-import { checkRowLayout } from './latentErdInfo';
+import { checkRowLayout, type ManifoldRowsInfo } from './latentErdInfo';
 import { modelInfoFormat } from './modelInfo';
 
 export const VAE_LSTM_GRAPHS = {
@@ -61,14 +61,7 @@ export interface VaeLstmInfo {
   stride?: VaeLstmStride;
   onnx: Record<VaeLstmGraph, { inputs: string[]; outputs: string[] }>;
   skeleton: { joints: string[]; parents: number[]; offsets: number[] };
-  rows: {
-    dim: number;
-    /** [start, end) of the joint positions (root facing frame: x left, y up, z forward), the control and the contacts. */
-    positions: [number, number];
-    control: [number, number];
-    contacts: [number, number];
-    joints: string[];
-  };
+  rows: ManifoldRowsInfo;
   normalisation: { mean: number[]; std: number[] };
   parity_max_abs?: Record<string, number>;
   report?: Record<string, unknown>;

@@ -2,6 +2,7 @@
 // the rule that only a left-out option takes its default (`optional`), shared by the page API (web/api) and
 // the generator worker, so both reject a bad value the same way.
 import { describeValue } from '../motion/describe';
+import { checkPathPoints, GroundPath, relativeToStart, type GroundPoint } from './path';
 import type { Gait } from './pathFollower';
 
 export const MAX_SIMULATED_SECONDS = 600;
@@ -34,4 +35,24 @@ export function checkFitSigma(value: unknown, name = 'fitSigma'): number {
 export function checkSeconds(seconds: unknown): number {
   if (typeof seconds !== 'number' || !(seconds > 0 && seconds <= MAX_SIMULATED_SECONDS)) throw new RangeError(`seconds must be a number above 0 and at most ${MAX_SIMULATED_SECONDS}, got ${describeValue(seconds)}`);
   return seconds;
+}
+
+/**
+ * What every path follower's worker checks alike (each checks its own option beside it): the points, gait,
+ * seed and foot lock; and the ground path it follows near the origin (smoothed when `stroke`: hand-drawn),
+ * to be moved back to `origin`, where the path starts.
+ */
+export function checkFollowRequest(p: { points: unknown; gait: unknown; seed: unknown; footLock?: unknown; stroke?: boolean }): {
+  gait: Gait;
+  seed: number;
+  lock: boolean;
+  origin: GroundPoint;
+  ground: GroundPath;
+} {
+  const points = checkPathPoints(p.points);
+  const gait = checkGait(p.gait);
+  const seed = checkSeed(p.seed);
+  const lock = checkFootLock(p.footLock);
+  const { origin, local } = relativeToStart(points);
+  return { gait, seed, lock, origin, ground: p.stroke ? GroundPath.fromStroke(local) : GroundPath.fromPoints(local) };
 }

@@ -9,7 +9,10 @@ import type { ModelInfo } from '../model/manifest';
 import type { Gait } from '../optimizer/pathFollower';
 import type { CleanupMethod, CleanupResult } from './cleanup/cleanup';
 import type { DenoiseParams } from './cleanup/cleanupRequests';
-import type { ModelSkeleton, ProgressOptions, RequestOptions } from './worker/workerClient';
+import type { FollowPathRequest, PathStats } from './worker/protocol';
+import type { ModelFileOptions, ModelSkeleton, ProgressOptions, RequestOptions } from './worker/workerClient';
+
+export type { PathStats };
 
 /**
  * What a model can do, and so where the page offers it:
@@ -37,26 +40,9 @@ export interface GenerateCall {
   [option: string]: unknown;
 }
 
-/** How a motion that was made on a path or under control is measured (docs/api.md FollowPathStats). */
-export interface PathStats {
-  meanError: number;
-  maxError: number;
-  arcProgress: number;
-  optimizeMs: number;
-  skating: number;
-  skatingBeforeLock: number;
-  sliding: number;
-  slidingBeforeLock: number;
-}
 
 /** A path to walk, checked (optimizer/path.ts), with the model's own option (fitSigma or speed) added by its check. */
-export interface PathRequest {
-  points: [number, number][];
-  gait: Gait;
-  seed: number;
-  footLock?: boolean;
-  /** A stroke drawn on the page (kept as drawn rather than smoothed for the API). */
-  stroke?: boolean;
+export interface PathRequest extends FollowPathRequest {
   fitSigma?: number;
   speed?: number;
 }
@@ -155,6 +141,11 @@ export interface ModelDescriptor<C extends ModelClientBase = ModelClientBase> {
     loading: string;
     run(client: C, params: DenoiseParams, options: ProgressOptions): Promise<CleanupResult>;
   };
+}
+
+/** A listed model's client options: its files, models/<id>.onnx and models/<id>.json beside the page, and its threads. */
+export function clientFiles(entry: ModelInfo, threads: number): ModelFileOptions {
+  return { threads, modelUrl: `models/${entry.id}.onnx`, infoUrl: `models/${entry.id}.json` };
 }
 
 /** The public stats of a walk (a worker's stats carry more). */

@@ -11,7 +11,7 @@ import { PlantedFeet } from '../../motion/footLock';
 import { decodeDance, type DanceRoot } from './danceDecode';
 import { seedsOfStyle, type DanceInfo } from './danceModel';
 import type { DanceChunk, DanceGenerateParams, DanceInitResult, DanceParityResult, DanceStepInputs, DanceStepOutputs, DanceStreamInfo, DanceStreamParams } from './danceProtocol';
-import type { BenchmarkResult } from '../generator/protocol';
+import type { BenchmarkResult } from '../worker/protocol';
 import { denormalise } from '../../model/sampler';
 import { checkFrameCount, SessionCore, timeSteps } from '../worker/session';
 

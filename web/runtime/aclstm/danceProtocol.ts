@@ -1,6 +1,6 @@
 // Messages between DanceClient (main thread) and dance.worker.ts. Every request carries an id; the
 // worker answers each with exactly one WorkerReply carrying the same id (see protocol.ts).
-import type { BenchmarkResult } from '../generator/protocol';
+import type { BenchmarkResult, FittedModelInit } from '../worker/protocol';
 
 export type { BenchmarkResult };
 
@@ -37,18 +37,7 @@ export interface DanceSeedInfo {
   name: string;
 }
 
-export interface DanceInitResult {
-  ok: true;
-  /** Threads onnxruntime-web runs with. */
-  threads: number;
-  /** Milliseconds to fetch and check the JSON and model and create the session. */
-  loadMs: number;
-  id: string;
-  fps: number;
-  joints: string[];
-  parents: number[];
-  /** joints × 3 rest offsets (metres), the skeleton the fitted frames keep. */
-  offsets: number[];
+export interface DanceInitResult extends FittedModelInit {
   styles: string[];
   /** Every seed motion, in file order (`seed` counts within one style's). */
   seeds: DanceSeedInfo[];

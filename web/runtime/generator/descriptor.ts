@@ -4,7 +4,7 @@
 
 import { checkFitSigma, optional } from '../../optimizer/options';
 import { describeValue } from '../../motion/describe';
-import { motionOf, pathStatsOf, type ModelDescriptor } from '../descriptor';
+import { clientFiles, motionOf, pathStatsOf, type ModelDescriptor } from '../descriptor';
 import { GeneratorClient } from './generatorClient';
 
 /** Sampling temperature when generate's is left out (docs/api.md). */
@@ -17,7 +17,7 @@ export const descriptor: ModelDescriptor<GeneratorClient> = {
   shortName: 'generator',
   labels: { generator: 'Generator + MAP optimiser' },
   capabilities: ['generate', 'walk', 'followPath', 'liveControl', 'cleanup'],
-  createClient: (entry, threads) => new GeneratorClient({ threads, modelUrl: `models/${entry.id}.onnx`, infoUrl: `models/${entry.id}.json` }),
+  createClient: (entry, threads) => new GeneratorClient(clientFiles(entry, threads)),
 
   generate: {
     options: ['model', 'frames', 'seed', 'temperature', 'refine'],

@@ -4,27 +4,10 @@ import type { CleanupResult } from '../cleanup/cleanup';
 import type { DenoiseParams } from '../cleanup/cleanupRequests';
 import type { StepInputs } from '../../model/generatorInfo';
 import type { Motion } from '../../motion/types';
-import type {
-  BenchmarkResult,
-  ControlChunkReply,
-  ControlStartParams,
-  ControlTargetParams,
-  FollowPathChunk,
-  FollowPathParams,
-  GeneratedChunk,
-  GenerateParams,
-  InitResult,
-  ParityResult,
-  RefinedFrames,
-  RefinerParityResult,
-  RefinerStepInputs,
-  SimulateControlParams,
-  SimulatedControlChunk,
-  StreamInfo,
-  StreamParams,
-} from './protocol';
+import type { ControlChunkReply, ControlStartParams, ControlTargetParams, FollowPathChunk, FollowPathParams, GeneratedChunk, GenerateParams, InitResult, ParityResult, RefinedFrames, RefinerParityResult, RefinerStepInputs, SimulateControlParams, SimulatedControlChunk, StreamInfo, StreamParams } from './protocol';
+import type { BenchmarkResult } from '../worker/protocol';
 import { sharedDownload } from '../worker/sharedDownloads';
-import { ModelClient, type ProgressOptions, type RequestOptions } from '../worker/workerClient';
+import { ModelClient, modelFiles, type ModelFileOptions, type ProgressOptions, type RequestOptions } from '../worker/workerClient';
 
 export type {
   BenchmarkResult,
@@ -51,35 +34,18 @@ export type SimulatedControl = GeneratedMotion &
   Pick<SimulatedControlChunk, 'speed' | 'heading' | 'targetSpeed' | 'targetHeading' | 'computeMs' | 'batchMs' | 'batchFrames'>;
 
 /** Generated frames as a Motion, with the generator's extras. */
-export type GeneratedMotion = Motion & {
-  contacts: Uint8Array;
-  /** frames × D feature rows in physical units. */
-  features: Float32Array;
-  rootHeading: Float32Array;
-  seedIndex: number;
-  /** Index of the first frame within its stream (0 for `generate`). */
-  startFrame: number;
-  /** With `refine`: the same frames refined and foot-locked (the Motion fields above stay the raw frames). */
-  refined?: RefinedFrames;
-};
+/**
+ * Generated frames as a Motion (the raw frames, with their contacts), with the chunk's extras: the feature rows,
+ * headings, seed, `startFrame`, and with `refine` the same frames refined and foot-locked (`refined`).
+ */
+export type GeneratedMotion = Motion & Omit<GeneratedChunk, 'frames' | 'positions'>;
 
-export interface GeneratorClientOptions {
-  /** Defaults resolve against the page: models/generator.onnx and models/generator.json. */
-  modelUrl?: string;
-  infoUrl?: string;
-  /** onnxruntime-web threads when the page is cross-origin isolated (default 2); without isolation always 1. */
-  threads?: number;
-  /** Gives up on the worker (rejecting `init` and later calls) if `init` has no answer by then: a stalled download or wasm. */
-  initTimeoutMs?: number;
-}
+/** Left out: models/generator.onnx and models/generator.json. */
+export type GeneratorClientOptions = ModelFileOptions;
 
 export class GeneratorClient extends ModelClient<StreamParams, InitResult, GeneratedChunk, StreamInfo, ParityResult, StepInputs, GeneratedMotion> {
   constructor(options: GeneratorClientOptions = {}) {
-    super(new Worker(new URL('./generator.worker.ts', import.meta.url), { type: 'module', name: 'generator' }), 'generator', {
-      ...options,
-      modelUrl: options.modelUrl ?? 'models/generator.onnx',
-      infoUrl: options.infoUrl ?? 'models/generator.json',
-    });
+    super(new Worker(new URL('./generator.worker.ts', import.meta.url), { type: 'module', name: 'generator' }), 'generator', modelFiles('generator', options));
   }
 
   /** Also the refiner's ONNX file (named in refiner.json beside the generator's JSON), for the first refined stream. */
@@ -146,14 +112,7 @@ export class GeneratorClient extends ModelClient<StreamParams, InitResult, Gener
   }
 
   protected toMotion(chunk: GeneratedChunk): GeneratedMotion {
-    return {
-      ...this.motionOf(chunk),
-      contacts: chunk.contacts,
-      features: chunk.features,
-      rootHeading: chunk.rootHeading,
-      seedIndex: chunk.seedIndex,
-      startFrame: chunk.startFrame,
-      ...(chunk.refined ? { refined: chunk.refined } : {}),
-    };
+    return this.chunkMotion(chunk);
   }
+
 }

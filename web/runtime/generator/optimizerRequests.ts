@@ -5,9 +5,9 @@
 // passes a checkpoint, cancellation.ts); a controlPull that has started runs whole, so the live stream
 // always stands where its last reply left it.
 import { followPath, gaitSeeds, type Gait } from '../../optimizer/pathFollower';
-import { checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed, optional } from '../../optimizer/options';
+import { checkFollowRequest, checkFitSigma, checkFootLock, checkGait, checkSeconds, checkSeed, optional } from '../../optimizer/options';
 import { checkSchedule, LiveController, simulateControl } from '../../optimizer/liveControl';
-import { checkPathPoints, GroundPath, moveBack, relativeToStart } from '../../optimizer/path';
+import { moveBack } from '../../optimizer/path';
 import { PlantedFeet, plantFeet } from '../../motion/footLock';
 import { footStats } from '../../motion/footSkating';
 import type { StepFn } from '../../optimizer/rollout';
@@ -48,14 +48,9 @@ export class OptimizerRequests {
   }
 
   async followPath(p: FollowPathParams, progress: (fraction: number) => void, signal?: AbortSignal): Promise<FollowPathChunk> {
-    const points = checkPathPoints(p.points);
-    const gait = checkGait(p.gait);
-    const seed = checkSeed(p.seed);
-    const fitSigma = checkFitSigma(optional(p.fitSigma, 0.1));
-    const lock = checkFootLock(p.footLock);
     // Followed, locked and measured near the origin; moved back to where the path is last.
-    const { origin, local } = relativeToStart(points);
-    const path = p.stroke ? GroundPath.fromStroke(local) : GroundPath.fromPoints(local);
+    const { gait, seed, lock, origin, ground: path } = checkFollowRequest(p);
+    const fitSigma = checkFitSigma(optional(p.fitSigma, 0.1));
     const info = this.core.info;
     const r = await followPath({ step: this.stepFn(signal), info, mean: this.core.mean, std: this.core.std, path, gait, seed, fitSigma, onProgress: progress });
     const shown = lock ? this.plant(r.positions, r.contacts) : { positions: r.positions, contacts: r.contacts };

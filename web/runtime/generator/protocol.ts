@@ -1,7 +1,7 @@
-// Messages between GeneratorClient (main thread) and generator.worker.ts. Every request carries an id;
-// the worker answers each with exactly one reply carrying the same id (WorkerReply, also used by the
-// dance worker: danceProtocol.ts).
+// Messages between GeneratorClient (main thread) and generator.worker.ts, beyond those every model worker
+// shares (worker/protocol.ts).
 import type { StepOutputs } from '../../model/generatorInfo';
+import type { FollowPathRequest, FollowPathStatsReply, ModelInit, WorkerReply } from '../worker/protocol';
 
 export interface GenerateParams {
   frames: number;
@@ -17,26 +17,7 @@ export interface GenerateParams {
 
 export type StreamParams = Omit<GenerateParams, 'frames'>;
 
-/** The requests every model worker understands (ortWorker.ts serveModel); `P` is the model's stream parameters. */
-export type ModelRequest<P, Inputs> =
-  /** threads: onnxruntime-web wasm threads when cross-origin isolated (default 2; always 1 otherwise). */
-  | { type: 'init'; modelUrl: string; infoUrl: string; threads?: number }
-  | ({ type: 'generate'; frames: number } & P)
-  | ({ type: 'startStream' } & P)
-  | { type: 'pull'; frames: number }
-  | { type: 'restart' }
-  | { type: 'benchmark'; batch: number; steps: number }
-  | { type: 'parity'; inputs?: Inputs };
-
-export interface InitResult {
-  ok: true;
-  /** Threads onnxruntime-web runs with (by default 2 when the page is cross-origin isolated, else 1). */
-  threads: number;
-  /** Milliseconds to fetch and check the JSON and model and create the session. */
-  loadMs: number;
-  fps: number;
-  joints: string[];
-  parents: number[];
+export interface InitResult extends ModelInit {
   dim: number;
   seeds: string[];
 }
@@ -99,74 +80,18 @@ export interface StreamInfo {
   seedName: string;
 }
 
-export interface BenchmarkResult {
-  batch: number;
-  steps: number;
-  threads: number;
-  /** Session calls per second. */
-  stepsPerSecond: number;
-  msPerCall: number;
-  /** stepsPerSecond × batch: frames generated per second across the batch. */
-  particleStepsPerSecond: number;
-}
+/** The generator worker's replies (the same shape as every model worker's). */
+export type GeneratorReply = WorkerReply;
 
 export interface ParityResult {
   inputs: { batch: number; x: Float32Array; h: Float32Array; c: Float32Array };
   outputs: StepOutputs;
 }
 
-/**
- * A worker's answer to one request (the same shape for every model worker). A cancelled request's error
- * reply has `name` "AbortError" (cancellation.ts).
- */
-export type WorkerReply = { id: number; ok: true; result: unknown } | { id: number; ok: false; error: string; name?: string };
-/**
- * Asks the worker to cancel request `request` (the id it was sent with); not itself answered. A queued
- * request is dropped without running and answered with an AbortError reply; a running one stops at its
- * next checkpoint (requestLoop.ts) and is answered so too, or, having none left, is answered as usual.
- */
-export interface CancelMessage {
-  type: 'cancel';
-  request: number;
-}
-/** Sent any number of times before a long request's reply: the share done (0…1). */
-export interface WorkerProgress {
-  id: number;
-  progress: number;
-}
-export type WorkerMessage = WorkerReply | WorkerProgress;
-export type GeneratorReply = WorkerReply;
-
-/** Id of replies that are about the worker as a whole (an uncaught error), not one request. */
-export const WORKER_ERROR_ID = -1;
-
 /** Generator worker only: follow a ground path (web/optimizer/pathFollower.ts). */
-export interface FollowPathParams {
-  /** [x, z] pairs, metres. */
-  points: [number, number][];
-  gait: 'walk' | 'run';
-  seed: number;
+export interface FollowPathParams extends FollowPathRequest {
   /** σ_fit (m) of the path-fit term; default 0.1. */
   fitSigma?: number;
-  /** The points are a hand-drawn stroke: drop jitter and smooth before following. */
-  stroke?: boolean;
-  /** Clean planted feet with the foot lock (web/motion/footLock.ts; default true). The root is not moved. */
-  footLock?: boolean;
-}
-
-export interface FollowPathStatsReply {
-  meanError: number;
-  maxError: number;
-  arcProgress: number;
-  optimizeMs: number;
-  windows: number;
-  particleSteps: number;
-  /** Foot skating (m/s, planted toe speed by the contacts returned) of the returned motion and of the motion before the foot lock (by the model's bits). */
-  skating: number;
-  skatingBeforeLock: number;
-  /** Foot sliding (m/s, the lowest foot point's speed within 4 cm of the floor; footSkating.ts lowFootSliding), the same two. */
-  sliding: number;
-  slidingBeforeLock: number;
 }
 
 export interface FollowPathChunk extends GeneratedChunk {

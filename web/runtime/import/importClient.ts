@@ -7,7 +7,7 @@ import { MotionFormatError, type Motion } from '../../motion/types';
 import { CancelledError } from '../worker/cancellation';
 import type { ImportError, ImportReply, ImportRequest, ImportRequestBody, ImportResult } from './importProtocol';
 import type { FileImportOutcome, ProgressListener } from './motionFiles';
-import type { CancelMessage } from '../generator/protocol';
+import type { CancelMessage } from '../worker/protocol';
 import type { RequestOptions } from '../worker/workerClient';
 
 /** The worker's error rebuilt on the page: a MotionFormatError again (format and line kept) when it was one, else an Error of its name. */

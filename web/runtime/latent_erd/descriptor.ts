@@ -5,7 +5,10 @@
 
 import { checkControlSignal } from '../../model/latentErdInfo';
 import { optional } from '../../optimizer/options';
-import { motionOf, pathStatsOf, type ModelDescriptor } from '../descriptor';
+import type { Motion } from '../../motion/types';
+import type { Gait } from '../../optimizer/pathFollower';
+import { clientFiles, motionOf, pathStatsOf, type ModelClientBase, type ModelDescriptor, type PathStats } from '../descriptor';
+import type { ProgressOptions, RequestOptions } from '../worker/workerClient';
 import { LatentErdClient } from './latentErdClient';
 import { checkPathSpeed, LATENT_PATH_SPEED } from './latentErdRequests';
 
@@ -13,41 +16,48 @@ import { checkPathSpeed, LATENT_PATH_SPEED } from './latentErdRequests';
 const LIVE_CHUNK = 4;
 const LIVE_AHEAD = 8;
 
-/** generate's and followPath's options of a model driven by a control signal (the latent ERD, the VAE-LSTM). */
-export const controlledOptions = {
-  generate: {
-    options: ['model', 'frames', 'seed', 'control'],
-    check: (o: Record<string, unknown>) => (o.control === undefined ? {} : { control: checkControlSignal(o.control, o.frames as number) }),
-  },
-  followPath: {
-    options: ['speed'],
-    check: (o: Record<string, unknown>, gait: 'walk' | 'run') => ({ speed: checkPathSpeed(optional(o.speed, LATENT_PATH_SPEED[gait])) }),
-  },
-} as const;
+/** What the clients of models driven by a control signal (the latent ERD, the VAE-LSTM) answer alike. */
+interface ControlledClient extends ModelClientBase {
+  generate(params: { seed: number; frames: number; control?: Float64Array }, options: RequestOptions): Promise<Motion>;
+  followPath(
+    params: { points: [number, number][]; gait: Gait; seed: number; speed?: number; footLock?: boolean; stroke?: boolean },
+    options: ProgressOptions,
+  ): Promise<Motion & { path: Float32Array; stats: PathStats }>;
+}
+
+/**
+ * generate and followPath of a model driven by a control signal: generate takes an optional per-frame control,
+ * followPath a speed; `working` is Path mode's progress line.
+ */
+export function controlledModel<C extends ControlledClient>(working: string): Required<Pick<ModelDescriptor<C>, 'generate' | 'followPath'>> {
+  return {
+    generate: {
+      options: ['model', 'frames', 'seed', 'control'],
+      check: (o) => (o.control === undefined ? {} : { control: checkControlSignal(o.control, o.frames as number) }),
+      async run(client, { seed, frames, control }, { signal }) {
+        return motionOf(await client.generate({ seed, frames, ...(control ? { control: control as Float64Array } : {}) }, { signal }));
+      },
+    },
+    followPath: {
+      options: ['speed'],
+      check: (o, gait) => ({ speed: checkPathSpeed(optional(o.speed, LATENT_PATH_SPEED[gait])) }),
+      async run(client, { points, gait, seed, speed, footLock, stroke }, options) {
+        const m = await client.followPath({ points, gait, seed, speed, ...(footLock === undefined ? {} : { footLock }), ...(stroke ? { stroke } : {}) }, options);
+        return { motion: motionOf(m), path: m.path, stats: pathStatsOf(m.stats) };
+      },
+      working: () => working,
+    },
+  };
+}
 
 export const descriptor: ModelDescriptor<LatentErdClient> = {
   kind: 'latent-erd',
   shortName: 'latent ERD',
   labels: { 'latent-erd': 'Latent ERD' },
   capabilities: ['generate', 'followPath', 'liveControl', 'cleanup'],
-  createClient: (entry, threads) => new LatentErdClient({ threads, modelUrl: `models/${entry.id}.onnx`, infoUrl: `models/${entry.id}.json` }),
+  createClient: (entry, threads) => new LatentErdClient(clientFiles(entry, threads)),
 
-  generate: {
-    ...controlledOptions.generate,
-    async run(client, { seed, frames, control }, { signal }) {
-      const m = await client.generate({ seed, frames, ...(control ? { control: control as Float64Array } : {}) }, { signal });
-      return motionOf(m);
-    },
-  },
-
-  followPath: {
-    ...controlledOptions.followPath,
-    async run(client, { points, gait, seed, speed, footLock, stroke }, options) {
-      const m = await client.followPath({ points, gait, seed, speed, ...(footLock === undefined ? {} : { footLock }), ...(stroke ? { stroke } : {}) }, options);
-      return { motion: motionOf(m), path: m.path, stats: pathStatsOf(m.stats) };
-    },
-    working: () => 'the latent ERD walks the path',
-  },
+  ...controlledModel<LatentErdClient>('the latent ERD walks the path'),
 
   liveControl: {
     chunk: LIVE_CHUNK,

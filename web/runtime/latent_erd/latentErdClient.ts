@@ -18,49 +18,28 @@ import type {
   LatentStreamInfo,
   LatentStreamParams,
 } from './latentErdProtocol';
-import { ModelClient, type ProgressOptions, type RequestOptions } from '../worker/workerClient';
+import { ModelClient, modelFiles, type ModelFileOptions, type ProgressOptions, type RequestOptions } from '../worker/workerClient';
 
 export type { LatentErdInitResult, LatentFollowPathParams, LatentParityInputs, LatentParityResult, LatentSimulateControlParams, LatentStreamInfo, LatentStreamParams };
 
-/** Emitted frames as a Motion (fitted, foot-locked positions and the decoded contacts), with the ERD's extras. */
-export type LatentMotion = Motion & {
-  contacts: Uint8Array;
-  /** frames × joints × 3: the decoded points before the skeleton fit. */
-  predicted: Float32Array;
-  /** frames × rows.dim physical decoded rows. */
-  rows: Float32Array;
-  /** frames × 3: x, z, heading of the root. */
-  roots: Float64Array;
-  rootHeading: Float32Array;
-  /** frames × 3: the control each frame was emitted for. */
-  control: Float32Array;
-  seedIndex: number;
-  startFrame: number;
-  erdCalls: number;
-  computeMs: number;
-};
+/**
+ * Emitted frames as a Motion (fitted, foot-locked positions and the decoded contacts), with the ERD's extras:
+ * the decoded points before the fit (`predicted`), the rows, the roots and headings, the control each frame was
+ * emitted for, the seed, `startFrame`, and the calls and time it took.
+ */
+export type LatentMotion = Motion & Omit<LatentChunk, 'frames' | 'positions'>;
 
 export type LatentFollowedPath = LatentMotion & Pick<LatentFollowPathChunk, 'stats' | 'path'>;
 export type LatentControlledMotion = LatentMotion & Pick<LatentControlChunk, 'speed' | 'heading'>;
 export type LatentSimulatedControl = LatentMotion &
   Pick<LatentSimulatedControlChunk, 'speed' | 'heading' | 'targetSpeed' | 'targetHeading' | 'computeMsPerFrame' | 'batchMs' | 'batchFrames'>;
 
-export interface LatentErdClientOptions {
-  /** Defaults resolve against the page: models/latent-erd.onnx and models/latent-erd.json (which names manifold.json). */
-  modelUrl?: string;
-  infoUrl?: string;
-  threads?: number;
-  initTimeoutMs?: number;
-}
+/** Left out: models/latent-erd.onnx and models/latent-erd.json (which names manifold.json). */
+export type LatentErdClientOptions = ModelFileOptions;
 
 export class LatentErdClient extends ModelClient<LatentStreamParams, LatentErdInitResult, LatentChunk, LatentStreamInfo, LatentParityResult, LatentParityInputs, LatentMotion> {
   constructor(options: LatentErdClientOptions = {}) {
-    super(new Worker(new URL('./latentErd.worker.ts', import.meta.url), { type: 'module', name: 'latent-erd' }), 'latent-erd', {
-      threads: options.threads,
-      initTimeoutMs: options.initTimeoutMs,
-      modelUrl: options.modelUrl ?? 'models/latent-erd.onnx',
-      infoUrl: options.infoUrl ?? 'models/latent-erd.json',
-    });
+    super(new Worker(new URL('./latentErd.worker.ts', import.meta.url), { type: 'module', name: 'latent-erd' }), 'latent-erd', modelFiles('latent-erd', options));
   }
 
   /** One raw ERD step and/or one decoder call (tests/fixtures/latent_erd_reference.json's `step.inputs` and `decode`). */
@@ -98,18 +77,7 @@ export class LatentErdClient extends ModelClient<LatentStreamParams, LatentErdIn
   }
 
   protected toMotion(chunk: LatentChunk): LatentMotion {
-    return {
-      ...this.motionOf(chunk),
-      contacts: chunk.contacts,
-      predicted: chunk.predicted,
-      rows: chunk.rows,
-      roots: chunk.roots,
-      rootHeading: chunk.rootHeading,
-      control: chunk.control,
-      seedIndex: chunk.seedIndex,
-      startFrame: chunk.startFrame,
-      erdCalls: chunk.erdCalls,
-      computeMs: chunk.computeMs,
-    };
+    return this.chunkMotion(chunk);
   }
+
 }

@@ -31,7 +31,7 @@ import type {
   LatentStreamInfo,
   LatentStreamParams,
 } from './latentErdProtocol';
-import type { BenchmarkResult } from '../generator/protocol';
+import type { BenchmarkResult } from '../worker/protocol';
 import { checkFrameCount, SessionCore, timeSteps } from '../worker/session';
 
 /** The ERD step session (latent normalisation as its normalisation: the session base wants one). */

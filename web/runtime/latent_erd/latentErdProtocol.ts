@@ -4,7 +4,7 @@
 // serves the latent ERD's control requests: followPath, controlStart / controlPull (Steer mode) and
 // simulateControl.
 import type { Gait } from '../../optimizer/pathFollower';
-import type { FollowPathStatsReply } from '../generator/protocol';
+import type { FittedModelInit, FollowPathRequest, FollowPathStatsReply } from '../worker/protocol';
 
 export interface LatentStreamParams {
   /** Picks the seed state: seed mod the number of seeds (of the gait's category when `gait` is given). */
@@ -61,16 +61,7 @@ export interface LatentSeedInfo {
   category: string;
 }
 
-export interface LatentErdInitResult {
-  ok: true;
-  threads: number;
-  loadMs: number;
-  id: string;
-  fps: number;
-  joints: string[];
-  parents: number[];
-  /** joints × 3 rest offsets (metres): the skeleton the fitted frames keep. */
-  offsets: number[];
+export interface LatentErdInitResult extends FittedModelInit {
   pooling: number;
   radius: number;
   lookahead: number;
@@ -110,14 +101,9 @@ export interface LatentChunk {
   computeMs: number;
 }
 
-export interface LatentFollowPathParams {
-  points: [number, number][];
-  gait: Gait;
-  seed: number;
+export interface LatentFollowPathParams extends FollowPathRequest {
   /** Forward speed asked for (m/s); default 1.2 for walk, 2.8 for run. */
   speed?: number;
-  stroke?: boolean;
-  footLock?: boolean;
 }
 
 export interface LatentFollowPathChunk extends LatentChunk {

@@ -12,8 +12,8 @@ import { controlAlongPath, controlTowardHeading, PolylinePath, type Control } fr
 import { plantFeet } from '../../motion/footLock';
 import { footStats } from '../../motion/footSkating';
 import { checkSchedule, checkTarget, SPEED_WINDOW, type ControlTarget } from '../../optimizer/liveControl';
-import { checkFootLock, checkGait, checkSeconds, checkSeed, optional } from '../../optimizer/options';
-import { angleDifference, checkPathPoints, GroundPath, moveBack, relativeToStart } from '../../optimizer/path';
+import { checkFollowRequest, checkFootLock, checkGait, checkSeconds, checkSeed, optional } from '../../optimizer/options';
+import { angleDifference, moveBack } from '../../optimizer/path';
 import { pathErrors, type Gait } from '../../optimizer/pathFollower';
 import { describeValue } from '../../motion/describe';
 import type { LatentErdCore, LatentErdStream } from './latentErdCore';
@@ -104,16 +104,11 @@ export class LatentErdRequests {
 
   async followPath(p: LatentFollowPathParams, progress: (fraction: number) => void, signal?: AbortSignal): Promise<LatentFollowPathChunk> {
     const started = performance.now();
-    const points = checkPathPoints(p.points);
-    const gait = checkGait(p.gait);
-    const seed = checkSeed(p.seed);
+    // Followed, locked and measured near the origin; moved back to where the path is last (as the generator's).
+    const { gait, seed, lock, origin, ground } = checkFollowRequest(p);
     const speed = checkPathSpeed(optional(p.speed, LATENT_PATH_SPEED[gait]));
-    const lock = checkFootLock(p.footLock);
     const core = this.core;
     const { fps, pooling } = core.layout;
-    // Followed, locked and measured near the origin; moved back to where the path is last (as the generator's).
-    const { origin, local } = relativeToStart(points);
-    const ground = p.stroke ? GroundPath.fromStroke(local) : GroundPath.fromPoints(local);
     const path = new PolylinePath(ground.points());
     const s = await core.createStream({ seed, gait, footLock: false }, signal, { root: { x: ground.xs[0], z: ground.zs[0], heading: ground.headingAt(0) } });
     // As the generator's follower: 2.5× the time the pace needs, and 2 s, before giving up.

@@ -10,7 +10,7 @@ import type {
   VaeLstmParityInputs,
   VaeLstmParityResult,
 } from './vaeLstmProtocol';
-import { ModelClient, type ProgressOptions } from '../worker/workerClient';
+import { ModelClient, modelFiles, type ModelFileOptions, type ProgressOptions } from '../worker/workerClient';
 
 export type { VaeLstmFollowPathParams, VaeLstmGenerateParams, VaeLstmInitResult, VaeLstmParityInputs, VaeLstmParityResult };
 
@@ -18,24 +18,14 @@ export type { VaeLstmFollowPathParams, VaeLstmGenerateParams, VaeLstmInitResult,
 export type VaeLstmMotion = Motion & Omit<VaeLstmChunk, 'frames' | 'positions'>;
 export type VaeLstmFollowedPath = VaeLstmMotion & Pick<VaeLstmFollowPathChunk, 'stats' | 'path'>;
 
-export interface VaeLstmClientOptions {
-  /** Defaults resolve against the page: models/vae-lstm.onnx and models/vae-lstm.json (which names the other graphs). */
-  modelUrl?: string;
-  infoUrl?: string;
-  threads?: number;
-  initTimeoutMs?: number;
-}
+/** Left out: models/vae-lstm.onnx and models/vae-lstm.json (which names the other graphs). */
+export type VaeLstmClientOptions = ModelFileOptions;
 
 type GenerateParams = Omit<VaeLstmGenerateParams, 'frames'>;
 
 export class VaeLstmClient extends ModelClient<GenerateParams, VaeLstmInitResult, VaeLstmChunk, never, VaeLstmParityResult, VaeLstmParityInputs, VaeLstmMotion> {
   constructor(options: VaeLstmClientOptions = {}) {
-    super(new Worker(new URL('./vaeLstm.worker.ts', import.meta.url), { type: 'module', name: 'vae-lstm' }), 'vae-lstm', {
-      threads: options.threads,
-      initTimeoutMs: options.initTimeoutMs,
-      modelUrl: options.modelUrl ?? 'models/vae-lstm.onnx',
-      infoUrl: options.infoUrl ?? 'models/vae-lstm.json',
-    });
+    super(new Worker(new URL('./vaeLstm.worker.ts', import.meta.url), { type: 'module', name: 'vae-lstm' }), 'vae-lstm', modelFiles('vae-lstm', options));
   }
 
   /** Raw graph calls and/or a whole generation from z1 (tests/fixtures/vae_lstm_reference.json). */
@@ -50,7 +40,6 @@ export class VaeLstmClient extends ModelClient<GenerateParams, VaeLstmInitResult
   }
 
   protected toMotion(chunk: VaeLstmChunk): VaeLstmMotion {
-    const { frames: _frames, positions: _positions, ...extras } = chunk;
-    return { ...this.motionOf(chunk), ...extras };
+    return this.chunkMotion(chunk);
   }
 }

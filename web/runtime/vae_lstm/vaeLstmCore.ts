@@ -21,7 +21,7 @@ import { plantFeet } from '../../motion/footLock';
 import { Rng } from '../../model/sampler';
 import { withStride } from '../../model/vaeLstmStride';
 import { VAE_LSTM_GRAPHS, type VaeLstmGraph, type VaeLstmInfo, type VaeLstmModel, type Z1Prior } from '../../model/vaeLstmInfo';
-import type { BenchmarkResult } from '../generator/protocol';
+import type { BenchmarkResult } from '../worker/protocol';
 import { checkFrameCount, SessionCore, timeSteps } from '../worker/session';
 import type { VaeLstmChunk, VaeLstmGenerateParams, VaeLstmInitResult, VaeLstmParityInputs, VaeLstmParityResult } from './vaeLstmProtocol';
 

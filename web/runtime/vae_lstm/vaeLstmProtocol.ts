@@ -1,9 +1,9 @@
 // Messages between VaeLstmClient (main thread) and vaeLstm.worker.ts. Every request carries an id; the worker
 // answers each with exactly one WorkerReply carrying the same id (see protocol.ts). The VAE-LSTM makes whole
 // motions (generate, followPath), so it serves no stream: startStream answers with an error saying so.
-import type { Gait } from '../../optimizer/pathFollower';
 import type { VaeLstmGraph } from '../../model/vaeLstmInfo';
-import type { FollowPathStatsReply } from '../generator/protocol';
+import type { LatentFollowPathParams } from '../latent_erd/latentErdProtocol';
+import type { FittedModelInit, FollowPathStatsReply } from '../worker/protocol';
 
 export interface VaeLstmGenerateParams {
   frames: number;
@@ -17,15 +17,7 @@ export interface VaeLstmGenerateParams {
   stride?: boolean;
 }
 
-export interface VaeLstmInitResult {
-  ok: true;
-  threads: number;
-  loadMs: number;
-  id: string;
-  fps: number;
-  joints: string[];
-  parents: number[];
-  offsets: number[];
+export interface VaeLstmInitResult extends FittedModelInit {
   latent: number;
   pooling: number;
   chunkSteps: number;
@@ -60,16 +52,7 @@ export interface VaeLstmChunk {
   computeMs: number;
 }
 
-export interface VaeLstmFollowPathParams {
-  points: [number, number][];
-  gait: Gait;
-  /** Picks z1: another seed, another motion for the same path. */
-  seed: number;
-  /** Forward speed along the path (m/s); default 1.2 for walk, 2.8 for run. */
-  speed?: number;
-  stroke?: boolean;
-  footLock?: boolean;
-}
+export type VaeLstmFollowPathParams = LatentFollowPathParams;
 
 export interface VaeLstmFollowPathChunk extends VaeLstmChunk {
   /** As the other followers': windows are steps of 4 frames, particleSteps cell steps. */

@@ -6,8 +6,8 @@
 // the other followers' return shapes and stats, measured the same way (pathErrors on the hips, footStats).
 import { controlAlongPath, PolylinePath, stepRoot, type Root } from '../../motion/control';
 import { footStats } from '../../motion/footSkating';
-import { checkFootLock, checkGait, checkSeed, optional } from '../../optimizer/options';
-import { checkPathPoints, GroundPath, moveBack, relativeToStart } from '../../optimizer/path';
+import { checkFollowRequest, optional } from '../../optimizer/options';
+import { moveBack } from '../../optimizer/path';
 import { pathErrors } from '../../optimizer/pathFollower';
 import { ARRIVED_SECONDS, checkPathSpeed, LATENT_PATH_SPEED, moveRootsBack } from '../latent_erd/latentErdRequests';
 import type { VaeLstmCore } from './vaeLstmCore';
@@ -33,15 +33,10 @@ export function controlForPath(path: PolylinePath, start: Root, speed: number, f
 
 export async function followPathVae(core: VaeLstmCore, p: VaeLstmFollowPathParams, progress: (fraction: number) => void, signal?: AbortSignal): Promise<VaeLstmFollowPathChunk> {
   const started = performance.now();
-  const points = checkPathPoints(p.points);
-  const gait = checkGait(p.gait);
-  const seed = checkSeed(p.seed);
-  const speed = checkPathSpeed(optional(p.speed, LATENT_PATH_SPEED[gait]));
-  const lock = checkFootLock(p.footLock);
-  const fps = core.fps;
   // Made near the origin and moved back to where the path is (as the other followers).
-  const { origin, local } = relativeToStart(points);
-  const ground = p.stroke ? GroundPath.fromStroke(local) : GroundPath.fromPoints(local);
+  const { gait, seed, lock, origin, ground } = checkFollowRequest(p);
+  const speed = checkPathSpeed(optional(p.speed, LATENT_PATH_SPEED[gait]));
+  const fps = core.fps;
   const path = new PolylinePath(ground.points());
   const start: Root = { x: ground.xs[0], z: ground.zs[0], heading: ground.headingAt(0) };
   // As the other followers: 2.5× the time the pace needs, and 2 s, before giving up.

@@ -5,7 +5,7 @@
 // reply carrying its id, cancellable).
 import * as ort from 'onnxruntime-web/wasm';
 import { ortGlueHref, ortWasmHref } from './ortFiles';
-import { WORKER_ERROR_ID, type ModelRequest } from '../generator/protocol';
+import { WORKER_ERROR_ID, type ModelRequest } from './protocol';
 import type { DownloadReply, DownloadRequest } from './sharedDownloads';
 import { describe, serveRequests, type Progress } from './requestLoop';
 

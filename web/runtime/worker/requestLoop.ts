@@ -3,7 +3,7 @@
 // message drops a queued request without running it, or aborts the running one's signal. The import
 // worker (import.worker.ts) is served by it too, with its own error replies and progress reports.
 import { CANCELLED_ERROR_NAME, CancelledError, isCancelled, nextTask } from './cancellation';
-import type { CancelMessage, WorkerReply } from '../generator/protocol';
+import type { CancelMessage, WorkerReply } from './protocol';
 
 /** Reports the share done of the request being handled (0…1). */
 export type Progress = (fraction: number) => void;

@@ -3,7 +3,7 @@
 // timing raw calls.
 import type { InferenceSession, Tensor, TensorConstructor } from 'onnxruntime-web';
 import { checkpoint } from './cancellation';
-import type { BenchmarkResult } from '../generator/protocol';
+import type { BenchmarkResult } from './protocol';
 
 /** Throws unless the session has every input and output the model's JSON names. */
 function checkSessionNames(session: InferenceSession, inputs: readonly string[], outputs: readonly string[]): void {

@@ -5,7 +5,7 @@
 // call, and dispose stops the worker.
 import type { Motion } from '../../motion/types';
 import { CANCELLED_ERROR_NAME, CancelledError } from './cancellation';
-import { WORKER_ERROR_ID, type BenchmarkResult, type CancelMessage, type WorkerMessage } from '../generator/protocol';
+import { WORKER_ERROR_ID, type BenchmarkResult, type CancelMessage, type WorkerMessage } from './protocol';
 import { assetUrl } from './assetBase';
 import { answerDownload, sharedDownload, type DownloadRequest } from './sharedDownloads';
 import { ortWasmHref } from './ortFiles';
@@ -140,6 +140,28 @@ export interface ModelSkeleton {
   parents: number[];
 }
 
+/**
+ * A model client's options: its files (left out: models/<id>.onnx and models/<id>.json, resolved against the
+ * page), onnxruntime-web threads when the page is cross-origin isolated (default 2; without isolation always 1),
+ * and how long `init` may take before the worker is given up (default 60 s: a stalled download or wasm).
+ */
+export interface ModelFileOptions {
+  modelUrl?: string;
+  infoUrl?: string;
+  threads?: number;
+  initTimeoutMs?: number;
+}
+
+/** The options ModelClient takes for model `id`'s files, with the defaults filled in. */
+export function modelFiles(id: string, options: ModelFileOptions): ModelClientOptions {
+  return {
+    threads: options.threads,
+    initTimeoutMs: options.initTimeoutMs,
+    modelUrl: options.modelUrl ?? `models/${id}.onnx`,
+    infoUrl: options.infoUrl ?? `models/${id}.json`,
+  };
+}
+
 export interface ModelClientOptions {
   /** Model file URLs (resolved against the page). */
   modelUrl: string;
@@ -223,6 +245,12 @@ export abstract class ModelClient<P extends object, Init extends ModelSkeleton, 
   }
 
   protected abstract toMotion(chunk: Chunk): M;
+
+  /** A chunk as a Motion with everything else the chunk carries, as it came (its extras: contacts, seed, …). */
+  protected chunkMotion<T extends Chunk>(chunk: T): Motion & Omit<T, 'frames' | 'positions'> {
+    const { frames: _frames, positions: _positions, ...extras } = chunk;
+    return { ...this.motionOf(chunk), ...extras };
+  }
 
   /** The Motion part of a chunk: the loaded model's rate and skeleton with the chunk's positions. */
   protected motionOf(chunk: Chunk): Motion {
