@@ -8,7 +8,7 @@ import { addNoise } from '../../web/motion/noise';
 import { parseLatentErdInfo, parseManifoldInfo, type LatentErdModel } from '../../web/model/latentErdInfo';
 import { groundFrame, motionRows, rowLayout, smooth, toLocal, toWorld } from '../../web/model/manifoldRows';
 import { LatentErdCore } from '../../web/runtime/latent_erd/latentErdCore';
-import { LatentErdRequests } from '../../web/runtime/latent_erd/latentErdRequests';
+import { LatentErdRequests, type ManifoldProjectParams } from '../../web/runtime/latent_erd/latentErdRequests';
 import { manifoldWindow, projectOnManifold, windowStarts, type ManifoldProjectionArgs, type ManifoldWindowInfo } from '../../web/runtime/autoencoder/manifoldProjection';
 import { readRepoFile } from './corpus';
 import { maxAbsDiff, ort, shippedSession } from './shippedModel';
@@ -229,7 +229,7 @@ describe('manifold projection on the shipped autoencoder', () => {
       expect(Array.from(viaCore.contacts)).toEqual(Array.from(direct.contacts));
       expect(fractions).toEqual([0, 0.25, 0.5, 0.75, 1]);
       const requests = new LatentErdRequests(core);
-      const viaRequest = (await requests.handle({ type: 'manifoldProject', positions }, () => undefined)) as Awaited<ReturnType<typeof project>>;
+      const viaRequest = await requests.manifoldProject({ positions }, () => undefined);
       expect(maxAbsDiff(viaRequest.positions, (await project(positions)).positions)).toBeLessThan(1e-6);
       expect(encoderLoads).toBe(1);
     });
@@ -239,8 +239,10 @@ describe('manifold projection on the shipped autoencoder', () => {
       controller.abort();
       await expect(core.projectManifold(Float32Array.from(clipPositions), undefined, controller.signal)).rejects.toThrow();
       const requests = new LatentErdRequests(core);
-      expect(() => requests.handle({ type: 'manifoldProject', positions: [1, 2, 3] }, () => undefined)).toThrow(/positions must be a Float32Array/);
-      expect(() => requests.handle({ type: 'manifoldProject', positions: new Float32Array(75), contacts: [1, 0] }, () => undefined)).toThrow(/contacts must be a Uint8Array/);
+      // As the worker passes them on: a request's body is whatever the page sent.
+      const sent = (body: object) => body as ManifoldProjectParams;
+      expect(() => requests.manifoldProject(sent({ positions: [1, 2, 3] }), () => undefined)).toThrow(/positions must be a Float32Array/);
+      expect(() => requests.manifoldProject(sent({ positions: new Float32Array(75), contacts: [1, 0] }), () => undefined)).toThrow(/contacts must be a Uint8Array/);
     });
 
     it('a core made without the encoder says so', async () => {

@@ -6,13 +6,20 @@ import { GeneratorCore } from './generatorCore';
 import { loadGeneratorInfo } from '../../model/generatorInfo';
 import { ort, serveModel } from '../worker/ortWorker';
 import { OptimizerRequests } from './optimizerRequests';
-import type { RefinerParityResult, RefinerStepInputs, StreamParams } from './protocol';
+import type { ControlStartParams, ControlTargetParams, FollowPathParams, RefinerParityResult, RefinerStepInputs, SimulateControlParams, StreamParams } from './protocol';
 import { loadRefiner } from '../refiner/refinerLoader';
 import { mapCleaner } from '../cleanup/cleanup';
 import { serveDenoise, type DenoiseParams } from '../cleanup/cleanupRequests';
 
 // One optimiser per loaded core (a new init replaces the core, and with it the live control stream).
 const optimizers = new WeakMap<GeneratorCore, OptimizerRequests>();
+
+function optimizerOf(core: GeneratorCore): OptimizerRequests {
+  let optimizer = optimizers.get(core);
+  if (!optimizer) optimizers.set(core, (optimizer = new OptimizerRequests(core)));
+  return optimizer;
+}
+
 /** The generator JSON's URL of the latest init: the refiner's files sit next to it. */
 let generatorInfoUrl = '';
 
@@ -27,19 +34,18 @@ serveModel({
     return new GeneratorCore(session, info, ort.Tensor, threads, { loadRefiner: (core) => loadRefiner(refinerInfoUrl, core.info, threads) });
   },
   streamParams: (r: StreamParams): StreamParams => ({ seed: r.seed, temperature: r.temperature, seedIndex: r.seedIndex, ...(r.refine === undefined ? {} : { refine: r.refine }) }),
-  extra(request, core, progress, signal) {
-    const generator = core as GeneratorCore;
-    if (request.type === 'refinerParity') return refinerParity(generator, request as unknown as { inputs: RefinerStepInputs; frames?: number[] });
-    if (request.type === 'denoise') {
-      return serveDenoise(request as unknown as DenoiseParams, {
+  requests: {
+    refinerParity: (r: { inputs: RefinerStepInputs; frames?: number[] }, core: GeneratorCore) => refinerParity(core, r),
+    denoise: (r: DenoiseParams, core: GeneratorCore, progress, signal) =>
+      serveDenoise(r, {
         methods: ['map', 'lowpass'],
-        info: () => Promise.resolve(generator.info),
-        cleaner: (options, onProgress) => mapCleaner({ step: (b, x, h, c) => generator.step(b, x, h, c, signal), info: generator.info, mean: generator.mean, std: generator.std, options, onProgress }),
-      }, progress);
-    }
-    let optimizer = optimizers.get(generator);
-    if (!optimizer) optimizers.set(generator, (optimizer = new OptimizerRequests(generator)));
-    return optimizer.handle(request as { type: string } & Record<string, unknown>, progress, signal);
+        info: () => Promise.resolve(core.info),
+        cleaner: (options, onProgress) => mapCleaner({ step: (b, x, h, c) => core.step(b, x, h, c, signal), info: core.info, mean: core.mean, std: core.std, options, onProgress }),
+      }, progress),
+    followPath: (r: FollowPathParams, core: GeneratorCore, progress, signal) => optimizerOf(core).followPath(r, progress, signal),
+    controlStart: async (r: ControlStartParams, core: GeneratorCore) => optimizerOf(core).controlStart(r),
+    controlPull: (r: ControlTargetParams & { frames: number }, core: GeneratorCore) => optimizerOf(core).controlPull(r),
+    simulateControl: (r: SimulateControlParams, core: GeneratorCore, progress, signal) => optimizerOf(core).simulate(r, progress, signal),
   },
 });
 

@@ -31,22 +31,6 @@ export class OptimizerRequests {
     return { controller: new LiveController({ step: this.stepFn(signal), info, mean: this.core.mean, std: this.core.std, seed, seedIndex }), seedIndex };
   }
 
-  /** Handles one optimiser request; undefined when `request` is not one. */
-  handle(request: { type: string } & Record<string, unknown>, progress: (fraction: number) => void, signal?: AbortSignal): Promise<unknown> | undefined {
-    switch (request.type) {
-      case 'followPath':
-        return this.followPath(request as unknown as FollowPathParams, progress, signal);
-      case 'controlStart':
-        return Promise.resolve(this.controlStart(request as unknown as ControlStartParams));
-      case 'controlPull':
-        return this.controlPull(request as unknown as ControlTargetParams & { frames: number; particles?: number });
-      case 'simulateControl':
-        return this.simulate(request as unknown as SimulateControlParams, progress, signal);
-      default:
-        return undefined;
-    }
-  }
-
   async followPath(p: FollowPathParams, progress: (fraction: number) => void, signal?: AbortSignal): Promise<FollowPathChunk> {
     // Followed, locked and measured near the origin; moved back to where the path is last.
     const { gait, seed, lock, origin, ground: path } = checkFollowRequest(p);

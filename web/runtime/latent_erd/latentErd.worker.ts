@@ -10,12 +10,18 @@ import { loadLatentErdModel } from '../../model/latentErdInfo';
 import { manifoldCleaner } from '../cleanup/cleanup';
 import { serveDenoise, type DenoiseParams } from '../cleanup/cleanupRequests';
 import { LatentErdCore } from './latentErdCore';
-import type { LatentStreamParams } from './latentErdProtocol';
-import { LatentErdRequests } from './latentErdRequests';
+import type { LatentControlStartParams, LatentControlTarget, LatentFollowPathParams, LatentSimulateControlParams, LatentStreamParams } from './latentErdProtocol';
+import { LatentErdRequests, type ManifoldProjectParams } from './latentErdRequests';
 import { loadExtraSession, ort, serveModel } from '../worker/ortWorker';
 
 // One set of control requests per loaded core (a new init replaces the core, and with it the live stream).
-const requests = new WeakMap<LatentErdCore, LatentErdRequests>();
+const controls = new WeakMap<LatentErdCore, LatentErdRequests>();
+
+function requestsOf(core: LatentErdCore): LatentErdRequests {
+  let requests = controls.get(core);
+  if (!requests) controls.set(core, (requests = new LatentErdRequests(core)));
+  return requests;
+}
 /** latent-erd.json's URL of the latest init: generator.json, whose skeleton the clean-up's IK uses, sits next to it. */
 let infoUrl = '';
 let generatorInfo: Promise<GeneratorInfo> | undefined;
@@ -43,21 +49,21 @@ serveModel({
     ...(r.knownFuture === undefined ? {} : { knownFuture: r.knownFuture }),
     ...(r.footLock === undefined ? {} : { footLock: r.footLock }),
   }),
-  extra(request, core, progress, signal) {
-    const erd = core as LatentErdCore;
-    if (request.type === 'denoise') {
-      return serveDenoise(request as unknown as DenoiseParams, {
+  requests: {
+    denoise: (r: DenoiseParams, core: LatentErdCore, progress, signal) =>
+      serveDenoise(r, {
         methods: ['manifold'],
         info: () => {
           generatorInfo ??= loadGeneratorInfo(new URL('generator.json', infoUrl).href);
           generatorInfo.catch(() => (generatorInfo = undefined)); // a failed fetch is tried again next time
           return generatorInfo;
         },
-        cleaner: (_options, onProgress) => manifoldCleaner((positions) => erd.projectManifold(positions, undefined, signal, onProgress)),
-      }, progress);
-    }
-    let handler = requests.get(erd);
-    if (!handler) requests.set(erd, (handler = new LatentErdRequests(erd)));
-    return handler.handle(request as { type: string } & Record<string, unknown>, progress, signal);
+        cleaner: (_options, onProgress) => manifoldCleaner((positions) => core.projectManifold(positions, undefined, signal, onProgress)),
+      }, progress),
+    followPath: (r: LatentFollowPathParams, core: LatentErdCore, progress, signal) => requestsOf(core).followPath(r, progress, signal),
+    controlStart: (r: LatentControlStartParams, core: LatentErdCore, _progress, signal) => requestsOf(core).controlStart(r, signal),
+    controlPull: async (r: LatentControlTarget & { frames: number }, core: LatentErdCore) => requestsOf(core).controlPull(r),
+    simulateControl: (r: LatentSimulateControlParams, core: LatentErdCore, progress, signal) => requestsOf(core).simulate(r, progress, signal),
+    manifoldProject: (r: ManifoldProjectParams, core: LatentErdCore, progress, signal) => requestsOf(core).manifoldProject(r, progress, signal),
   },
 });

@@ -77,24 +77,6 @@ export class LatentErdRequests {
 
   constructor(private readonly core: LatentErdCore) {}
 
-  /** Handles one control request; undefined when `request` is not one. */
-  handle(request: { type: string } & Record<string, unknown>, progress: (fraction: number) => void, signal?: AbortSignal): Promise<unknown> | undefined {
-    switch (request.type) {
-      case 'followPath':
-        return this.followPath(request as unknown as LatentFollowPathParams, progress, signal);
-      case 'controlStart':
-        return this.controlStart(request as unknown as LatentControlStartParams, signal);
-      case 'controlPull':
-        return this.controlPull(request as unknown as LatentControlTarget & { frames: number });
-      case 'simulateControl':
-        return this.simulate(request as unknown as LatentSimulateControlParams, progress, signal);
-      case 'manifoldProject':
-        return this.manifoldProject(request as unknown as ManifoldProjectParams, progress, signal);
-      default:
-        return undefined;
-    }
-  }
-
   /** The `manifold` clean-up of canonical positions (frames × joints × 3 at the model's fps) and optional contacts (frames × 2). */
   manifoldProject(p: ManifoldProjectParams, progress: (fraction: number) => void, signal?: AbortSignal): Promise<ManifoldProjection> {
     if (!(p.positions instanceof Float32Array)) throw new TypeError(`positions must be a Float32Array of frames × joints × 3 values, got ${describeValue(p.positions)}`);

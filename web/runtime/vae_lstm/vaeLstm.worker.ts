@@ -19,9 +19,8 @@ serveModel({
     ...(r.control === undefined ? {} : { control: r.control }),
     ...(r.footLock === undefined ? {} : { footLock: r.footLock }),
   }),
-  extra(request, core, progress, signal) {
-    if (request.type !== 'followPath') return undefined;
-    return followPathVae(core as unknown as VaeLstmCore, request as unknown as VaeLstmFollowPathParams, progress, signal);
+  requests: {
+    followPath: (r: VaeLstmFollowPathParams, core: VaeLstmStreamless, progress, signal) => followPathVae(core, r, progress, signal),
   },
 });
 

@@ -115,15 +115,21 @@ export interface ModelCore<Stream, StreamParams> {
   parity(inputs: never): Promise<unknown>;
 }
 
-export interface ModelWorker<Info, Stream, P> {
+/**
+ * A model's own requests by type (the generator's path following and control, clean-up, …): each handler gets
+ * the request as its client sent it, typed by the handler, and the loaded core.
+ */
+export type ModelRequests<Core> = Record<string, (request: never, core: Core, progress: Progress, signal: AbortSignal) => Promise<unknown>>;
+
+export interface ModelWorker<Info, Stream, P, Core extends ModelCore<Stream, P> = ModelCore<Stream, P>> {
   /** Names the model in messages: "generator" → "generator worker: …", "the generator model is not loaded". */
   name: string;
   loadInfo(url: string): Promise<Info>;
-  makeCore(session: ort.InferenceSession, info: Info, threads: number): ModelCore<Stream, P>;
+  makeCore(session: ort.InferenceSession, info: Info, threads: number): Core;
   /** The stream parameters of a generate or startStream request. */
   streamParams(request: P): P;
-  /** Requests of this model only (the generator's path following and control); undefined: not one of them. */
-  extra?(request: { type: string }, core: ModelCore<Stream, P>, progress: Progress, signal: AbortSignal): Promise<unknown> | undefined;
+  /** Requests of this model only, by type. */
+  requests?: ModelRequests<Core>;
 }
 
 /**
@@ -133,8 +139,8 @@ export interface ModelWorker<Info, Stream, P> {
  * cancelled (a cancelled start leaves no stream); a `pull` that has started runs whole, so the stream
  * always stands where its last reply left it (a cancelled pull still queued never runs).
  */
-export function serveModel<Info, Stream, P, StepInputs>(spec: ModelWorker<Info, Stream, P>): void {
-  let core: ModelCore<Stream, P> | undefined;
+export function serveModel<Info, Stream, P, StepInputs, Core extends ModelCore<Stream, P>>(spec: ModelWorker<Info, Stream, P, Core>): void {
+  let core: Core | undefined;
   let stream: { value: Stream; params: P } | undefined;
   const requireCore = () => core ?? fail(`the ${spec.name} model is not loaded: send init first`);
   const requireStream = () => stream ?? fail('no stream: send startStream first');
@@ -184,9 +190,11 @@ export function serveModel<Info, Stream, P, StepInputs>(spec: ModelWorker<Info, 
       case 'parity':
         return requireCore().parity(request.inputs as never);
       default: {
-        const handled = spec.extra?.(request, requireCore(), progress, signal);
-        if (handled) return handled;
-        throw new Error(`unknown request type "${(request as { type?: unknown }).type}"`);
+        const type = (request as { type?: unknown }).type;
+        const handler = typeof type === 'string' && Object.hasOwn(spec.requests ?? {}, type) ? spec.requests![type] : undefined;
+        if (!handler) throw new Error(`unknown request type "${type}"`);
+        // The handler's type says what its client sends with this type (the protocol files).
+        return handler(request as never, requireCore(), progress, signal);
       }
     }
   });
