@@ -18,6 +18,7 @@ from ..generator.shipped import ShippedGenerator
 from ..onnx.compact import weight_format
 from ..paths import MODELS_DIR, REPO_ROOT, REPORTS_DIR
 from . import measures as m
+from .figure import FIGURE, plot_latent_erd
 from .training import load_erd
 
 LOOKAHEADS = (0, 1, 3, 6, 9)
@@ -268,7 +269,7 @@ def latent_erd_markdown(r: dict) -> str:
     """docs/models/latent-erd.md from the numbers in latent-erd.json; nothing here measures."""
     man, pred, longr, seams = r["manifold"], r["prediction"], r["long_runs"], r["seams"]
     sr, sh, sl = r["sliding_real"], r["sliding_held_out_control"], r["sliding_random_control"]
-    lines = ["# Motion manifold and latent ERD", ""] + summary_lines(r) + [""] + targets_lines(r) + [
+    lines = ["# Motion manifold and latent ERD", ""] + summary_lines(r) + ["", f"![prediction error and pose change over the long runs]({FIGURE})", ""] + targets_lines(r) + [
         "Made by `python -m training.latent_erd.evaluate` on the shipped models (`public/models/manifold-*.onnx`, "
         "`latent-erd.onnx`, native onnxruntime, one thread); the page's numbers come from `npm run evaluate:latent-erd` "
         "(headless Chromium, `docs/models/latent-erd-browser.json`). The method follows Yearsley's thesis: a denoising "
@@ -436,8 +437,10 @@ def read_report(path: Path = REPORT_JSON) -> dict:
 
 
 def rewrite_latent_erd_markdown() -> None:
-    """latent-erd.md again from the committed latent-erd.json, without measuring."""
-    REPORT_MD.write_text(latent_erd_markdown(read_report()))
+    """latent-erd.md and its figure again from the committed latent-erd.json, without measuring."""
+    report = read_report()
+    REPORT_MD.write_text(latent_erd_markdown(report))
+    plot_latent_erd(report)
 
 
 def write_report(mocap: str | None, frames: int, n_seeds: int, pose_checkpoint: Path, notes: dict) -> dict:
@@ -447,4 +450,5 @@ def write_report(mocap: str | None, frames: int, n_seeds: int, pose_checkpoint: 
     report["notes"] = notes
     REPORT_JSON.write_text(json.dumps(report, indent=1) + "\n")
     REPORT_MD.write_text(latent_erd_markdown(report))
+    plot_latent_erd(report)
     return report
