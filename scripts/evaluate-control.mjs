@@ -10,7 +10,10 @@
 // metrics.py low_foot_speeds) are measured in the page, the control responses here from the returned motions,
 // against unconstrained generation (generate, temperature 0.5) from the same seed states, and sliding against
 // the real held-out clips measured the same way (docs/models/refiner.json, python -m training.refiner.evaluate).
-import { mkdirSync, readFileSync, writeFileSync } from 'node:fs';
+// The report's figure, docs/models/control.png, is drawn from control.json by python -m training.generator.control_figure,
+// which this script runs after writing the report (also with --from-json).
+import { spawnSync } from 'node:child_process';
+import { existsSync, mkdirSync, readFileSync, writeFileSync } from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { launchBrowser, openPlayground, ROOT, startServer } from '../tests/support/browser.mjs';
@@ -113,6 +116,14 @@ async function main() {
   writeFileSync(path.join(OUT, 'control.json'), JSON.stringify(report, null, 1) + '\n');
   writeFileSync(path.join(OUT, 'control.md'), markdown(report));
   console.log(`wrote ${path.join(OUT, 'control.md')}`);
+  drawFigure();
+}
+
+// control.png from control.json: the figure is drawn in Python (matplotlib, as the other reports' figures).
+function drawFigure() {
+  const venv = path.join(ROOT, '.venv/bin/python');
+  const done = spawnSync(existsSync(venv) ? venv : 'python3', ['-m', 'training.generator.control_figure'], { cwd: ROOT, stdio: 'inherit' });
+  if (done.status !== 0) console.warn('control.png not drawn: run python -m training.generator.control_figure');
 }
 
 function markdown(r) {
@@ -121,7 +132,7 @@ function markdown(r) {
   const walk = r.paths.filter((p) => p.gait === 'walk');
   const run = r.paths.filter((p) => p.gait === 'run');
   const pass = (ok) => (ok ? 'yes' : '**no**');
-  lines.push('# Path following and live control', '', ...summaryLines(r), '');
+  lines.push('# Path following and live control', '', ...summaryLines(r), '', '![path error, turn response and speed error](control.png)', '');
   lines.push(
     `Made by \`npm run evaluate:control\` (${r.date}) in headless Chromium through \`playground.followPath\` and \`playground.simulateControl\`, ${r.seeds} seeds per case, one onnxruntime-web thread (cross-origin isolated: ${r.crossOriginIsolated}), 1-minute load average ${fmt(r.loadBefore, 1)} before and ${fmt(r.loadAfter, 1)} after on this 2-core machine (timings are only meaningful near 1, this run alone). ` +
       'The optimiser is `web/optimizer/` over the shipped generator (see [generator.md](generator.md)); paths are `tests/fixtures/benchmark_paths.json`.',
@@ -227,7 +238,10 @@ function summaryLines(r) {
 function writeFromJson() {
   const r = JSON.parse(readFileSync(path.join(OUT, 'control.json'), 'utf8'));
   if (process.argv.includes('--stdout')) process.stdout.write(markdown(r));
-  else writeFileSync(path.join(OUT, 'control.md'), markdown(r));
+  else {
+    writeFileSync(path.join(OUT, 'control.md'), markdown(r));
+    drawFigure();
+  }
 }
 
 // A single run is one short motion: compare it with single real clips, whose sliding spreads widely (the pooled
