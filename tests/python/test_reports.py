@@ -13,8 +13,10 @@ from conftest import REPO
 
 MODELS = REPO / "docs" / "models"
 REPORTS = ["generator", "refiner", "aclstm", "latent-erd", "vae-lstm", "control", "cleanup"]
-FIGURES = {"generator": "generator.png", "refiner": "refiner.png", "aclstm": "aclstm.png",
-           "vae-lstm": "vae-lstm-variations.png"}
+# Every report's figure, as its Markdown links it (relative to docs/models): each drawn by the report's writer, control.png
+# by training/generator/control_figure.py from control.json; cleanup.md shows a screenshot of the page's panel.
+FIGURES = {"generator": "generator.png", "refiner": "refiner.png", "aclstm": "aclstm.png", "latent-erd": "latent-erd.png",
+           "vae-lstm": "vae-lstm-variations.png", "control": "control.png", "cleanup": "../cleanup.png"}
 # The other pages in docs/models are not reports of a model, so they need no summary (their table cells are checked):
 # refiner-notes.md and refiner-browser.md are parts of refiner.md, which its writer copies in; aclstm-pilots.md is the
 # acLSTM's pilot runs (history, linked from aclstm.md, written by training/aclstm/pilots.py); weights.md measures how
@@ -44,15 +46,24 @@ def test_a_report_opens_with_its_title_and_five_summary_lines(name):
             assert line.startswith(f"- **{label}:**"), f"{name}.md: {line[:40]!r} should open with {label!r}"
 
 
+def test_every_report_has_a_figure():
+    assert sorted(FIGURES) == sorted(REPORTS)
+
+
 @pytest.mark.parametrize("name", REPORTS)
-def test_the_figure_comes_before_the_first_table(name):
+def test_the_figure_comes_right_after_the_summary(name):
     lines = report_lines(name)
     first_table = next((i for i, line in enumerate(lines) if line.startswith("|")), len(lines))
-    if name in FIGURES:
-        figure = next((i for i, line in enumerate(lines) if re.match(rf"!\[[^\]]*\]\({re.escape(FIGURES[name])}\)", line)), None)
-        assert figure is not None, f"{name}.md shows {FIGURES[name]}"
-        assert figure < first_table, f"{name}.md: the figure before the first table"
-        assert figure == 8, f"{name}.md: the figure right after the summary"
+    figure = next((i for i, line in enumerate(lines) if re.match(rf"!\[[^\]]*\]\({re.escape(FIGURES[name])}\)", line)), None)
+    assert figure is not None, f"{name}.md shows {FIGURES[name]}"
+    assert figure < first_table, f"{name}.md: the figure before the first table"
+    assert figure == 8, f"{name}.md: the figure right after the summary"
+
+
+@pytest.mark.parametrize("name", REPORTS)
+def test_the_figure_file_exists(name):
+    path = MODELS / FIGURES[name]
+    assert path.is_file() and path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", f"{name}.md links {FIGURES[name]}, which is not a PNG file"
 
 
 @pytest.mark.parametrize("path", sorted(MODELS.glob("*.md")), ids=lambda p: p.name)
