@@ -1,5 +1,5 @@
 // npm run evaluate:cleanup → docs/models/cleanup.json and cleanup.md: the clean-up methods against the low-pass
-// baseline on held-out CMU clips with synthetic noise, run by the page's own code (web/runtime/cleanup.ts) on
+// baseline on held-out CMU clips with synthetic noise, run by the page's own code (web/runtime/cleanup/cleanup.ts) on
 // onnxruntime-web's Node build (the wasm runtime the browser workers use).
 import { writeFileSync } from 'node:fs';
 import { it } from 'vitest';

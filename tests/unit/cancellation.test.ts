@@ -1,5 +1,5 @@
 // Cancelling requests. The client/worker protocol: the real WorkerClient talks over a MessageChannel to
-// the real request loop (web/runtime/requestLoop.ts) serving scripted requests: a request cancelled while
+// the real request loop (web/runtime/worker/requestLoop.ts) serving scripted requests: a request cancelled while
 // queued never runs, a running one stops at its next checkpoint, both reject with an AbortError, and the
 // next request runs normally. The model cores on the shipped models (onnxruntime-web's Node build): a
 // request cancelled part-way rejects, and the streams it ran beside (a refined stream, the live control
@@ -11,7 +11,8 @@ import { parseDanceInfo } from '../../web/runtime/aclstm/danceModel';
 import { GeneratorCore } from '../../web/runtime/generator/generatorCore';
 import { parseGeneratorInfo } from '../../web/model/generatorInfo';
 import { OptimizerRequests } from '../../web/runtime/generator/optimizerRequests';
-import type { GeneratedChunk, WorkerMessage } from '../../web/runtime/generator/protocol';
+import type { GeneratedChunk } from '../../web/runtime/generator/protocol';
+import type { WorkerMessage } from '../../web/runtime/worker/protocol';
 import { RefinerCore } from '../../web/runtime/refiner/refinerCore';
 import { parseRefinerInfo } from '../../web/runtime/refiner/refinerModel';
 import { serveRequests } from '../../web/runtime/worker/requestLoop';

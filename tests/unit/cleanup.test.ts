@@ -1,4 +1,4 @@
-// Motion clean-up's shared pipeline (web/runtime/cleanup.ts) on a real held-out CMU clip: the result keeps the
+// Motion clean-up's shared pipeline (web/runtime/cleanup/cleanup.ts) on a real held-out CMU clip: the result keeps the
 // imported skeleton (joints, parents, frame count, one length per bone), the options are checked, and a skeleton
 // that cannot be mapped is refused before any model work.
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';

@@ -1,4 +1,4 @@
-// The dance step loop (web/runtime/danceCore.ts) on the shipped acLSTM model, run by onnxruntime-web's
+// The dance step loop (web/runtime/aclstm/danceCore.ts) on the shipped acLSTM model, run by onnxruntime-web's
 // Node build (the same wasm runtime the browser worker uses): one-step parity with the Python
 // onnxruntime fixture, determinism, streams that continue exactly, fitted frames at exact bone lengths, and
 // feet planted by their contact labels locked in place.

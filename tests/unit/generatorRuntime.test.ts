@@ -1,4 +1,4 @@
-// The generator step loop (web/runtime/generatorCore.ts) on the shipped model, run by onnxruntime-web's
+// The generator step loop (web/runtime/generator/generatorCore.ts) on the shipped model, run by onnxruntime-web's
 // Node build (the same wasm runtime the browser worker uses): one-step parity with the Python
 // onnxruntime fixture, seeded determinism, and streams that continue exactly where they stopped.
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';

@@ -1,4 +1,4 @@
-// The latent ERD's runtime (web/runtime/latentErdCore.ts and the online stream web/model/latentStream.ts,
+// The latent ERD's runtime (web/runtime/latent_erd/latentErdCore.ts and the online stream web/model/latentStream.ts,
 // the port of training/latent_erd/streaming.py) on the shipped models, run by onnxruntime-web's Node build
 // (the same wasm runtime the browser worker uses): parity with tests/fixtures/latent_erd_reference.json (one
 // ERD step, one decoder window, a whole stream from a seed), that the look-ahead matters, chunked streams,

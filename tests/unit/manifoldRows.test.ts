@@ -1,6 +1,6 @@
 // The motion manifold's rows (web/model/manifoldRows.ts, the port of training/data/windows.py) against
 // tests/fixtures/manifold_rows.json (python -m training.fixtures.manifold_rows), and the `manifold` clean-up
-// (web/runtime/manifoldProjection.ts) on the fixture's held-out clip through the shipped autoencoder, run by
+// (web/runtime/autoencoder/manifoldProjection.ts) on the fixture's held-out clip through the shipped autoencoder, run by
 // onnxruntime-web's Node build, directly and through the latent ERD worker's core and request.
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { controlFromTrajectory, wrap } from '../../web/motion/control';

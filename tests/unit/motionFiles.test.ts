@@ -1,4 +1,4 @@
-// Reading dropped or picked files (web/runtime/motionFiles.ts): the kind from the name or the contents, gzip.
+// Reading dropped or picked files (web/runtime/import/motionFiles.ts): the kind from the name or the contents, gzip.
 import { gzipSync } from 'node:zlib';
 import { describe, expect, it } from 'vitest';
 import { baseName, FileImporter, kindFromName, kindFromText, MAX_FILE_BYTES, readTextFile, type ImportProgress } from '../../web/runtime/import/motionFiles';

@@ -1,4 +1,4 @@
-// The refiner runtime (web/runtime/refinerCore.ts) on the shipped models, run by onnxruntime-web's Node build
+// The refiner runtime (web/runtime/refiner/refinerCore.ts) on the shipped models, run by onnxruntime-web's Node build
 // (the same wasm runtime the browser worker uses): the JSON checks, one-step parity and the end effectors
 // against tests/fixtures/refiner_reference.json (Python onnxruntime), the streamed refinement, and the
 // generator's `refine` streams (raw frames unchanged, refined + foot-locked frames that skate less).

@@ -12,9 +12,9 @@ import { descriptorsByKind, Registry } from '../../web/runtime/registry';
 const WEB = resolve(__dirname, '../../web');
 const MANIFEST = parseManifest(JSON.parse(readFileSync(resolve(__dirname, '../../public/models/index.json'), 'utf8')));
 
-/** web/-relative paths (posix) and texts of every .ts file. */
+/** web/-relative paths (posix) and texts of every .ts and .html file. */
 function webSources(): Map<string, string> {
-  const files = (readdirSync(WEB, { recursive: true }) as string[]).filter((f) => f.endsWith('.ts')).map((f) => f.split('\\').join('/'));
+  const files = (readdirSync(WEB, { recursive: true }) as string[]).filter((f) => /\.(ts|html)$/.test(f)).map((f) => f.split('\\').join('/'));
   return new Map(files.sort().map((f) => [f, readFileSync(join(WEB, f), 'utf8')]));
 }
 
@@ -34,19 +34,38 @@ function mirroredFolders(): string[] {
   return readdirSync(join(WEB, 'runtime'), { withFileTypes: true }).filter((d) => d.isDirectory() && training.has(d.name)).map((d) => d.name);
 }
 
+/** A model id in camel case, as a property would name it ("latent-erd" → "latentErd"). */
+const camel = (id: string) => id.replace(/-([a-z0-9])/g, (_, c: string) => c.toUpperCase());
+
 /**
- * "file: 'literal'" for each string literal outside the model folders and the registry that is exactly a
- * model id or kind of the manifest (`names`): a comparison, a quoted table key or a default naming a model.
- * (Bare keys are left alone: glTF's `asset.generator` is no model.)
+ * "file: 'name'" for each place outside the model folders and the registry that names a model id or kind of
+ * the manifest (`names`): a string literal or quoted table key that is exactly one (a comparison, a key, a
+ * default), a regular expression that matches one, a property named after one (`app.latentErd`), or an HTML
+ * attribute value that is one (a fixed `<option value="…">`). Prose is left alone ("loading the generator…"),
+ * and so are bare keys, since glTF's `asset: { generator: … }` is no model.
  */
 function modelNamesOutsideFolders(sources: Map<string, string>, names: Set<string>): string[] {
   const folders = mirroredFolders().map((f) => `runtime/${f}/`);
+  const properties = new Map([...names].map((n) => [camel(n), n]));
   const found: string[] = [];
+  const named = (text: string) => [...names].filter((n) => new RegExp(`(?<![\\w-])${n}(?![\\w-])`).test(text));
   for (const [file, source] of sources) {
     if (folders.some((f) => file.startsWith(f)) || file === 'runtime/registry.ts') continue;
-    for (const m of code(source).matchAll(/(['"`])([a-z][a-z0-9-]*)\1|\b([a-z][a-zA-Z0-9]*|'[a-z0-9-]+')\s*:/g)) {
-      const literal = m[2] ?? m[3]?.replace(/'/g, '');
-      if (literal && names.has(literal) && (m[2] !== undefined || m[3]?.startsWith("'"))) found.push(`${file}: '${literal}'`);
+    if (file.endsWith('.html')) {
+      for (const m of source.matchAll(/=\s*"([^"]*)"/g)) if (names.has(m[1])) found.push(`${file}: '${m[1]}'`);
+      continue;
+    }
+    const text = code(source);
+    for (const m of text.matchAll(/(['"`])([a-z][a-z0-9-]*)\1|'([a-z0-9-]+)'\s*:/g)) {
+      const literal = m[2] ?? m[3];
+      if (names.has(literal)) found.push(`${file}: '${literal}'`);
+    }
+    for (const m of text.matchAll(/(?<=[=(,:!&|?]\s*)\/((?:\\.|[^/\n\\])+)\/[dgimsuy]*/g)) {
+      for (const n of named(m[1])) found.push(`${file}: /${n}/`);
+    }
+    for (const m of text.matchAll(/\.([a-z][a-zA-Z0-9]*)\b/g)) {
+      const id = properties.get(m[1]);
+      if (id !== undefined && (file.startsWith('ui/') || file.startsWith('api/'))) found.push(`${file}: .${m[1]}`);
     }
   }
   return found;
@@ -103,8 +122,24 @@ describe('the page names no model outside its folder', () => {
 
   it('finds a planted comparison, table key and default', () => {
     const planted = new Map(sources);
-    planted.set('ui/planted.ts', "if (model === 'latent-erd') go();\nconst short = { 'vae-lstm': 'VAE' };\nconst m = o.model ?? \"generator\"; // 'aclstm' in a comment is fine");
-    expect(modelNamesOutsideFolders(planted, names)).toEqual(["ui/planted.ts: 'latent-erd'", "ui/planted.ts: 'vae-lstm'", "ui/planted.ts: 'generator'"]);
+    planted.set('ui/planted.ts', [
+      "if (model === 'latent-erd') go();",
+      "const short = { 'vae-lstm': 'VAE' };",
+      'const m = o.model ?? "generator"; // \'aclstm\' in a comment is fine',
+      "const why = message.replace(/^(generator|refiner) denoise: /, '');",
+      'const { client } = await app.latentErd.load();',
+      "note('loading the generator…'); const asset = { generator: 'Motion Playground' };",
+    ].join('\n'));
+    planted.set('ui/planted.html', '<select id="m"><option value="vae-lstm">VAE-LSTM</option><option value="">off</option></select>');
+    expect(modelNamesOutsideFolders(planted, names)).toEqual([
+      "ui/planted.ts: 'latent-erd'",
+      "ui/planted.ts: 'vae-lstm'",
+      "ui/planted.ts: 'generator'",
+      'ui/planted.ts: /generator/',
+      'ui/planted.ts: /refiner/',
+      'ui/planted.ts: .latentErd',
+      "ui/planted.html: 'vae-lstm'",
+    ]);
   });
 
   it('imports three.js only in web/viewer/', () => {

@@ -1,4 +1,4 @@
-// The VAE-LSTM's runtime (web/runtime/vaeLstmCore.ts, vaeLstmRequests.ts) on the shipped models, run by
+// The VAE-LSTM's runtime (web/runtime/vae_lstm/vaeLstmCore.ts, vaeLstmRequests.ts) on the shipped models, run by
 // onnxruntime-web's Node build (the same wasm runtime the browser worker uses): parity with
 // tests/fixtures/vae_lstm_reference.json (each of the four graphs, and a whole generation over more than one
 // chunk of the cell), seeds, the placement on the asked control, the skeleton fit and the foot lock, paths,

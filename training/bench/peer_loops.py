@@ -26,7 +26,7 @@ from ..models.generator import MixtureLSTM
 from ..onnx.sessions import cpu_session
 
 
-STEPS_PER_CALL = 32  # the page's calls (web/runtime/danceCore.ts STEPS_PER_CALL, as training/aclstm/shipped.py)
+STEPS_PER_CALL = 32  # the page's calls (web/runtime/aclstm/danceCore.ts STEPS_PER_CALL, as training/aclstm/shipped.py)
 
 
 def _rate(step, frames: int, warmup: int) -> float:

@@ -1,4 +1,4 @@
-"""How the VAE-LSTM makes motion (the page does the same with the exported graphs, web/runtime/vaeLstmCore.ts):
+"""How the VAE-LSTM makes motion (the page does the same with the exported graphs, web/runtime/vae_lstm/vaeLstmCore.ts):
 
 - From the prior (Algorithm 1): z_1 ~ N(0, I) drawn from a seed, the control signal encoded in one pass, the
   cell run on its own state for every step, the canvas decoded in one pass. A model whose JSON's sampling has a
@@ -69,7 +69,7 @@ def draw_z1(rng: Rng, latent: int, z1_prior: dict | None = None) -> np.ndarray:
 def prior_latents(seed: int, latent: int, steps: int = 0, rho: float = 0.0, z1_prior: dict | None = None) -> tuple[np.ndarray, np.ndarray | None]:
     """z1 (latent,) drawn from `seed` by the page's random source (control.Rng; draw_z1), and with `steps` the
     per-step latents (steps, latent): z1 first, then rho · previous + sqrt(1 − rho²) · a new draw, in the
-    same stream (web/runtime/vaeLstmCore.ts priorLatents draws the same)."""
+    same stream (web/runtime/vae_lstm/vaeLstmCore.ts priorLatents draws the same)."""
     rng = Rng(seed)
     z1 = draw_z1(rng, latent, z1_prior)
     if not steps:

@@ -239,6 +239,7 @@ export class MotionPlaygroundElement extends HTMLElement {
     } else if (mode === 'steer') {
       view.model = app.controlModel.steerable;
     }
+    if (!view.model) delete view.model; // no model chosen yet: the model list has not arrived (or listed none)
     return view;
   }
 
@@ -422,14 +423,18 @@ export class MotionPlaygroundElement extends HTMLElement {
    * style and seed; otherwise the generator with the view's seed, temperature and refine. Shows nothing.
    */
   generate(options?: GenerateOptions): Promise<Motion> {
-    if (options !== undefined) return this.playground.generate(options);
-    const view = this.view;
-    const frames = 300;
-    if (view.mode === 'dance' && view.model) return this.playground.generate({ model: view.model, seed: view.seed ?? 0, frames, ...(view.style ? { style: view.style } : {}) });
-    const walk: ViewState = view.mode === 'walk' ? view : {};
-    const walker = this.app?.registry.defaultFor('walk');
-    if (!walker) return Promise.reject(new Error('generate: no model for Random walk is listed in models/index.json'));
-    return this.playground.generate({ model: walker.info.id, seed: walk.seed ?? 0, refine: walk.refine ?? false, frames, ...(walk.temperature !== undefined ? { temperature: walk.temperature } : {}) });
+    const api = this.playground; // starts a lazy element
+    if (options !== undefined) return api.generate(options);
+    // The view's models are known once the model list is.
+    return api.ready.then(() => {
+      const view = this.view;
+      const frames = 300;
+      if (view.mode === 'dance' && view.model) return api.generate({ model: view.model, seed: view.seed ?? 0, frames, ...(view.style ? { style: view.style } : {}) });
+      const walk: ViewState = view.mode === 'walk' ? view : {};
+      // The Random walk model (left out when none is listed: generate then says which models there are).
+      const walker = this.app?.registry.defaultFor('walk')?.info.id;
+      return api.generate({ ...(walker ? { model: walker } : {}), seed: walk.seed ?? 0, refine: walk.refine ?? false, frames, ...(walk.temperature !== undefined ? { temperature: walk.temperature } : {}) } as GenerateOptions);
+    });
   }
 
   /** BVH text of `motion`, or of the shown motion when left out. */

@@ -97,7 +97,7 @@ export interface FollowPathOptions extends CancellableOptions {
   footLock?: boolean;
 }
 
-/** How well a walk follows its path, and its foot skating and sliding (web/runtime/descriptor.ts PathStats). */
+/** How well a walk follows its path, and its foot skating and sliding (web/runtime/worker/protocol.ts PathStats). */
 export type FollowPathStats = PathStats;
 
 export type FollowedPathMotion = Motion & { contacts: Uint8Array; stats: FollowPathStats };
@@ -302,7 +302,7 @@ function controlModel(registry: Registry, capability: 'followPath' | 'liveContro
   const fallback = registry.defaultFor(capability);
   if (value === undefined && fallback) return fallback;
   const ids = registry.ids(capability).map((id) => `"${id}"`);
-  const what = ids.length === 2 ? ids.join(' or ') : `one of ${ids.join(', ')}`;
+  const what = ids.length === 0 ? 'a listed model id (none is listed)' : ids.length === 1 ? ids[0] : ids.length === 2 ? ids.join(' or ') : `one of ${ids.join(', ')}`;
   const { entry } = pickModel(registry, capability, value, what);
   return registry.find(entry.id)!;
 }
@@ -366,8 +366,10 @@ export function createPlayground(app: App): Playground {
       app.useModels(m);
     },
     (e) => {
-      // The page still works without models; say so rather than failing `ready`.
+      // The page still works without models (clips, import, export, low-pass clean-up need none); say so rather
+      // than failing `ready`, and let the modes waiting for the list go on with none.
       app.reportError(`Model list unavailable: ${errorMessage(e)}`);
+      app.useModels([]);
     },
   );
 

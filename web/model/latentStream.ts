@@ -16,7 +16,7 @@
 //
 // The arithmetic follows the Python's: normalising the control and de-normalising the window in float64
 // and rounding to float32 once, the decoded rows and the root in float64. The networks are behind
-// `LatentBackend` (onnxruntime in web/runtime/latentErdCore.ts), so this file needs no onnxruntime.
+// `LatentBackend` (onnxruntime in web/runtime/latent_erd/latentErdCore.ts), so this file needs no onnxruntime.
 import { stepRoot, type Root } from '../motion/control';
 import type { LatentErdInfo, ManifoldInfo } from './latentErdInfo';
 

@@ -40,7 +40,6 @@ export interface GenerateCall {
   [option: string]: unknown;
 }
 
-
 /** A path to walk, checked (optimizer/path.ts), with the model's own option (fitSigma or speed) added by its check. */
 export interface PathRequest extends FollowPathRequest {
   fitSigma?: number;
@@ -63,7 +62,7 @@ export interface LiveTarget {
 }
 
 /** A batch of live control: frames with their achieved speed and heading, and the time they took. */
-export type LiveChunk = Motion & { contacts?: Uint8Array; startFrame: number; speed: Float32Array; heading: Float32Array; computeMs: number };
+export type LiveControlChunk = Motion & { contacts?: Uint8Array; startFrame: number; speed: Float32Array; heading: Float32Array; computeMs: number };
 
 /** simulateControl's result (docs/api.md ControlledMotion). */
 export type SimulatedControl = Motion & { contacts: Uint8Array; speed: Float32Array; heading: Float32Array; computeMs: Float32Array };
@@ -83,7 +82,7 @@ export interface SimulateRequest {
 export interface ModelDescriptor<C extends ModelClientBase = ModelClientBase> {
   /** The `kind` of public/models/index.json entries this describes. */
   kind: string;
-  /** Lower-case name in titles and stats lines ("latent ERD"); a model id can have its own in `names`. */
+  /** Lower-case name in titles and stats lines ("latent ERD"). */
   shortName: string;
   /** The picker's label of each model (by id); a model not named here is listed by its id. */
   labels?: Record<string, string>;
@@ -107,9 +106,11 @@ export interface ModelDescriptor<C extends ModelClientBase = ModelClientBase> {
   followPath?: {
     /** Option names besides points, model, gait, seed, footLock and signal. */
     options: readonly string[];
-    /** Checks the model's own options for `gait`, returned as PathRequest fields. `fromPage`: Path mode's settings, clamped already. */
+    /** Checks the API's options the model reads (its `options`) for `gait`, returned as PathRequest fields. */
     check(options: Record<string, unknown>, gait: Gait): Pick<PathRequest, 'fitSigma' | 'speed'>;
     run(client: C, request: PathRequest, options: ProgressOptions): Promise<PathWalk>;
+    /** The speed asked for when none is given, per gait (models whose `options` include speed; Path mode's slider). */
+    defaultSpeed?: Record<Gait, number>;
     /** A path walked quickly enough to start as soon as it is drawn (no Go needed). */
     immediate?: boolean;
     /** Draws a new sample of the same path with the next seed (Path mode's Vary). */
@@ -128,7 +129,7 @@ export interface ModelDescriptor<C extends ModelClientBase = ModelClientBase> {
     /** The controller searches with particles: Steer adapts their number to the time a batch takes. */
     particles: boolean;
     start(client: C, params: { seed: number; gait: Gait }, options: RequestOptions): Promise<{ seedName: string }>;
-    pull(client: C, frames: number, target: LiveTarget, options: RequestOptions): Promise<LiveChunk>;
+    pull(client: C, frames: number, target: LiveTarget, options: RequestOptions): Promise<LiveControlChunk>;
     simulate(client: C, request: SimulateRequest, options: ProgressOptions): Promise<SimulatedControl>;
   };
   /** Why the model takes no live control, for a model that has none but could be mistaken for one. */

@@ -37,11 +37,6 @@ export class Registry {
     });
   }
 
-  /** Every runnable model, in manifest order. */
-  all(): readonly RegisteredModel[] {
-    return this.models;
-  }
-
   /** The models that can do `capability`, in manifest order. */
   with(capability: Capability): RegisteredModel[] {
     return this.models.filter((m) => m.descriptor.capabilities.includes(capability));

@@ -12,14 +12,14 @@ import { Viewer } from '../viewer/viewer';
 import type { ModelInfo } from '../model/manifest';
 import type { ModelClientBase, ModelDescriptor } from '../runtime/descriptor';
 import { Registry } from '../runtime/registry';
-import { WorkerFailedError, type ModelSkeleton } from '../runtime/worker/workerClient';
+import type { ModelSkeleton } from '../runtime/worker/workerClient';
 import { ImportClient } from '../runtime/import/importClient';
 import { baseName, type FileImportOutcome } from '../runtime/import/motionFiles';
 import { ImportIndicator } from './files';
 import { $, downloadBlob, errorMessage, type DomScope } from './dom';
 import { Capture } from './capture';
 import { ExportMenu } from './exportMenu';
-import { BusyIndicator, ModelHost, pageThreads } from './modelHost';
+import { BusyIndicator, ModelHost, pageThreads, withClient } from './modelHost';
 import { CleanupPanel } from './cleanupPanel';
 import { DanceMode } from './modes/danceMode';
 import type { ModeHost } from './modes/host';
@@ -166,15 +166,9 @@ export class App implements ModeHost {
    * Runs `use` with model `id`'s client (loaded on first use) and descriptor. A worker that failed (not a
    * request it refused) is forgotten, so the next call starts a new one.
    */
-  async withModel<T>(id: string, use: (client: ModelClientBase, descriptor: ModelDescriptor) => Promise<T>): Promise<T> {
+  withModel<T>(id: string, use: (client: ModelClientBase, descriptor: ModelDescriptor) => Promise<T>): Promise<T> {
     const host = this.host(id);
-    const { client } = await host.load();
-    try {
-      return await use(client, this.models.find(id)!.descriptor);
-    } catch (e) {
-      if (e instanceof WorkerFailedError) host.reset(client);
-      throw e;
-    }
+    return withClient(host, (client) => use(client, this.models.find(id)!.descriptor));
   }
 
   /**
@@ -231,7 +225,8 @@ export class App implements ModeHost {
       this.setLiveLabel('Random walk', walker ? `${walker.descriptor.shortName} · 30 fps · live` : 'loading…');
       this.exportBtn.title = 'Download the last 20 s of the walk as BVH';
     } else if (mode === 'steer') {
-      this.setLiveLabel('Steer', `${this.models.shortName(this.controlModel.steerable)} · 30 fps · live control`);
+      const steered = this.controlModel.steerable;
+      this.setLiveLabel('Steer', steered ? `${this.models.shortName(steered)} · 30 fps · live control` : 'loading…');
       this.exportBtn.title = 'Download the last 20 s of steering as BVH';
     } else {
       this.setLiveLabel('Dance', 'loading…');

@@ -1,5 +1,5 @@
 // The page's part of importing dropped or picked files (read and parsed in the import worker:
-// runtime/importClient.ts, runtime/motionFiles.ts): the progress shown while a large import runs.
+// runtime/import/importClient.ts, runtime/import/motionFiles.ts): the progress shown while a large import runs.
 import type { ImportProgress, ProgressListener } from '../runtime/import/motionFiles';
 import { $ } from './dom';
 

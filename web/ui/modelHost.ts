@@ -1,6 +1,7 @@
 // The page's model clients (a worker + onnxruntime-web each), created on first use and shared by
-// `playground.generate` and the live modes (Random walk, Dance). A loading indicator shows while any
-// model loads.
+// the API and the modes. A loading indicator shows while any model loads.
+
+import { WorkerFailedError } from '../runtime/worker/workerClient';
 
 /**
  * onnxruntime-web threads for a page whose URL query is `search`, on `cores` cores: `?threads=N` (an
@@ -80,5 +81,19 @@ export class ModelHost<C extends Client<Info>, Info> {
       if (this.loading === loading) this.loading = null;
       c.dispose();
     }, () => undefined);
+  }
+}
+
+/**
+ * Runs `use` with the host's client (loaded on first use). A worker that failed (WorkerFailedError) is forgotten,
+ * so the next use starts a new one; a request it refused, or a cancelled one, leaves it for the next use.
+ */
+export async function withClient<C extends Client<Info>, Info, T>(host: ModelHost<C, Info>, use: (client: C) => Promise<T>): Promise<T> {
+  const { client } = await host.load();
+  try {
+    return await use(client);
+  } catch (e) {
+    if (e instanceof WorkerFailedError) host.reset(client);
+    throw e;
   }
 }

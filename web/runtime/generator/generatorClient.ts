@@ -33,7 +33,6 @@ export type ControlledMotion = GeneratedMotion & Pick<ControlChunkReply, 'speed'
 export type SimulatedControl = GeneratedMotion &
   Pick<SimulatedControlChunk, 'speed' | 'heading' | 'targetSpeed' | 'targetHeading' | 'computeMs' | 'batchMs' | 'batchFrames'>;
 
-/** Generated frames as a Motion, with the generator's extras. */
 /**
  * Generated frames as a Motion (the raw frames, with their contacts), with the chunk's extras: the feature rows,
  * headings, seed, `startFrame`, and with `refine` the same frames refined and foot-locked (`refined`).

@@ -41,6 +41,7 @@ export function controlledModel<C extends ControlledClient>(working: string): Re
     followPath: {
       options: ['speed'],
       check: (o, gait) => ({ speed: checkPathSpeed(optional(o.speed, LATENT_PATH_SPEED[gait])) }),
+      defaultSpeed: LATENT_PATH_SPEED,
       async run(client, { points, gait, seed, speed, footLock, stroke }, options) {
         const m = await client.followPath({ points, gait, seed, speed, ...(footLock === undefined ? {} : { footLock }), ...(stroke ? { stroke } : {}) }, options);
         return { motion: motionOf(m), path: m.path, stats: pathStatsOf(m.stats) };

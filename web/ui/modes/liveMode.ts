@@ -5,6 +5,7 @@
 
 import { detectContacts } from '../../motion/contacts';
 import type { Motion } from '../../motion/types';
+import { WorkerFailedError } from '../../runtime/worker/workerClient';
 import { errorMessage } from '../dom';
 import type { ModeHost } from './host';
 
@@ -94,7 +95,7 @@ export abstract class LiveMode<Chunk extends LiveChunk> {
    * (its start and every pull) carry `signal`, which aborts when the stream is replaced or stopped.
    */
   protected abstract open(signal: AbortSignal): Promise<LiveStream<Chunk>>;
-  /** Forgets the model after a failure, so the next start loads it afresh. */
+  /** Forgets the model after its worker failed, so the next start loads it afresh. */
   protected abstract forget(): void;
   /** Called with each new chunk once it is shown (`first`: a new stream). */
   protected abstract received(chunk: Chunk, first: boolean): void;
@@ -117,7 +118,9 @@ export abstract class LiveMode<Chunk extends LiveChunk> {
       await this.loop(token, stream);
     } catch (e) {
       if (token !== this.token) return;
-      this.forget();
+      // Only a worker that failed is dropped: the client is shared (the API, other modes), and a request it
+      // refused, or a mode's own check, leaves it working.
+      if (e instanceof WorkerFailedError) this.forget();
       this.stop();
       this.status.textContent = '';
       this.app.reportError(`${this.settings.label}: ${errorMessage(e)}`);

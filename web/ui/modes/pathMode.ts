@@ -1,8 +1,8 @@
 // Path mode: draw a path on the ground (mouse, pen or touch) and the chosen model walks it (the model
 // choice, modelChoice.ts): the generator's path follower (web/optimizer) optimises the motion in the
 // generator worker, the latent ERD follows the path in closed loop in its worker (a control signal
-// from where the character stands, every latent step: web/runtime/latentErdRequests.ts), or the VAE-LSTM
-// makes the whole walk for the whole path in one pass (web/runtime/vaeLstmRequests.ts), as soon as the path
+// from where the character stands, every latent step: web/runtime/latent_erd/latentErdRequests.ts), or the VAE-LSTM
+// makes the whole walk for the whole path in one pass (web/runtime/vae_lstm/vaeLstmRequests.ts), as soon as the path
 // is drawn; Vary draws a new latent sample for the same path. Compare has a second model walk the same path
 // beside the first (the viewer's companion figure), each with its own numbers. The result plays
 // with the path as followed (mint) and the character's root trajectory (the viewer's purple trail) on the ground.
@@ -13,7 +13,6 @@ import { MAX_PATH_LENGTH, MIN_PATH_LENGTH } from '../../optimizer/path';
 import type { Motion } from '../../motion/types';
 import type { ModelDescriptor, PathStats } from '../../runtime/descriptor';
 import type { Registry } from '../../runtime/registry';
-import { LATENT_PATH_SPEED } from '../../runtime/latent_erd/latentErdRequests';
 import { GroundLine, TARGET_COLOR } from '../../viewer/groundPath';
 import { $, changeTo, element, errorMessage, readSeed, setSliderFill } from '../dom';
 import type { ModeHost } from './host';
@@ -125,7 +124,9 @@ export class PathMode {
     this.showSpeed();
     this.speed.addEventListener('input', () => this.showSpeed());
     this.gait.addEventListener('change', () => {
-      this.speed.value = String(LATENT_PATH_SPEED[this.params().gait]);
+      // The gait's usual speed, as the models that take a speed ask for it when given none.
+      const speeds = this.app.registry.with('followPath').map((m) => m.descriptor.followPath!.defaultSpeed).find((s) => s !== undefined);
+      if (speeds) this.speed.value = String(speeds[this.params().gait]);
       this.showSpeed();
     });
     // Only the generator has a fit tolerance (the optimiser's), only the others a speed: the slider of the
@@ -414,12 +415,15 @@ export class PathMode {
       return;
     }
     const { gait } = this.params();
-    const model = this.app.controlModel.value;
-    const other = this.compareModel();
     const run = (this.optimising = new AbortController());
     this.progress.value = 0;
     this.showState();
     try {
+      await this.app.whenModels(); // a path a link gives is walked once the models are listed
+      if (run.signal.aborted) return;
+      const model = this.app.controlModel.value;
+      if (!model) throw new Error('no model that follows paths is listed in models/index.json');
+      const other = this.compareModel();
       const progressOf = (m: string, part: number, parts: number) => (fraction: number) => {
         this.progress.value = (part + fraction) / parts;
         const what = this.follower(m)?.working(gait) ?? 'walking the path';

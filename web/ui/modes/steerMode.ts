@@ -9,15 +9,15 @@
 // compares target and achieved speed.
 
 import { angleDifference } from '../../optimizer/path';
-import type { ModelClientBase, ModelDescriptor } from '../../runtime/descriptor';
+import type { LiveControlChunk, ModelClientBase, ModelDescriptor } from '../../runtime/descriptor';
 import { GroundArrow, TARGET_COLOR } from '../../viewer/groundPath';
 import { $, currentScope, setSliderFill } from '../dom';
 import type { ModeHost } from './host';
-import { LiveMode, type LiveChunk, type LiveStream } from './liveMode';
+import { LiveMode, type LiveStream } from './liveMode';
 import type { Gait } from '../../optimizer/pathFollower';
 
 /** What a live batch of either model carries: frames, achieved speed and heading per frame, compute time. */
-type SteerChunk = LiveChunk & { startFrame: number; speed: Float32Array; heading: Float32Array; computeMs: number };
+type SteerChunk = LiveControlChunk;
 
 
 /** Frames per optimised batch, and frames kept ready beyond the playhead (0.4 s at 30 fps). */
@@ -75,7 +75,7 @@ export class SteerMode extends LiveMode<SteerChunk> {
   private readonly statusLine = $('steer-status');
   private readonly scope = currentScope();
   private readonly arrow = new GroundArrow(TARGET_COLOR, 0.85);
-  private client: ModelClientBase | undefined;
+  private client: { id: string; client: ModelClientBase } | undefined;
   /** The model of the stream running (the choice when it started), and how it is steered. */
   private model = '';
   private live: NonNullable<ModelDescriptor['liveControl']> | undefined;
@@ -181,7 +181,7 @@ export class SteerMode extends LiveMode<SteerChunk> {
     if (!live) throw new Error('no model that takes live control is listed in models/index.json');
     this.statusLine.dataset.model = model;
     const { client, info } = await this.app.host(model).load();
-    this.client = client;
+    this.client = { id: model, client };
     const stream = await live.start(client, { seed: 0, gait: this.gaitValue }, { signal });
     this.seedName = stream.seedName;
     // The stream starts at the origin facing +z, at the slider's speed.
@@ -201,7 +201,7 @@ export class SteerMode extends LiveMode<SteerChunk> {
   }
 
   protected forget(): void {
-    if (this.client) this.app.host(this.model).reset(this.client);
+    if (this.client) this.app.host(this.client.id).reset(this.client.client);
   }
 
   protected received(chunk: SteerChunk, first: boolean): void {
