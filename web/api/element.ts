@@ -14,6 +14,7 @@ import { App } from '../ui/app';
 import { buildIn, errorMessage, type DomScope } from '../ui/dom';
 import { embedSnippet, FIRST_VIEW, formatViewValue, parseView, parseViewValue, viewQuery, VIEW_KEYS, type Mode, type ViewKey, type ViewState } from '../ui/viewState';
 import { fetchMotionSource } from '../runtime/import/motionSource';
+import { prefetchRuntime } from '../runtime/worker/workerClient';
 
 const OTHER_ATTRIBUTES = ['src', 'autoplay', 'camera-controls', 'controls', 'poster', 'loading', 'link'] as const;
 const CONTROLS = ['full', 'minimal', 'none'] as const;
@@ -147,10 +148,11 @@ export class MotionPlaygroundElement extends HTMLElement {
   }
 
   /**
-   * Starts loading the generator (its worker, the onnxruntime wasm, the model) right away when the view about to
-   * be shown is Random walk, beside the models list rather than after `ready`: the first generated frame comes
-   * sooner (npm run bench -- first-frame). Only a guess from the attributes and link, read silently (applyView
-   * reports their errors later); a failed load is retried when the mode asks for the model.
+   * When the view about to be shown is Random walk: starts fetching the onnxruntime wasm at once, beside the model
+   * list, and loading the walk model (its worker and files) as soon as the list names it, rather than after
+   * `ready`: the first generated frame comes sooner (npm run bench -- first-frame). Only a guess from the
+   * attributes and link, read silently (applyView reports their errors later); a failed load is retried when the
+   * mode asks for the model.
    */
   private preloadFirstModel(app: App): void {
     if (this.hasAttribute('src')) return;
@@ -158,6 +160,7 @@ export class MotionPlaygroundElement extends HTMLElement {
     const params = new URLSearchParams(location.search || location.hash.replace(/^#/, ''));
     const mode = (this.hasAttribute('link') ? quiet((k) => params.get(k)) : undefined) ?? quiet((k) => this.getAttribute(k)) ?? FIRST_VIEW.mode;
     if (mode !== 'walk') return;
+    prefetchRuntime();
     void app.whenModels().then((registry) => {
       const walker = registry.defaultFor('walk');
       if (walker) app.host(walker.info.id).load().catch(() => undefined);

@@ -260,6 +260,14 @@ export abstract class ModelClient<P extends object, Init extends ModelSkeleton, 
   }
 }
 
+/**
+ * Starts fetching the onnxruntime wasm that every model worker asks the page for, before any model is chosen (the
+ * model list may still be loading); a failed fetch is forgotten and tried again when a worker asks.
+ */
+export function prefetchRuntime(): void {
+  sharedDownload(ortWasmHref()).catch(() => undefined);
+}
+
 /** A model file URL resolved against the asset base (assetBase.ts; the worker would resolve relative URLs against its own script). */
 export function pageUrl(url: string): string {
   return assetUrl(url);
