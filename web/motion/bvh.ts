@@ -29,7 +29,8 @@
 // bvhJointNames(m.joints) (m's names wherever the importer can return them), m's parents and positions
 // (rigid skeletons: exactly, up to 6-decimal rounding) provided the joints are in depth-first order, as
 // every importer returns them, and the figure is over about 1.07 m tall (else pass unitScale: 0.01 to
-// parseBVH). The frame rate must be at least 1 fps.
+// parseBVH; a figure whose joints all coincide, under 0.05 file units tall at rest, is read as centimetres).
+// The frame rate must be at least 1 fps.
 import { MotionFormatError, type Motion } from './types';
 import { DEG, quatAboutAxis, quatConjugate, quatIdentity, quatMultiply, quatRotate, quatToEulerZYX, type Axis, type Quat, type Vec3 } from './math';
 import { jointAt, parentNodeGlobal, rigClip, rotationPairs, solveGlobalRotations, type RigClip } from './jointRotations';
@@ -51,6 +52,8 @@ export const BVH_UNIT_CANDIDATES: ReadonlyArray<{ name: string; scale: number }>
   { name: 'CMU units', scale: 0.0254 / 0.45 },
 ];
 const TYPICAL_HEIGHT = 1.7;
+/** Rest figures shorter than this (file units: 5 cm even in metres, the largest unit) are too small to tell the unit by. */
+const MIN_DETECTABLE_HEIGHT = 0.05;
 
 /**
  * Import limits. JOINT and End Site entries (the root included): room for the MAX_JOINTS joints of a
@@ -294,7 +297,9 @@ export function detectBVHUnitScale(nodes: ReadonlyArray<{ offset: Vec3; parent: 
   // Height is the y extent; a figure lying flat in its rest pose falls back to its largest extent.
   let height = extent(1);
   if (!(height > 0)) height = Math.max(extent(0), extent(2));
-  if (!(height > 0)) return 0.01;
+  // A rest figure of (almost) no size (every bone of zero length, as exportBVH writes a skeleton whose joints all
+  // coincide: 0.001 cm bones) says nothing of its unit; no candidate makes it a figure, so the exporter's centimetres.
+  if (!(height >= MIN_DETECTABLE_HEIGHT)) return 0.01;
   let best = BVH_UNIT_CANDIDATES[0].scale;
   for (const { scale } of BVH_UNIT_CANDIDATES) {
     if (Math.abs(Math.log((height * scale) / TYPICAL_HEIGHT)) < Math.abs(Math.log((height * best) / TYPICAL_HEIGHT))) best = scale;
