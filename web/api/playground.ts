@@ -284,14 +284,54 @@ function checkView(options: unknown): ViewOptions {
  * The `signal` option: undefined when left out, else anything with an AbortSignal's `aborted` and
  * `addEventListener` (so a signal from the page embedding this one in an iframe works too).
  */
-function checkSignal(options: unknown): AbortSignal | undefined {
-  const signal = typeof options === 'object' && options !== null ? (options as { signal?: unknown }).signal : undefined;
-  if (signal === undefined) return undefined;
-  const s = signal as Partial<AbortSignal> | null;
-  if (typeof s !== 'object' || s === null || typeof s.aborted !== 'boolean' || typeof s.addEventListener !== 'function') {
-    throw new TypeError(`signal must be an AbortSignal (an AbortController's signal), got ${describeValue(signal)}`);
+/** A call's `signal` option as the call uses it: an AbortSignal of the API's own that follows the one given. */
+export interface FollowedSignal {
+  /** Undefined when the option was left out; else aborts (with the given signal's reason) when the given one does. */
+  signal: AbortSignal | undefined;
+  /** Stops following the given signal (called once the call settles); never throws. */
+  release(): void;
+}
+
+/**
+ * The `signal` option: an object with what the API uses of an AbortSignal (`aborted`, `addEventListener`,
+ * `removeEventListener`; an AbortController's signal, from this window or another). The call never hands the
+ * given object to its workers: it listens to it once, here (a listener that cannot be added is refused), and
+ * passes on a signal of its own, so an odd signal-like object (one whose methods throw) cannot leave a call
+ * hanging, and removing the listener afterwards is tried once and its failure ignored.
+ */
+export function checkSignal(options: unknown): FollowedSignal {
+  const given = typeof options === 'object' && options !== null ? (options as { signal?: unknown }).signal : undefined;
+  if (given === undefined) return { signal: undefined, release: () => undefined };
+  const s = given as Partial<AbortSignal> | null;
+  if (typeof s !== 'object' || s === null || typeof s.aborted !== 'boolean' || typeof s.addEventListener !== 'function' || typeof s.removeEventListener !== 'function') {
+    throw new TypeError(`signal must be an AbortSignal (an AbortController's signal), got ${describeValue(given)}`);
   }
-  return signal as AbortSignal;
+  const own = new AbortController();
+  const reason = () => {
+    try {
+      return s.reason;
+    } catch {
+      return undefined;
+    }
+  };
+  const onAbort = () => own.abort(reason());
+  try {
+    s.addEventListener.call(s, 'abort', onAbort, { once: true });
+  } catch (e) {
+    throw new TypeError(`signal must be an AbortSignal (an AbortController's signal): its addEventListener failed (${errorMessage(e)})`);
+  }
+  let released = false;
+  const release = () => {
+    if (released) return;
+    released = true;
+    try {
+      s.removeEventListener!.call(s, 'abort', onAbort);
+    } catch {
+      // an odd signal's failure to forget the listener costs nothing: the listener only aborts our own signal
+    }
+  };
+  if (s.aborted) own.abort(reason());
+  return { signal: own.signal, release };
 }
 
 /**
@@ -348,8 +388,8 @@ function errorGuards(app: App) {
   /** Like `guardedAsync` for a call with a `signal` option (checked first): `fn` gets it, and the call rejects as soon as it aborts. */
   function cancellable<T>(context: string, options: unknown, fn: (signal: AbortSignal | undefined) => Promise<T>): Promise<T> {
     return guardedAsync(context, () => {
-      const signal = checkSignal(options);
-      return unlessAborted(signal, () => fn(signal));
+      const { signal, release } = checkSignal(options);
+      return unlessAborted(signal, () => fn(signal)).finally(release);
     });
   }
 
