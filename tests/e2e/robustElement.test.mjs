@@ -126,4 +126,93 @@ describe('the element and the page against odd input', { timeout: 300_000 }, () 
     assert.deepEqual(problems.filter((p) => !/request failed/.test(p)), []);
     await context.close();
   });
+
+  // #5: file names, URLs, attributes, link parameters and API strings of 10^5 characters give messages of at most 300.
+  test('every message shown or fired stays within 300 characters, whatever the input', async () => {
+    const long = (c) => c.repeat(LONG);
+    // The page: files dropped with long names, the API's methods with long strings.
+    const { context, page } = await openPlayground(browser, url);
+    const page1 = await page.evaluate(async (LONG) => {
+      const el = document.querySelector('motion-playground');
+      const seen = { toasts: [], errors: [], lastErrors: [] };
+      el.addEventListener('error', (e) => seen.errors.push(e.detail.reason));
+      new MutationObserver(() => {
+        for (const t of el.shadowRoot.querySelectorAll('.toast-text')) seen.toasts.push(t.textContent);
+      }).observe(el.shadowRoot, { subtree: true, childList: true });
+      const note = () => seen.lastErrors.push(window.playground.lastError() ?? '');
+      const drop = async (files) => {
+        const dt = new DataTransfer();
+        for (const f of files) dt.items.add(new File([f.text], f.name));
+        const target = $uiOne('.viewer-canvas');
+        for (const type of ['dragenter', 'dragover', 'drop']) target.dispatchEvent(new DragEvent(type, { dataTransfer: dt, bubbles: true, cancelable: true }));
+        await new Promise((resolve) => setTimeout(resolve, 1500));
+        note();
+      };
+      const name = 'n'.repeat(LONG);
+      await drop([{ name: `${name}.bvh`, text: 'not a motion' }]);
+      await drop([{ name: `${name}.xyz`, text: 'what' }]);
+      await drop([{ name: `${name}.amc`, text: '1\nroot 0 0 0 0 0 0\n' }]);
+      const tiny = 'HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 3 Xposition Yposition Zposition\n End Site\n {\n  OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n0 0 0\n';
+      await drop([{ name: `${name}.bvh`, text: tiny }, { name: `${name}.txt`, text: 'x' }]);
+      const text = 'x'.repeat(LONG);
+      const calls = [
+        () => window.playground.generate({ model: text, frames: 5 }),
+        () => window.playground.generate({ model: 'generator', frames: 5, [text]: 1 }),
+        () => window.playground.importMotion(text, 'bvh'),
+        () => window.playground.importMotion(`HIERARCHY\nROOT ${text}\n`, 'bvh'),
+        () => window.playground.importMotion('HIERARCHY', text),
+        () => window.playground.show({ joints: [text] }, text),
+        () => window.playground.setView({ framing: text }),
+        () => window.playground.followPath({ points: text }),
+        () => window.playground.simulateControl({ seconds: 1, schedule: [{ t: 0, speed: 1, heading: 0 }], gait: text }),
+        () => window.playground.denoise(window.playground.current(), { method: text }),
+        () => window.playground.addNoise(window.playground.current(), { [text]: 1 }),
+        () => window.playground.exportBVH(window.playground.current(), { [text]: 1 }),
+      ];
+      const thrown = [];
+      for (const call of calls) {
+        try {
+          await call();
+          thrown.push('(no error)');
+        } catch (e) {
+          thrown.push(e.message);
+        }
+        note();
+      }
+      for (const t of el.shadowRoot.querySelectorAll('.toast-text')) seen.toasts.push(t.textContent);
+      return { ...seen, thrown };
+    }, LONG);
+    await context.close();
+
+    // The element: every attribute it reads, 10^5 characters long, then `src` set to a long missing URL; the link's parameters.
+    const attrs = ['mode', 'model', 'dance-style', 'seed', 'temperature', 'refine', 'path', 'controls', 'loading', 'allowed-origins'].map((a) => `${a}="${long(a[0])}"`).join(' ');
+    pages.set('long.html', sitePage(`
+      <motion-playground id="attrs" ${attrs} poster="javascript:${long('p')}" src="/nope/${long('a')}.bvh"></motion-playground>
+      <motion-playground id="link" link></motion-playground>`));
+    const site = await open('long.html', `#mode=${long('m')}&seed=${long('9')}&path=${long('1,')}`);
+    await waitForEvent(site.page, 'attrs', 'load', 'the element with long attributes loads');
+    await waitForEvent(site.page, 'link', 'load', 'the element with a long link loads');
+    await site.page.evaluate((LONG) => { document.getElementById('attrs').src = `/nope/${'b'.repeat(LONG)}.bvh`; }, LONG);
+    await waitUntil(site.page, () => window.events.filter((e) => e.id === 'attrs' && e.type === 'error' && /^src: /.test(e.detail.reason)).length >= 2, null, { message: 'both src fail' });
+    const fired = (await events(site.page, null, 'error')).map((e) => e.detail.reason);
+    const shown = await site.page.evaluate(() => [...document.querySelectorAll('motion-playground')].flatMap((el) => [
+      ...[...el.shadowRoot.querySelectorAll('.toast-text')].map((t) => t.textContent),
+      el.playground.lastError() ?? '',
+    ]));
+    await site.context.close();
+
+    const everything = { ...page1, fired, shown };
+    for (const [what, messages] of Object.entries(everything)) {
+      const over = messages.filter((m) => m.length > MAX_MESSAGE).map((m) => `${m.length}: ${m.slice(0, 80)}…`);
+      assert.deepEqual(over, [], `${what}: every message is at most ${MAX_MESSAGE} characters`);
+    }
+    // Each path did give a message (the test reaches the sinks it means to).
+    assert.ok(page1.toasts.some((t) => /^Could not import n+/.test(t) || /nnnn/.test(t)), `a banner names the dropped file: ${JSON.stringify(page1.toasts.map((t) => t.slice(0, 60)))}`);
+    assert.ok(page1.thrown.filter((m) => m !== '(no error)').length >= 10, JSON.stringify(page1.thrown.map((m) => m.slice(0, 60))));
+    for (const pattern of [/^src: .*HTTP 404/, /^attribute mode=/, /^attribute seed=/, /^attribute path=/, /controls=/, /poster/]) {
+      assert.ok(fired.some((r) => pattern.test(r)), `an error event matches ${pattern}: ${JSON.stringify(fired.map((r) => r.slice(0, 60)))}`);
+    }
+    assert.ok(fired.filter((r) => /^src: /.test(r)).every((r) => r.includes('…')), 'a cut URL shows where it was cut');
+    assert.ok(shown.some((t) => /^Link: /.test(t)), 'the long link parameters give messages');
+  });
 });

@@ -14,6 +14,7 @@ import { App } from '../ui/app';
 import { buildIn, errorMessage, type DomScope } from '../ui/dom';
 import { embedSnippet, FIRST_VIEW, formatViewValue, parseView, parseViewValue, viewQuery, VIEW_KEYS, type Mode, type ViewKey, type ViewState } from '../ui/viewState';
 import { fetchMotionSource } from '../runtime/import/motionSource';
+import { capMessage, quoteInput } from '../motion/text';
 import { prefetchRuntime } from '../runtime/worker/workerClient';
 
 const OTHER_ATTRIBUTES = ['src', 'autoplay', 'camera-controls', 'controls', 'poster', 'loading', 'link'] as const;
@@ -210,7 +211,7 @@ export class MotionPlaygroundElement extends HTMLElement {
       const styles = models.find((m) => m.id === id)?.styles ?? [];
       let style = view.style;
       if (style !== undefined && styles.length && !styles.includes(style)) {
-        this.fire('error', { reason: `style=${JSON.stringify(style)}: ${id} dances ${styles.join(', ')}` });
+        this.fire('error', { reason: `style=${quoteInput(style)}: ${id} dances ${styles.join(', ')}` });
         style = undefined;
       }
       app.danceMode.preset(style, view.seed);
@@ -337,7 +338,7 @@ export class MotionPlaygroundElement extends HTMLElement {
     let controls: Controls = 'full';
     if (text !== null) {
       if ((CONTROLS as readonly string[]).includes(text)) controls = text as Controls;
-      else this.fire('error', { reason: `attribute controls=${JSON.stringify(text)}: must be one of ${CONTROLS.join(', ')}` });
+      else this.fire('error', { reason: `attribute controls=${quoteInput(text)}: must be one of ${CONTROLS.join(', ')}` });
     }
     for (const c of CONTROLS) this.frame.classList.toggle(`controls-${c}`, c === controls);
   }
@@ -353,7 +354,7 @@ export class MotionPlaygroundElement extends HTMLElement {
     try {
       url = new URL(src, document.baseURI);
     } catch {
-      this.fire('error', { reason: `attribute poster=${JSON.stringify(src)}: not a URL` });
+      this.fire('error', { reason: `attribute poster=${quoteInput(src)}: not a URL` });
       return;
     }
     if (url.protocol !== 'https:' && url.protocol !== 'http:' && url.protocol !== 'data:') {
@@ -386,6 +387,8 @@ export class MotionPlaygroundElement extends HTMLElement {
   }
 
   private fire(type: PlaygroundEventName, detail?: object): void {
+    // An error's reason is at most MAX_MESSAGE characters, whatever the file name, URL or attribute it quotes.
+    if (type === 'error' && detail && 'reason' in detail) detail = { ...detail, reason: capMessage(String(detail.reason)) };
     this.dispatchEvent(new CustomEvent(type, { detail }));
   }
 

@@ -16,6 +16,7 @@ import { checkSchedule } from '../optimizer/liveControl';
 import { checkPathPoints, GroundPath } from '../optimizer/path';
 import { checkFootLock, checkGait, checkSeconds, checkSeed, optional } from '../optimizer/options';
 import { describeValue } from '../motion/describe';
+import { capMessage } from '../motion/text';
 import { loadManifest, type ModelInfo } from '../model/manifest';
 import { assetUrl } from '../runtime/worker/assetBase';
 import { checkCleanupOptions, type CleanupMethod, type CleanupStats } from '../runtime/cleanup/cleanup';
@@ -359,7 +360,7 @@ const SIMULATE_OPTIONS = ['model', 'seconds', 'schedule', 'seed', 'gait', 'footL
 function errorGuards(app: App) {
   /** Shows `context: message` on the page and returns an Error with that message (the original as cause). */
   function reported(context: string, e: unknown): Error {
-    const message = `${context}: ${errorMessage(e)}`;
+    const message = capMessage(`${context}: ${errorMessage(e)}`); // as the page shows it (lastError())
     app.reportError(message);
     const err = new Error(message, { cause: e });
     if (e instanceof Error) err.name = e.name;

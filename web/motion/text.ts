@@ -19,6 +19,22 @@ export function quoteInput(value: string, max = MAX_QUOTE): string {
   return `"${shown}${value.length > max ? '…' : ''}"`;
 }
 
+/** Longest message the page shows (a banner, `lastError()`) or the element fires in an `error` event. */
+export const MAX_MESSAGE = 300;
+
+/**
+ * `message` in at most `max` characters: a longer one keeps its start and its end with "…" between them (the
+ * end often says what went wrong, the start where), never splitting a surrogate pair.
+ */
+export function capMessage(message: string, max = MAX_MESSAGE): string {
+  if (message.length <= max) return message;
+  let head = Math.ceil((max - 1) * 0.6);
+  let tail = max - 1 - head;
+  if (/[\ud800-\udbff]/.test(message[head - 1] ?? '')) head--;
+  if (/[\udc00-\udfff]/.test(message[message.length - tail] ?? '')) tail--;
+  return `${message.slice(0, head)}…${tail > 0 ? message.slice(message.length - tail) : ''}`;
+}
+
 const NUMBER = /^[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?$/;
 
 /** Rejects empty and binary input before any parsing. */

@@ -6,6 +6,7 @@ import { detectContacts } from '../motion/contacts';
 import { exportBVH } from '../motion/bvh';
 import { exportGLB } from '../motion/gltf';
 import type { RestPose } from '../motion/restPose';
+import { capMessage } from '../motion/text';
 import type { Motion } from '../motion/types';
 import type { PlaybackState } from '../viewer/playback';
 import { Viewer } from '../viewer/viewer';
@@ -272,8 +273,9 @@ export class App implements ModeHost {
     return this.lastErrorMessage;
   }
 
-  /** Shows an error to the user and remembers it for `playground.lastError()`. */
-  reportError(message: string): void {
+  /** Shows an error to the user and remembers it for `playground.lastError()`, cut to MAX_MESSAGE characters. */
+  reportError(text: string): void {
+    const message = capMessage(text);
     this.lastErrorMessage = message;
     this.toasts.show(message, 'error');
     this.events.error(message);

@@ -1,5 +1,7 @@
-// Dismissable messages at the top of the page. Errors stay until dismissed; notes fade by themselves.
+// Dismissable messages at the top of the page, at most MAX_MESSAGE characters. Errors stay until dismissed; notes
+// fade by themselves.
 
+import { capMessage } from '../motion/text';
 import { element } from './dom';
 
 export type ToastKind = 'error' | 'info';
@@ -13,7 +15,7 @@ export class Toasts {
     const el = element('div', `toast ${kind}`);
     el.setAttribute('role', kind === 'error' ? 'alert' : 'status');
     const icon = element('span', 'toast-icon', kind === 'error' ? '!' : 'i');
-    const text = element('div', 'toast-text', message);
+    const text = element('div', 'toast-text', capMessage(message)); // a file name or URL may be any length
     const close = element('button', 'toast-close', '×');
     close.type = 'button';
     close.setAttribute('aria-label', 'Dismiss');

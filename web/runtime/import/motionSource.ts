@@ -1,5 +1,16 @@
 // Fetching the <motion-playground> element's `src`: only from the page's own origin or an allowed
-// list, over http(s), at most MAX_SOURCE_BYTES, gunzipped when gzipped. Errors say why, briefly.
+// list, over http(s), at most MAX_SOURCE_BYTES, gunzipped when gzipped. Errors say why, briefly, quoting the URL
+// short (MAX_URL_QUOTE characters): a `src` may be any length.
+
+import { quoteInput } from '../../motion/text';
+
+/** Longest stretch of a URL an error message quotes. */
+export const MAX_URL_QUOTE = 120;
+
+/** A URL as a message quotes it: in quotes, cut after MAX_URL_QUOTE characters. */
+function quoteUrl(url: string): string {
+  return quoteInput(url, MAX_URL_QUOTE);
+}
 
 export const MAX_SOURCE_BYTES = 32 * 1024 * 1024;
 
@@ -19,7 +30,7 @@ export function checkSourceUrl(src: string, pageHref: string, allowed: readonly 
   try {
     url = new URL(src, pageHref);
   } catch {
-    throw new Error(`${JSON.stringify(src.slice(0, 80))} is not a URL`);
+    throw new Error(`${quoteUrl(src)} is not a URL`);
   }
   if (url.protocol !== 'http:' && url.protocol !== 'https:') throw new Error(`only http(s) URLs are fetched, not ${url.protocol}`);
   const page = new URL(pageHref).origin;
@@ -37,16 +48,16 @@ export async function fetchMotionSource(src: string, pageHref: string, allowed: 
   try {
     response = await fetchFn(url.href, { credentials: 'same-origin' });
   } catch (e) {
-    throw new Error(`could not fetch ${url.href} (${e instanceof Error ? e.message : String(e)})`);
+    throw new Error(`could not fetch ${quoteUrl(url.href)} (${e instanceof Error ? e.message : String(e)})`);
   }
-  if (!response.ok) throw new Error(`${url.href}: HTTP ${response.status}`);
+  if (!response.ok) throw new Error(`${quoteUrl(url.href)}: HTTP ${response.status}`);
   const declared = Number(response.headers.get('content-length'));
-  if (declared > MAX_SOURCE_BYTES) throw new Error(`${url.href} is ${(declared / 1e6).toFixed(0)} MB; the limit is ${MAX_SOURCE_BYTES / 1e6 | 0} MB`);
-  const bytes = await readLimited(response, url.href);
+  if (declared > MAX_SOURCE_BYTES) throw new Error(`${quoteUrl(url.href)} is ${(declared / 1e6).toFixed(0)} MB; the limit is ${MAX_SOURCE_BYTES / 1e6 | 0} MB`);
+  const bytes = await readLimited(response, quoteUrl(url.href));
   const gzipped = bytes.length > 2 && bytes[0] === 0x1f && bytes[1] === 0x8b;
   if (!gzipped) return new TextDecoder().decode(bytes);
   const unzipped = new Response(new Blob([bytes as BlobPart]).stream().pipeThrough(new DecompressionStream('gzip')));
-  return new TextDecoder().decode(await readLimited(unzipped, url.href));
+  return new TextDecoder().decode(await readLimited(unzipped, quoteUrl(url.href)));
 }
 
 async function readLimited(response: Response, what: string): Promise<Uint8Array> {
@@ -72,3 +83,4 @@ async function readLimited(response: Response, what: string): Promise<Uint8Array
   }
   return out;
 }
+
