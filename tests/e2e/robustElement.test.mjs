@@ -215,4 +215,23 @@ describe('the element and the page against odd input', { timeout: 300_000 }, () 
     assert.ok(fired.filter((r) => /^src: /.test(r)).every((r) => r.includes('…')), 'a cut URL shows where it was cut');
     assert.ok(shown.some((t) => /^Link: /.test(t)), 'the long link parameters give messages');
   });
+
+  // #6: a `%` that is no escape in a `src` file name: the clip loads, named by its file.
+  test('a src file name with a stray % loads and is named by its file', async () => {
+    pages.set('percent.html', sitePage(`
+      <motion-playground id="stray" src="clips/a%zz.bvh"></motion-playground>
+      <motion-playground id="escaped" src="clips/caf%C3%A9.bvh?v=2#x"></motion-playground>`));
+    const { context, page, problems } = await open('percent.html');
+    for (const id of ['stray', 'escaped']) await waitForEvent(page, id, 'load', `#${id} loads`);
+    const r = await page.evaluate(() => Object.fromEntries([...document.querySelectorAll('motion-playground')].map((el) => [el.id, {
+      frames: el.playground.current()?.frames ?? null,
+      name: el.shadowRoot.getElementById('clip-name').textContent,
+      error: el.playground.lastError(),
+    }])));
+    assert.deepEqual(r.stray, { frames: 450, name: 'a%zz', error: null });
+    assert.deepEqual(r.escaped, { frames: 450, name: 'café', error: null });
+    assert.deepEqual(await events(page, null, 'error'), []);
+    assert.deepEqual(problems, []);
+    await context.close();
+  });
 });

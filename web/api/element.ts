@@ -13,7 +13,7 @@ import type { Motion } from '../motion/types';
 import { App } from '../ui/app';
 import { buildIn, errorMessage, type DomScope } from '../ui/dom';
 import { embedSnippet, FIRST_VIEW, formatViewValue, parseView, parseViewValue, viewQuery, VIEW_KEYS, type Mode, type ViewKey, type ViewState } from '../ui/viewState';
-import { fetchMotionSource } from '../runtime/import/motionSource';
+import { fetchMotionSource, sourceName } from '../runtime/import/motionSource';
 import { capMessage, quoteInput } from '../motion/text';
 import { prefetchRuntime } from '../runtime/worker/workerClient';
 
@@ -324,7 +324,7 @@ export class MotionPlaygroundElement extends HTMLElement {
       const text = await fetchMotionSource(src, location.href, allowedOrigins(this.getAttribute('allowed-origins')));
       const motion = await this.app.importer.importText(text, 'bvh');
       if (token !== this.srcToken) return;
-      this.app.show(motion, decodeURIComponent(src.split('/').pop() ?? 'motion').replace(/\.bvh$/i, ''));
+      this.app.show(motion, sourceName(src));
       if (!this.hasAttribute('autoplay')) this.app.viewer.pause();
     } catch (e) {
       if (token === this.srcToken) this.app.reportError(`src: ${errorMessage(e)}`);

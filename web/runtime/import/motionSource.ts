@@ -84,3 +84,23 @@ async function readLimited(response: Response, what: string): Promise<Uint8Array
   return out;
 }
 
+/** Longest name a `src` gives its clip (MAX_SOURCE_NAME characters, cut in the middle). */
+export const MAX_SOURCE_NAME = 120;
+
+/**
+ * The clip's name from its `src`: the last path segment, without query, fragment or .bvh(.gz), percent-decoded
+ * where that is valid (`caf%C3%A9.bvh` is "café"; a stray `%` as in `a%zz.bvh` stays as written), "motion"
+ * when nothing is left.
+ */
+export function sourceName(src: string): string {
+  const file = src.replace(/[?#].*$/s, '').split('/').pop() ?? '';
+  let name: string;
+  try {
+    name = decodeURIComponent(file);
+  } catch {
+    name = file; // not a valid escape: the name as written
+  }
+  name = name.replace(/\.bvh(\.gz)?$/i, '');
+  if (name.length > MAX_SOURCE_NAME) name = `${name.slice(0, MAX_SOURCE_NAME - 41)}…${name.slice(-40)}`;
+  return name || 'motion';
+}
