@@ -234,4 +234,21 @@ describe('the element and the page against odd input', { timeout: 300_000 }, () 
     assert.deepEqual(problems, []);
     await context.close();
   });
+
+  // #7: a `src` that never answers: after 30 s an `error`, and the element goes on.
+  test('a src that never answers fails after 30 s with an error event', async () => {
+    const origin = `http://127.0.0.1:${far.port}`;
+    pages.set('hang.html', sitePage(`<motion-playground id="hang" src="${origin}/hang.bvh" allowed-origins="${origin}"></motion-playground>`));
+    const { context, page, problems } = await open('hang.html');
+    const started = Date.now();
+    await waitUntil(page, () => window.events.some((e) => e.type === 'error'), null, { timeout: 60_000, message: 'the hanging src fires error' });
+    const waited = Date.now() - started;
+    const [error] = await events(page, 'hang', 'error');
+    assert.match(error.detail.reason, /^src: .*hang\.bvh.* no answer within 30 s/);
+    assert.ok(waited > 25_000, `it waited the 30 s (${waited} ms)`);
+    await waitForEvent(page, 'hang', 'load', 'the element loads after the failed src');
+    assert.equal(await page.evaluate(() => document.getElementById('hang').playground.current()), null);
+    assert.deepEqual(problems, []);
+    await context.close();
+  });
 });

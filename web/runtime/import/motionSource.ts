@@ -41,12 +41,36 @@ export function checkSourceUrl(src: string, pageHref: string, allowed: readonly 
   return url;
 }
 
-/** The text of the BVH at `src`, checked and size-limited. */
-export async function fetchMotionSource(src: string, pageHref: string, allowed: readonly string[], fetchFn: typeof fetch = fetch): Promise<string> {
+/** How long the `src` fetch may take, from the request to the last byte, before it fails with an error. */
+export const SOURCE_TIMEOUT_MS = 30_000;
+
+/**
+ * The text of the BVH at `src`, checked and size-limited. The whole fetch fails after `timeoutMs`
+ * (SOURCE_TIMEOUT_MS) without an answer.
+ */
+export async function fetchMotionSource(src: string, pageHref: string, allowed: readonly string[], fetchFn: typeof fetch = fetch, timeoutMs = SOURCE_TIMEOUT_MS): Promise<string> {
   const url = checkSourceUrl(src, pageHref, allowed);
+  const controller = new AbortController();
+  let timer: ReturnType<typeof setTimeout> | undefined;
+  const deadline = new Promise<never>((_, reject) => {
+    timer = setTimeout(() => {
+      const late = new Error(`${quoteUrl(url.href)}: no answer within ${timeoutMs / 1000} s`);
+      reject(late); // first, so the fetch failing as it is aborted is not what is said
+      controller.abort(late);
+    }, timeoutMs);
+  });
+  try {
+    // Raced as well as aborted: a fetch that ignores its signal cannot hold the element either.
+    return await Promise.race([fetchChecked(url, fetchFn, controller.signal), deadline]);
+  } finally {
+    clearTimeout(timer);
+  }
+}
+
+async function fetchChecked(url: URL, fetchFn: typeof fetch, signal: AbortSignal): Promise<string> {
   let response: Response;
   try {
-    response = await fetchFn(url.href, { credentials: 'same-origin' });
+    response = await fetchFn(url.href, { credentials: 'same-origin', signal });
   } catch (e) {
     throw new Error(`could not fetch ${quoteUrl(url.href)} (${e instanceof Error ? e.message : String(e)})`);
   }
