@@ -251,4 +251,22 @@ describe('the element and the page against odd input', { timeout: 300_000 }, () 
     assert.deepEqual(problems, []);
     await context.close();
   });
+
+  // #9: `allowed-origins` holds for where a redirect ends, not only for the URL asked for.
+  test('a src redirected to an origin that is not allowed is refused, naming that origin', async () => {
+    const origin = `http://127.0.0.1:${far.port}`;
+    pages.set('redirect.html', sitePage(`
+      <motion-playground id="away" src="${origin}/to-other.bvh" allowed-origins="${origin}"></motion-playground>
+      <motion-playground id="home" src="${origin}/to-self.bvh" allowed-origins="${origin}"></motion-playground>`));
+    const { context, page, problems } = await open('redirect.html');
+    for (const id of ['away', 'home']) await waitForEvent(page, id, 'load', `#${id} loads`);
+    const r = await page.evaluate(() => Object.fromEntries([...document.querySelectorAll('motion-playground')].map((el) => [el.id, el.playground.current()?.frames ?? null])));
+    assert.deepEqual(r, { away: null, home: 450 }, 'the clip redirected away is not shown; the one redirected within the allowed origin is');
+    const reasons = (await events(page, 'away', 'error')).map((e) => e.detail.reason);
+    assert.equal(reasons.length, 1, JSON.stringify(reasons));
+    assert.match(reasons[0], new RegExp(`^src: .*redirected to http://localhost:${other.port}\\b.*not this page's origin or in allowed-origins`));
+    assert.deepEqual(await events(page, 'home', 'error'), []);
+    assert.deepEqual(problems, []);
+    await context.close();
+  });
 });

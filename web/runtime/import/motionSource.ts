@@ -33,20 +33,24 @@ export function checkSourceUrl(src: string, pageHref: string, allowed: readonly 
     throw new Error(`${quoteUrl(src)} is not a URL`);
   }
   if (url.protocol !== 'http:' && url.protocol !== 'https:') throw new Error(`only http(s) URLs are fetched, not ${url.protocol}`);
-  const page = new URL(pageHref).origin;
-  const origins = allowed.map(originOf).filter((o): o is string => o !== null);
-  if (url.origin !== page && !origins.includes(url.origin)) {
+  if (!originAllowed(url.origin, pageHref, allowed)) {
     throw new Error(`${url.origin} is not this page's origin or in allowed-origins; the file was not fetched`);
   }
   return url;
+}
+
+/** Whether a file may come from `origin`: the page's own, or one in the allowed list. */
+function originAllowed(origin: string, pageHref: string, allowed: readonly string[]): boolean {
+  return origin === new URL(pageHref).origin || allowed.map(originOf).includes(origin);
 }
 
 /** How long the `src` fetch may take, from the request to the last byte, before it fails with an error. */
 export const SOURCE_TIMEOUT_MS = 30_000;
 
 /**
- * The text of the BVH at `src`, checked and size-limited. The whole fetch fails after `timeoutMs`
- * (SOURCE_TIMEOUT_MS) without an answer.
+ * The text of the BVH at `src`, checked and size-limited. A redirect must end on an allowed origin too (the
+ * final URL is checked by the same rule, so an open redirect on an allowed site reaches no other), and the
+ * whole fetch fails after `timeoutMs` (SOURCE_TIMEOUT_MS) without an answer.
  */
 export async function fetchMotionSource(src: string, pageHref: string, allowed: readonly string[], fetchFn: typeof fetch = fetch, timeoutMs = SOURCE_TIMEOUT_MS): Promise<string> {
   const url = checkSourceUrl(src, pageHref, allowed);
@@ -61,18 +65,26 @@ export async function fetchMotionSource(src: string, pageHref: string, allowed: 
   });
   try {
     // Raced as well as aborted: a fetch that ignores its signal cannot hold the element either.
-    return await Promise.race([fetchChecked(url, fetchFn, controller.signal), deadline]);
+    return await Promise.race([fetchChecked(url, pageHref, allowed, fetchFn, controller.signal), deadline]);
   } finally {
     clearTimeout(timer);
   }
 }
 
-async function fetchChecked(url: URL, fetchFn: typeof fetch, signal: AbortSignal): Promise<string> {
+async function fetchChecked(url: URL, pageHref: string, allowed: readonly string[], fetchFn: typeof fetch, signal: AbortSignal): Promise<string> {
   let response: Response;
   try {
     response = await fetchFn(url.href, { credentials: 'same-origin', signal });
   } catch (e) {
     throw new Error(`could not fetch ${quoteUrl(url.href)} (${e instanceof Error ? e.message : String(e)})`);
+  }
+  if (response.url) {
+    // Where the redirects (if any) ended: the file is read only from an allowed origin.
+    const final = originOf(response.url);
+    if (final === null || !originAllowed(final, pageHref, allowed)) {
+      response.body?.cancel().catch(() => undefined);
+      throw new Error(`${quoteUrl(url.href)} was redirected to ${final ?? quoteUrl(response.url)}, which is not this page's origin or in allowed-origins; the file was not read`);
+    }
   }
   if (!response.ok) throw new Error(`${quoteUrl(url.href)}: HTTP ${response.status}`);
   const declared = Number(response.headers.get('content-length'));
