@@ -269,4 +269,39 @@ describe('the element and the page against odd input', { timeout: 300_000 }, () 
     assert.deepEqual(problems, []);
     await context.close();
   });
+
+  // #12: an unknown `loading` is refused with the allowed values; each bad `controls`, `poster` and `loading` fires one error.
+  test('bad loading, controls and poster attributes each fire one error, and the defaults are kept', async () => {
+    pages.set('attributes.html', sitePage(`<motion-playground id="odd" controls="huge" poster="javascript:alert(1)" loading="never"></motion-playground>
+      <motion-playground id="bad-url" poster="http://[oops"></motion-playground>`));
+    const { context, page, problems } = await open('attributes.html');
+    for (const id of ['odd', 'bad-url']) await waitForEvent(page, id, 'load', `#${id} starts at once (loading keeps its default, eager)`);
+    const reasons = async (id) => (await events(page, id, 'error')).map((e) => e.detail.reason);
+    assert.deepEqual((await reasons('odd')).sort(), [
+      'attribute controls="huge": must be one of full, minimal, none',
+      'attribute loading="never": must be one of eager, lazy',
+      'attribute poster: javascript: URLs are not allowed',
+    ]);
+    assert.deepEqual(await reasons('bad-url'), ['attribute poster="http://[oops": not a URL']);
+    const controls = await page.evaluate(() => [...document.getElementById('odd').shadowRoot.querySelector('.app').classList].filter((c) => c.startsWith('controls-')));
+    assert.deepEqual(controls, ['controls-full']);
+    // Changed later: once per change.
+    await page.evaluate(() => {
+      const el = document.getElementById('odd');
+      el.controls = 'big';
+      el.loading = 'soon';
+      el.poster = 'ftp://x/y.png';
+      el.controls = 'minimal';
+      el.controls = 'big';
+    });
+    const later = (await reasons('odd')).slice(3);
+    assert.deepEqual(later, [
+      'attribute controls="big": must be one of full, minimal, none',
+      'attribute loading="soon": must be one of eager, lazy',
+      'attribute poster: ftp: URLs are not allowed',
+      'attribute controls="big": must be one of full, minimal, none',
+    ]);
+    assert.deepEqual(problems, []);
+    await context.close();
+  });
 });

@@ -20,6 +20,8 @@ import { prefetchRuntime } from '../runtime/worker/workerClient';
 const OTHER_ATTRIBUTES = ['src', 'autoplay', 'camera-controls', 'controls', 'poster', 'loading', 'link'] as const;
 const CONTROLS = ['full', 'minimal', 'none'] as const;
 type Controls = (typeof CONTROLS)[number];
+const LOADING = ['eager', 'lazy'] as const;
+type Loading = (typeof LOADING)[number];
 
 /** What the element fires: `error` and `progress` carry a detail, `motion` the shown motion's name. */
 export type PlaygroundEventName = 'load' | 'error' | 'progress' | 'play' | 'pause' | 'motion';
@@ -41,6 +43,8 @@ export class MotionPlaygroundElement extends HTMLElement {
   /** Taken off the page (disconnectedCallback): its frame loop and live stream are stopped until it is back. */
   private suspended = false;
   private linkTimer = 0;
+  /** The bad value of `controls`, `poster` or `loading` whose `error` has fired (badAttribute). */
+  private readonly reportedBad = new Map<string, string>();
   /** Bumped for every `src` load: a slower earlier one does not replace a later one. */
   private srcToken = 0;
 
@@ -68,7 +72,7 @@ export class MotionPlaygroundElement extends HTMLElement {
       this.app?.resume();
     }
     if (this.app || this.lazyObserver) return;
-    if (this.getAttribute('loading') === 'lazy' && 'IntersectionObserver' in window) {
+    if (this.loadingMode() === 'lazy' && 'IntersectionObserver' in window) {
       // Nothing is fetched (onnxruntime-web, models) until the element comes near the viewport.
       this.lazyObserver = new IntersectionObserver((entries) => {
         if (entries.some((e) => e.isIntersecting)) this.start();
@@ -94,6 +98,7 @@ export class MotionPlaygroundElement extends HTMLElement {
     if (this.reflecting || before === after) return;
     if (name === 'controls') return this.showControls();
     if (name === 'poster') return this.showPoster();
+    if (name === 'loading') return void this.loadingMode(); // a bad value is reported; it counts when the element connects
     if (name === 'camera-controls' && this.app) this.app.viewer.controls.enabled = after !== null;
     if (!this.app || !this.api) return; // applied when it starts
     if (name === 'src') {
@@ -336,15 +341,18 @@ export class MotionPlaygroundElement extends HTMLElement {
   private showControls(): void {
     const text = this.getAttribute('controls');
     let controls: Controls = 'full';
-    if (text !== null) {
-      if ((CONTROLS as readonly string[]).includes(text)) controls = text as Controls;
-      else this.fire('error', { reason: `attribute controls=${quoteInput(text)}: must be one of ${CONTROLS.join(', ')}` });
+    if (text === null || (CONTROLS as readonly string[]).includes(text)) {
+      controls = (text ?? 'full') as Controls;
+      this.reportedBad.delete('controls');
+    } else {
+      this.badAttribute('controls', text, `controls=${quoteInput(text)}: must be one of ${CONTROLS.join(', ')}`);
     }
     for (const c of CONTROLS) this.frame.classList.toggle(`controls-${c}`, c === controls);
   }
 
   private showPoster(): void {
     const src = this.getAttribute('poster');
+    if (src !== this.reportedBad.get('poster')) this.reportedBad.delete('poster');
     if (!src) {
       this.posterImage.hidden = true;
       this.posterImage.removeAttribute('src');
@@ -354,15 +362,40 @@ export class MotionPlaygroundElement extends HTMLElement {
     try {
       url = new URL(src, document.baseURI);
     } catch {
-      this.fire('error', { reason: `attribute poster=${quoteInput(src)}: not a URL` });
+      this.badAttribute('poster', src, `poster=${quoteInput(src)}: not a URL`);
       return;
     }
     if (url.protocol !== 'https:' && url.protocol !== 'http:' && url.protocol !== 'data:') {
-      this.fire('error', { reason: `attribute poster: ${url.protocol} URLs are not allowed` });
+      this.badAttribute('poster', src, `poster: ${url.protocol} URLs are not allowed`);
       return;
     }
     this.posterImage.src = url.href;
     this.posterImage.hidden = this.app?.current != null;
+  }
+
+  /**
+   * The `loading` attribute: `eager` (the default) or `lazy`; any other value fires `error` with the allowed
+   * values and counts as `eager`.
+   */
+  private loadingMode(): Loading {
+    const text = this.getAttribute('loading');
+    if (text === null || (LOADING as readonly string[]).includes(text)) {
+      this.reportedBad.delete('loading');
+      return (text ?? 'eager') as Loading;
+    }
+    this.badAttribute('loading', text, `loading=${quoteInput(text)}: must be one of ${LOADING.join(', ')}`);
+    return 'eager';
+  }
+
+  /**
+   * Fires `error` ("attribute <reason>") for a bad value of `name` (controls, poster, loading), once per value: the
+   * value is checked when it changes and again as the element connects or rebuilds its UI, which must not say it
+   * twice. A good value clears it, so the same bad value set again is reported again.
+   */
+  private badAttribute(name: string, value: string, reason: string): void {
+    if (this.reportedBad.get(name) === value) return;
+    this.reportedBad.set(name, value);
+    this.fire('error', { reason: `attribute ${reason}` });
   }
 
   /** Progress bars and the model indicator inside the shadow root, as `progress` events. */
