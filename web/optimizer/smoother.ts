@@ -51,6 +51,8 @@ export interface SmootherInput {
   /** joints × 3 offsets to decode with (the clip's own segment lengths). */
   offsets: ArrayLike<number>;
   onFrame?: (frame: number, frames: number) => void;
+  /** A cancellation checkpoint, awaited between frames where no model step is (frame 0's update, the backward pass): it throws to stop. */
+  pause?: () => Promise<void>;
 }
 
 export interface SmootherResult {
@@ -168,6 +170,7 @@ export async function smoothFeatures(a: SmootherInput): Promise<SmootherResult> 
   const root0: RootStart = { ...a.start };
   const P0 = new Float64Array(n * n);
   for (let d = 0; d < n; d++) P0[d * n + d] = FIRST_FRAME_SIGMA ** 2;
+  await a.pause?.();
   const u0 = update(first.slice(0, n), P0, 0, root0);
   xf.push(u0.x); Pf.push(u0.cov); xp.push(u0.x); Pp.push(P0); F.push(new Float64Array(0));
   contactRows.push(first.slice(n));
@@ -260,6 +263,7 @@ export async function smoothFeatures(a: SmootherInput): Promise<SmootherResult> 
   const xs: Float64Array[] = new Array(frames);
   xs[frames - 1] = xf[frames - 1];
   for (let f = frames - 2; f >= 0; f--) {
+    if (f % 16 === 0) await a.pause?.();
     const diff = new Float64Array(n);
     for (let d = 0; d < n; d++) diff[d] = xs[f + 1][d] - xp[f + 1][d];
     const g = choleskySolve(cholesky(Pp[f + 1], n), diff, n); // P⁻¹ (x_s − x_p)

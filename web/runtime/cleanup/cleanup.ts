@@ -21,6 +21,17 @@ import type { Motion } from '../../motion/types';
 import { describeValue } from '../../motion/describe';
 import { smoothFeatures } from '../../optimizer/smoother';
 import type { StepFn } from '../../optimizer/rollout';
+import { checkpoint } from '../worker/cancellation';
+
+/**
+ * A cancellation checkpoint between the stages of a clean-up (cancellation.ts): without `signal` nothing; else it
+ * throws a CancelledError once the request is cancelled, first letting the worker read its messages every 20 ms
+ * of work. The stages before the first model step and after the last take seconds on a long clip.
+ */
+async function pause(signal: AbortSignal | undefined): Promise<void> {
+  const look = signal && checkpoint(signal);
+  if (look) await look;
+}
 
 export const CLEANUP_METHODS = ['map', 'manifold', 'lowpass'] as const;
 export type CleanupMethod = (typeof CLEANUP_METHODS)[number];
@@ -58,20 +69,45 @@ const OPTION_RANGES = { sigmaRoot: [0.001, 1, 'metres'], sigmaAngle: [0.001, 1.5
 
 /** Checks clean-up options (the API and the worker both do); throws with a short reason naming the option. */
 export function checkCleanupOptions(options: unknown): CleanupOptions {
-  if (typeof options !== 'object' || options === null || Array.isArray(options)) throw new Error(`denoise: options must be an object like { method: 'map' }, got ${describeValue(options)}`);
+  if (typeof options !== 'object' || options === null || Array.isArray(options)) throw new Error(`options must be an object like { method: 'map' }, got ${describeValue(options)}`);
   const o = options as Record<string, unknown>;
   for (const key of Object.keys(o)) {
-    if (key !== 'method' && !(key in OPTION_RANGES)) throw new Error(`denoise: unknown option "${key.slice(0, 40)}" (known: method, ${Object.keys(OPTION_RANGES).join(', ')})`);
+    if (key !== 'method' && !(key in OPTION_RANGES)) throw new Error(`unknown option "${key.slice(0, 40)}" (known: method, ${Object.keys(OPTION_RANGES).join(', ')})`);
   }
-  if (!CLEANUP_METHODS.includes(o.method as CleanupMethod)) throw new Error(`denoise: method must be one of ${CLEANUP_METHODS.join(', ')}, got ${describeValue(o.method)}`);
+  if (!CLEANUP_METHODS.includes(o.method as CleanupMethod)) throw new Error(`method must be one of ${CLEANUP_METHODS.join(', ')}, got ${describeValue(o.method)}`);
   const out: CleanupOptions = { method: o.method as CleanupMethod };
   for (const [key, [lo, hi, unit]] of Object.entries(OPTION_RANGES)) {
     const v = o[key];
     if (v === undefined) continue;
-    if (typeof v !== 'number' || !Number.isFinite(v) || v < lo || v > hi) throw new Error(`denoise: ${key} must be a number of ${unit} from ${lo} to ${hi}, got ${describeValue(v)}`);
+    if (typeof v !== 'number' || !Number.isFinite(v) || v < lo || v > hi) throw new Error(`${key} must be a number of ${unit} from ${lo} to ${hi}, got ${describeValue(v)}`);
     (out as unknown as Record<string, number>)[key] = v;
   }
   return out;
+}
+
+/**
+ * Frame rates clean-up takes (fps). Real capture lies well inside: CMU's 120, consumer suits 60–240, high-speed
+ * optical systems up to 1000. Below 1 fps a "motion" is a slide show whose frames the 30 fps model steps cannot
+ * bridge, and at 0.01 fps the resampling to 30 fps made millions of model frames (the worker busy for minutes, at
+ * 1e-6 fps a 672,750,000,075-value array); above 1000 fps the resampling averages thousands of samples per frame.
+ */
+export const CLEANUP_FPS: readonly [number, number] = [1, 1000];
+/** Longest motion clean-up takes (s): an hour, 108,000 model frames at 30 fps (each a model step, minutes of work already). */
+export const MAX_CLEANUP_SECONDS = 3600;
+
+/**
+ * Checks that clean-up can handle `motion` (a validated Motion) in time and memory: its frame rate within CLEANUP_FPS
+ * and its length within MAX_CLEANUP_SECONDS, so the frames at the model's rate stay bounded. The API and the worker
+ * both check, before any model work; throws a short reason.
+ */
+export function checkCleanupMotion(motion: Pick<Motion, 'fps' | 'frames'>): void {
+  const [lo, hi] = CLEANUP_FPS;
+  const { fps, frames } = motion;
+  if (!(fps >= lo && fps <= hi)) throw new RangeError(`the motion's frame rate must be from ${lo} to ${hi} fps for clean-up (capture is recorded within), got ${Number(fps.toPrecision(6))} fps`);
+  const seconds = (frames - 1) / fps;
+  if (seconds > MAX_CLEANUP_SECONDS) {
+    throw new RangeError(`the motion lasts ${(seconds / 60).toFixed(1)} min; clean-up takes at most ${MAX_CLEANUP_SECONDS / 60} min (cut it into parts)`);
+  }
 }
 
 /** Cut-off (Hz) of the root track's smoothing: keeps the hips' sway with each step, drops jitter. */
@@ -151,27 +187,32 @@ export interface CanonicalCleaned {
  * Observation σ per point: the measured jitter by default; `sigmaRoot` sets the hips', `sigmaAngle` the others' as
  * that angle times the segment's length (a rotation error δ of a segment moves its end by δ · length).
  */
-export function mapCleaner(args: { step: StepFn; info: GeneratorInfo; mean: ArrayLike<number>; std: ArrayLike<number>; options: CleanupOptions; onProgress?: (fraction: number) => void }) {
+export function mapCleaner(args: { step: StepFn; info: GeneratorInfo; mean: ArrayLike<number>; std: ArrayLike<number>; options: CleanupOptions; onProgress?: (fraction: number) => void; signal?: AbortSignal }) {
   return async (input: CanonicalInput): Promise<CanonicalCleaned> => {
-    const { info, options } = args;
+    const { info, options, signal } = args;
+    await pause(signal);
     const K = CANONICAL_JOINTS.length;
     const frames = input.points.length / (K * 3);
     const encoded = encodeFeatures(info, input.points, input.rotations);
     const jitter = Math.max(SIGMA_FLOOR, input.jitter);
     const offsets = segmentOffsets(info, input.steady.points, input.steady.jitter);
+    await pause(signal);
     const sigma = Array.from({ length: K }, (_, k) => {
       if (k === 0) return options.sigmaRoot ?? jitter;
       if (options.sigmaAngle === undefined) return jitter;
       return Math.max(SIGMA_FLOOR, options.sigmaAngle * Math.hypot(offsets[k * 3], offsets[k * 3 + 1], offsets[k * 3 + 2]));
     });
     const { rootTrack, start } = smoothRootTrack(encoded.features, encoded.start, info.onnx.dim, input.fps);
+    await pause(signal);
     const r = await smoothFeatures({
+      pause: () => pause(signal),
       step: args.step, info, mean: args.mean, std: args.std,
       points: input.points, sigma, encoded: encoded.features, rootTrack, start, offsets,
       onFrame: (f) => args.onProgress?.(f / frames),
     });
     // Decoded on the clip's own segment lengths, so the cleaned points keep its proportions.
     const decoded = decodeFeatures(info, r.features, start, offsets);
+    await pause(signal);
     return {
       positions: withSlowPart(decoded.positions, input.slow, input.fps),
       bits: decoded.contacts,
@@ -234,8 +275,10 @@ export async function cleanUpOnCanonical(
   motion: Motion,
   method: CleanupMethod,
   clean: (input: CanonicalInput) => Promise<CanonicalCleaned>,
+  signal?: AbortSignal,
 ): Promise<CleanupResult> {
   const began = performance.now();
+  await pause(signal);
   const mapping = mapSkeleton(motion, legLength(info));
   const K = CANONICAL_JOINTS.length;
   const fps = info.fps;
@@ -251,16 +294,20 @@ export async function cleanUpOnCanonical(
   const floor = floorHeight(points);
   for (let i = 1; i < points.length; i += 3) points[i] -= floor;
   const jitter = medianJitter(beforePoints);
+  await pause(signal);
   const rotations = canonicalRotations(info, points);
   const beforeRotations = resampleQuaternions(rotations, K, fps, motion.fps, motion.frames);
+  await pause(signal);
   const slowHz = belowNyquist(slowBandHz(jitter), motion.fps);
   const slow = { points: resampleLinear(lowpassRows(beforePoints, K * 3, motion.fps, { cutoffHz: slowHz }), K * 3, motion.fps, fps, frames), hz: slowHz };
   for (let i = 1; i < slow.points.length; i += 3) slow.points[i] -= floor;
   const steadyHz = belowNyquist(STEADY_BAND_HZ, motion.fps);
   const steadyMotion = lowpassMotion(motion, { cutoffHz: steadyHz });
+  await pause(signal);
   const steadyJitter = jitter * Math.sqrt(Math.min(1, (2.05 * steadyHz) / motion.fps));
   const steadyBefore = toCanonical(steadyMotion, mapping);
   const steady = { points: resampleLinear(steadyBefore, K * 3, motion.fps, fps, frames), jitter: steadyJitter };
+  await pause(signal);
   const cleaned = await clean({ points, rotations, fps, jitter: jitter / Math.sqrt(window >= 5 ? window - 1 : (2 * window) / Math.PI), slow, steady });
   const { skeleton } = info;
   // Contacts labelled on the cleaned motion (the model's bits with the feet's heights and speeds), planted feet pinned.
@@ -268,10 +315,13 @@ export async function cleanUpOnCanonical(
   const planted = { positions: pinFeet(cleaned.positions, contacts30, skeleton.joints, PIN_TOLERANCE), contacts: contacts30 };
   for (let i = 1; i < planted.positions.length; i += 3) planted.positions[i] += floor;
   const afterRotations = canonicalRotations(info, planted.positions);
+  await pause(signal);
   // After: back at the imported motion's frame times.
   const afterPoints = resampleLinear(planted.positions, K * 3, fps, motion.fps, motion.frames);
   const after = { points: afterPoints, rotations: resampleQuaternions(afterRotations, K, fps, motion.fps, motion.frames) };
+  await pause(signal);
   const moved = fromCanonical(steadyMotion, mapping, { points: steadyBefore, rotations: beforeRotations }, after, steadyJitter / mapping.scale);
+  await pause(signal);
   const contacts = resampleNearest(planted.contacts, 2, fps, motion.fps, motion.frames);
   return {
     motion: { ...moved, contacts },

@@ -4,7 +4,7 @@
 import type { GeneratorInfo } from '../../model/generatorInfo';
 import { validateMotion } from '../../motion/validate';
 import type { Motion } from '../../motion/types';
-import { checkCleanupOptions, cleanUpOnCanonical, lowpassCleanup, type CanonicalCleaned, type CanonicalInput, type CleanupOptions, type CleanupResult } from './cleanup';
+import { checkCleanupMotion, checkCleanupOptions, cleanUpOnCanonical, lowpassCleanup, type CanonicalCleaned, type CanonicalInput, type CleanupOptions, type CleanupResult } from './cleanup';
 
 export interface DenoiseParams {
   motion: Motion;
@@ -18,15 +18,16 @@ export interface DenoiseBackend {
   cleaner: (options: CleanupOptions, progress: (fraction: number) => void) => (input: CanonicalInput) => Promise<CanonicalCleaned>;
 }
 
-export async function serveDenoise(p: DenoiseParams, backend: DenoiseBackend, progress: (fraction: number) => void): Promise<CleanupResult> {
+export async function serveDenoise(p: DenoiseParams, backend: DenoiseBackend, progress: (fraction: number) => void, signal?: AbortSignal): Promise<CleanupResult> {
   const motion = validateMotion(p.motion);
   const options = checkCleanupOptions(p.options);
-  if (!backend.methods.includes(options.method)) throw new Error(`denoise: method ${options.method} is not served by this worker`);
+  checkCleanupMotion(motion);
+  if (!backend.methods.includes(options.method)) throw new Error(`method ${options.method} is not served by this worker`);
   if (options.method === 'lowpass') {
     progress(1);
     return lowpassCleanup(motion, options);
   }
-  const result = await cleanUpOnCanonical(await backend.info(), motion, options.method, backend.cleaner(options, progress));
+  const result = await cleanUpOnCanonical(await backend.info(), motion, options.method, backend.cleaner(options, progress), signal);
   progress(1);
   return result;
 }

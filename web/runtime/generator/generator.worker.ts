@@ -40,8 +40,8 @@ serveModel({
       serveDenoise(r, {
         methods: ['map', 'lowpass'],
         info: () => Promise.resolve(core.info),
-        cleaner: (options, onProgress) => mapCleaner({ step: (b, x, h, c) => core.step(b, x, h, c, signal), info: core.info, mean: core.mean, std: core.std, options, onProgress }),
-      }, progress),
+        cleaner: (options, onProgress) => mapCleaner({ step: (b, x, h, c) => core.step(b, x, h, c, signal), info: core.info, mean: core.mean, std: core.std, options, onProgress, signal }),
+      }, progress, signal),
     followPath: (r: FollowPathParams, core: GeneratorCore, progress, signal) => optimizerOf(core).followPath(r, progress, signal),
     controlStart: async (r: ControlStartParams, core: GeneratorCore) => optimizerOf(core).controlStart(r),
     controlPull: (r: ControlTargetParams & { frames: number }, core: GeneratorCore) => optimizerOf(core).controlPull(r),

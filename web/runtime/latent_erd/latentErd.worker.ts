@@ -59,7 +59,7 @@ serveModel({
           return generatorInfo;
         },
         cleaner: (_options, onProgress) => manifoldCleaner((positions) => core.projectManifold(positions, undefined, signal, onProgress)),
-      }, progress),
+      }, progress, signal),
     followPath: (r: LatentFollowPathParams, core: LatentErdCore, progress, signal) => requestsOf(core).followPath(r, progress, signal),
     controlStart: (r: LatentControlStartParams, core: LatentErdCore, _progress, signal) => requestsOf(core).controlStart(r, signal),
     controlPull: async (r: LatentControlTarget & { frames: number }, core: LatentErdCore) => requestsOf(core).controlPull(r),
