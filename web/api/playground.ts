@@ -19,7 +19,7 @@ import { describeValue } from '../motion/describe';
 import { capMessage } from '../motion/text';
 import { loadManifest, type ModelInfo } from '../model/manifest';
 import { assetUrl } from '../runtime/worker/assetBase';
-import { checkCleanupOptions, type CleanupMethod, type CleanupStats } from '../runtime/cleanup/cleanup';
+import { checkCleanupMotion, checkCleanupOptions, type CleanupMethod, type CleanupStats } from '../runtime/cleanup/cleanup';
 import type { Capability, GenerateCall, ModelDescriptor, PathStats } from '../runtime/descriptor';
 import { Registry, type RegisteredModel } from '../runtime/registry';
 import { mapSkeleton } from '../motion/skeletonMap';
@@ -504,6 +504,7 @@ export function createPlayground(app: App): Playground {
         const rest = { ...(options as unknown as Record<string, unknown>) };
         delete rest.signal;
         const o = checkCleanupOptions(typeof options === 'object' && options !== null ? rest : options);
+        checkCleanupMotion(input); // a frame rate or length clean-up cannot handle is refused here, before any worker
         if (o.method !== 'lowpass') mapSkeleton(input, 1); // an unmappable skeleton fails here, naming its missing joints
         await ready;
         const cleaner = app.registry.with('cleanup').find((m) => m.descriptor.cleanup!.methods.includes(o.method));
