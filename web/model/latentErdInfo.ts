@@ -6,6 +6,7 @@
 // two belong together. Also the checks of the latent ERD's request options that the page API and the
 // worker share (the per-frame control signal, the seed's seed state).
 import { describeValue } from '../motion/describe';
+import { checkNoHoles } from '../motion/validate';
 import { MAX_FRAMES } from '../motion/text';
 import { modelInfoFormat, type FieldChecks } from './modelInfo';
 
@@ -227,9 +228,11 @@ export function checkControlSignal(control: unknown, frames: number, name = 'con
   if (!Array.isArray(control)) throw new TypeError(`${name} must be an array of ${shape} triples, one per frame, got ${describeValue(control)}`);
   if (control.length < frames) throw new RangeError(`${name} has ${control.length} frames; it needs at least one per frame (${frames})`);
   if (control.length > MAX_FRAMES) throw new RangeError(`${name} has ${control.length} frames; at most ${MAX_FRAMES} are accepted`);
+  checkNoHoles(control, name);
   const out = new Float64Array(control.length * 3);
   for (let f = 0; f < control.length; f++) {
     const c = control[f] as unknown;
+    if (Array.isArray(c)) checkNoHoles(c, `${name}[${f}]`);
     if (!Array.isArray(c) || c.length !== 3 || !c.every((v) => typeof v === 'number' && Number.isFinite(v))) {
       throw new TypeError(`${name}[${f}] must be a triple of finite numbers ${shape}, got ${describeValue(c)}`);
     }

@@ -19,6 +19,21 @@ export function positionOutOfBounds(value: number, frame: number, joint: string,
   return `frame ${frame} puts joint ${quoteInput(joint)} at ${AXIS_NAMES[axis]} = ${Number(value.toPrecision(7))} m (at most ±${MAX_POSITION} m on each axis)`;
 }
 
+/**
+ * The index of the first hole of a sparse array (`[1, , 2]`, `new Array(3)`, a deleted item), or -1: forEach, every
+ * and map skip holes, so an array check that uses them passes a hole that fails later as `undefined`.
+ */
+export function firstHole(array: readonly unknown[]): number {
+  for (let i = 0; i < array.length; i++) if (!(i in array)) return i;
+  return -1;
+}
+
+/** Throws a TypeError naming the first hole of `array` (called `name` in the message), if it has one. */
+export function checkNoHoles(array: readonly unknown[], name: string): void {
+  const i = firstHole(array);
+  if (i >= 0) throw new TypeError(`${name}[${i}] is missing (the array has a hole there)`);
+}
+
 function fail(message: string): never {
   throw new Error(`Invalid motion: ${message}`);
 }
@@ -47,6 +62,11 @@ export function validateMotion(m: unknown): Motion {
   const joints = o.joints;
   if (!Array.isArray(joints) || joints.length === 0) fail('joints must be a non-empty array of names');
   if (joints.length > MAX_JOINTS) fail(`too many joints (${joints.length}, at most ${MAX_JOINTS})`);
+  const hole = (a: unknown[], name: string) => {
+    const i = firstHole(a);
+    if (i >= 0) fail(`${name}[${i}] is missing (the array has a hole there)`);
+  };
+  hole(joints, 'joints');
   const seen = new Set<string>();
   joints.forEach((name, j) => {
     if (typeof name !== 'string' || name.length === 0) fail(`joints[${j}] must be a non-empty string`);
@@ -58,12 +78,14 @@ export function validateMotion(m: unknown): Motion {
   if (!Array.isArray(parents) || parents.length !== joints.length) {
     fail(`parents must be an array with one entry per joint (${joints.length}), got ${Array.isArray(parents) ? parents.length : typeof parents}`);
   }
+  hole(parents, 'parents');
   parents.forEach((p, j) => {
     if (typeof p !== 'number' || !Number.isInteger(p)) fail(`parents[${j}] must be an integer`);
     if (j === 0 && p !== -1) fail(`the first joint must be the root (parent -1), got parent ${p}`);
     if (j > 0 && (p < 0 || p >= j)) fail(`parents[${j}] = ${p}: every non-root joint needs a parent listed before it`);
   });
 
+  if (Array.isArray(o.positions)) hole(o.positions, 'positions');
   const positions = toFloat32(o.positions, 'positions');
   const expected = frames * joints.length * 3;
   if (expected > MAX_VALUES) fail(`too many position values (${expected}, at most ${MAX_VALUES})`);
@@ -82,6 +104,7 @@ export function validateMotion(m: unknown): Motion {
   if (o.contacts !== undefined) {
     const c = o.contacts;
     if (!(c instanceof Uint8Array) && !Array.isArray(c)) fail('contacts must be a Uint8Array or an array of 0/1');
+    if (Array.isArray(c)) hole(c, 'contacts');
     const contacts = c instanceof Uint8Array ? c : Uint8Array.from(c as number[]);
     if (contacts.length !== frames * 2) fail(`contacts has ${contacts.length} values, expected frames × 2 = ${frames * 2}`);
     for (let i = 0; i < contacts.length; i++) {

@@ -8,6 +8,7 @@ import { decodeFeatures } from '../model/featureDecode';
 import { noiseCorrelation, type GeneratorInfo } from '../model/generatorInfo';
 import { Rng } from '../model/sampler';
 import { describeValue } from '../motion/describe';
+import { checkNoHoles } from '../motion/validate';
 import { contactCost, lastToes, particleFeatures, type ToeState } from './objective';
 import { angleDifference } from './path';
 import { seedStreamState, type RolloutResult, type SteerRequest, type StepFn, type Steering, type StreamState } from './rollout';
@@ -226,6 +227,7 @@ export interface ScheduleEntry extends ControlTarget {
 /** Checks a control schedule: a non-empty list of { t, speed, heading }, t ≥ 0 and increasing, the first at t = 0. */
 export function checkSchedule(schedule: unknown): ScheduleEntry[] {
   if (!Array.isArray(schedule) || schedule.length === 0) throw new TypeError(`schedule must be a non-empty array of { t, speed, heading }, got ${describeValue(schedule)}`);
+  checkNoHoles(schedule, 'schedule');
   return schedule.map((e, i) => {
     if (typeof e !== 'object' || e === null) throw new TypeError(`schedule[${i}] must be an object { t, speed, heading }, got ${describeValue(e)}`);
     const { t, speed, heading } = e as Record<string, unknown>;

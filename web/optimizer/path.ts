@@ -2,6 +2,7 @@
 // resampled at even arc length, with lookups by arc length and nearest-point projection; and moving a path
 // to the origin and its motion back (the follower works near the origin, see relativeToStart).
 import { describeValue } from '../motion/describe';
+import { checkNoHoles } from '../motion/validate';
 
 export type GroundPoint = [number, number];
 
@@ -24,7 +25,9 @@ export function checkPathPoints(points: unknown): GroundPoint[] {
   if (!Array.isArray(points)) throw new TypeError(`points must be an array of [x, z] pairs (metres), got ${describeValue(points)}`);
   if (points.length < 2) throw new RangeError(`points needs at least 2 [x, z] pairs, got ${points.length}`);
   if (points.length > MAX_PATH_POINTS) throw new RangeError(`points has ${points.length} pairs; at most ${MAX_PATH_POINTS} are accepted`);
+  checkNoHoles(points, 'points');
   return points.map((p, i) => {
+    if (Array.isArray(p)) checkNoHoles(p, `points[${i}]`);
     if (!Array.isArray(p) || p.length !== 2 || !p.every((v) => typeof v === 'number' && Number.isFinite(v))) {
       throw new TypeError(`points[${i}] must be a pair of finite numbers [x, z], got ${describeValue(p)}`);
     }
