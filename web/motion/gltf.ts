@@ -7,7 +7,9 @@
 //   gltfJointNames(joints: readonly string[]): string[]
 //     the node name each joint gets: a name of letters, digits and other characters glTF readers keep is kept
 //     as it is; in any other whitespace and . : / [ ] { } and control characters become "_" (three.js's
-//     animation paths and Blender's bone names cannot hold some of them), and a clash gets "_2", "_3", ….
+//     animation paths and Blender's bone names cannot hold some of them), a name Object.prototype has
+//     (__proto__, constructor, …: three.js's GLTFLoader renames those) gets "_joint" after it, and a clash gets
+//     "_2", "_3", …. A renamed joint's node keeps its own name in `extras.name`.
 //
 // Metres, y up, +z forward: glTF's own axes are the playground's, so nothing is converted. The file holds
 //   - one node per joint (rest translation = its rest offset from the node above, rotation identity) and, as
@@ -35,9 +37,15 @@ export interface GLBExportOptions {
 /** Characters a node name may not keep (three.js animation paths reserve . : / [ ]; whitespace and controls). */
 const UNSAFE_NAME_CHARACTERS = /[\s.:/[\]{}\u0000-\u001f\u007f-\u009f]/g;
 
+/**
+ * A name three.js's GLTFLoader can keep: it counts node names in a plain object (createUniqueName), where
+ * Object.prototype's properties (`__proto__`, `constructor`, `toString`, …) are already present, and gave such a node
+ * the name "constructor_NaN", which nothing looks up. Those names get `_joint` after them.
+ */
 function safeName(name: string): string {
   const clean = name.replace(UNSAFE_NAME_CHARACTERS, '_');
-  return clean === '' ? 'unnamed' : clean;
+  if (clean === '') return 'unnamed';
+  return clean in Object.prototype ? `${clean}_joint` : clean;
 }
 
 /** `base`, or `base_2`, `base_3`, … whichever `taken` lacks first; added to `taken`. */
@@ -179,6 +187,7 @@ export function exportGLB(motion: Motion, options: GLBExportOptions = {}): Uint8
   for (let n = 0; n < nodeCount; n++) {
     const translation = n === 0 ? world[0] : n < J ? rest[n] : [0, 0, 0];
     const node: Record<string, unknown> = { name: n < J ? jointNames[n] : helperNames[n - J], translation: Array.from(translation) };
+    if (n < J && jointNames[n] !== clip.joints[n]) node.extras = { name: clip.joints[n] }; // the joint's own name (three.js: userData.name)
     if (tree.children[n].length > 0) node.children = tree.children[n];
     nodes.push(node);
   }
