@@ -68,7 +68,7 @@ describe('the element src fetch', () => {
     const zipped = new Uint8Array(await new Response(new Blob([text]).stream().pipeThrough(new CompressionStream('gzip'))).arrayBuffer());
     expect(await fetchMotionSource('a.bvh.gz', page, [], async () => new Response(zipped))).toBe(text);
     const big = new Response(new Uint8Array(MAX_SOURCE_BYTES + 1));
-    await expect(fetchMotionSource('a.bvh', page, [], async () => big)).rejects.toThrow(/larger than the 33 MB limit/);
+    await expect(fetchMotionSource('a.bvh', page, [], async () => big)).rejects.toThrow(/larger than the 32 MiB limit/);
     await expect(fetchMotionSource('a.bvh', page, [], async () => new Response('no', { status: 404 }))).rejects.toThrow(/HTTP 404/);
   });
 });

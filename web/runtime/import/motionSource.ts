@@ -12,6 +12,8 @@ function quoteUrl(url: string): string {
   return quoteInput(url, MAX_URL_QUOTE);
 }
 
+/** Bytes in a mebibyte: the limit is 32 MiB (33.6 million bytes; "33 MB" before, where the docs said 32). */
+const MIB = 1024 * 1024;
 export const MAX_SOURCE_BYTES = 32 * 1024 * 1024;
 
 /** An origin as the allowed list compares it ("https://example.org"); null for text that is not one. */
@@ -88,7 +90,7 @@ async function fetchChecked(url: URL, pageHref: string, allowed: readonly string
   }
   if (!response.ok) throw new Error(`${quoteUrl(url.href)}: HTTP ${response.status}`);
   const declared = Number(response.headers.get('content-length'));
-  if (declared > MAX_SOURCE_BYTES) throw new Error(`${quoteUrl(url.href)} is ${(declared / 1e6).toFixed(0)} MB; the limit is ${MAX_SOURCE_BYTES / 1e6 | 0} MB`);
+  if (declared > MAX_SOURCE_BYTES) throw new Error(`${quoteUrl(url.href)} is ${(declared / MIB).toFixed(1)} MiB; the limit is ${MAX_SOURCE_BYTES / MIB} MiB`);
   const bytes = await readLimited(response, quoteUrl(url.href));
   const gzipped = bytes.length > 2 && bytes[0] === 0x1f && bytes[1] === 0x8b;
   if (!gzipped) return new TextDecoder().decode(bytes);
@@ -107,7 +109,7 @@ async function readLimited(response: Response, what: string): Promise<Uint8Array
     total += value.length;
     if (total > MAX_SOURCE_BYTES) {
       await reader.cancel();
-      throw new Error(`${what} is larger than the ${MAX_SOURCE_BYTES / 1e6 | 0} MB limit`);
+      throw new Error(`${what} is larger than the ${MAX_SOURCE_BYTES / MIB} MiB limit`);
     }
     parts.push(value);
   }
