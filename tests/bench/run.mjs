@@ -16,11 +16,12 @@ import * as control from './control.mjs';
 import * as firstFrame from './firstFrame.mjs';
 import * as generator from './generator.mjs';
 import * as largeImport from './largeImport.mjs';
+import * as memory from './memory.mjs';
 import * as peers from './peers.mjs';
 import * as playback from './playback.mjs';
 
 /** In the order `npm run bench` runs them. */
-const FAMILIES = [playback, generator, aclstm, control, peers, firstFrame, largeImport, cleanup];
+const FAMILIES = [playback, generator, aclstm, control, peers, firstFrame, largeImport, cleanup, memory];
 const BENCHMARKS = FAMILIES.flatMap((family) => family.BENCHMARKS);
 
 async function main() {

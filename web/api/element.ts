@@ -30,9 +30,14 @@ export class MotionPlaygroundElement extends HTMLElement {
   static readonly observedAttributes = [...VIEW_KEYS, 'dance-style', ...OTHER_ATTRIBUTES];
 
   private readonly shadow: ShadowRoot;
-  private readonly frame: HTMLElement;
-  private readonly posterImage: HTMLImageElement;
+  private frame!: HTMLElement;
+  private posterImage!: HTMLImageElement;
   private app: App | null = null;
+  /** Aborted when the playground is taken down (teardown): the listeners it put on the page and the shadow root. */
+  private lifetime: AbortController | null = null;
+  private progressObserver: MutationObserver | null = null;
+  /** The clip shown when the element was taken down, shown again when it is put back (Clip mode without `src`). */
+  private keptClip: { motion: Motion; name: string } | null = null;
   private api: Playground | null = null;
   private lazyObserver: IntersectionObserver | null = null;
   private readonly started: Promise<void>;
@@ -40,8 +45,6 @@ export class MotionPlaygroundElement extends HTMLElement {
   /** Set while the element writes its own attributes (reflecting the UI): no re-apply. */
   private reflecting = false;
   private wasPlaying = false;
-  /** Taken off the page (disconnectedCallback): its frame loop and live stream are stopped until it is back. */
-  private suspended = false;
   private linkTimer = 0;
   /** The bad value of `controls`, `poster` or `loading` whose `error` has fired (badAttribute). */
   private readonly reportedBad = new Map<string, string>();
@@ -51,15 +54,20 @@ export class MotionPlaygroundElement extends HTMLElement {
   constructor() {
     super();
     this.shadow = this.attachShadow({ mode: 'open' });
+    this.renderTemplate();
+    this.started = new Promise((resolve) => (this.markStarted = resolve));
+  }
+
+  /** The shadow root's markup, fresh (at first, and when a taken-down element is built again). */
+  private renderTemplate(): void {
     const style = document.createElement('style');
     style.textContent = css;
     // The template is the element's own static markup (never anything from a file, attribute or URL).
     const template = document.createElement('template');
     template.innerHTML = templateHtml;
-    this.shadow.append(style, template.content.cloneNode(true));
+    this.shadow.replaceChildren(style, template.content.cloneNode(true));
     this.frame = this.shadow.querySelector<HTMLElement>('.app')!;
     this.posterImage = this.shadow.querySelector<HTMLImageElement>('.poster')!;
-    this.started = new Promise((resolve) => (this.markStarted = resolve));
   }
 
   // ---------- lifecycle ----------
@@ -67,10 +75,6 @@ export class MotionPlaygroundElement extends HTMLElement {
   connectedCallback(): void {
     this.showControls();
     this.showPoster();
-    if (this.suspended) {
-      this.suspended = false;
-      this.app?.resume();
-    }
     if (this.app || this.lazyObserver) return;
     if (this.loadingMode() === 'lazy' && 'IntersectionObserver' in window) {
       // Nothing is fetched (onnxruntime-web, models) until the element comes near the viewport.
@@ -84,14 +88,34 @@ export class MotionPlaygroundElement extends HTMLElement {
   }
 
   disconnectedCallback(): void {
+    // Taken off the page: everything it started stops, unless it was only moved (connected again in this task,
+    // when it keeps its state).
+    queueMicrotask(() => {
+      if (!this.isConnected) this.teardown();
+    });
+  }
+
+  /**
+   * Stops everything the element started (issue 43): its live mode, a path optimisation or clean-up under way,
+   * the frame loop, every worker, the WebGL context, the observers and the listeners on the page. The API keeps
+   * answering with the last state; put back on the page, the element builds its playground again from its
+   * attributes (a clip shown in Clip mode is shown again).
+   */
+  private teardown(): void {
     this.lazyObserver?.disconnect();
     this.lazyObserver = null;
-    // Taken off the page: stop drawing and streaming, unless it was only moved (connected again in this task).
-    queueMicrotask(() => {
-      if (this.isConnected || !this.app || this.suspended) return;
-      this.suspended = true;
-      this.app.suspend();
-    });
+    const app = this.app;
+    if (!app) return;
+    this.app = null;
+    this.lifetime?.abort();
+    this.lifetime = null;
+    this.progressObserver?.disconnect();
+    this.progressObserver = null;
+    clearTimeout(this.linkTimer);
+    this.srcToken++;
+    const motion = app.currentMode === 'clip' && !this.hasAttribute('src') ? app.current : null;
+    this.keptClip = motion ? { motion, name: this.shadow.getElementById('clip-name')?.textContent || 'motion' } : null;
+    app.dispose();
   }
 
   attributeChangedCallback(name: string, before: string | null, after: string | null): void {
@@ -113,16 +137,31 @@ export class MotionPlaygroundElement extends HTMLElement {
     if (this.app) return;
     this.lazyObserver?.disconnect();
     this.lazyObserver = null;
-    const scope: DomScope = { root: this.shadow, frame: this.frame, ownsEvent: (e) => this.ownsEvent(e) };
+    if (this.api) {
+      // Built before and taken down (taken off the page, now back): a fresh UI for a fresh playground.
+      this.renderTemplate();
+      this.showControls();
+      this.showPoster();
+      this.wasPlaying = false;
+    }
+    const lifetime = (this.lifetime = new AbortController());
+    const { signal } = lifetime;
+    const kept = this.keptClip;
+    this.keptClip = null;
+    const scope: DomScope = { root: this.shadow, frame: this.frame, ownsEvent: (e) => this.ownsEvent(e), signal };
     const app = buildIn(scope, () => new App(scope, {
       motion: (name) => {
-        this.posterImage.hidden = true;
+        if (signal.aborted) return;
+        if (this.frame.dataset.context !== 'lost') this.posterImage.hidden = true; // no context: the poster stays
         this.fire('motion', { name, frames: app.current?.frames ?? 0 });
         this.linkSoon();
       },
-      error: (reason) => this.fire('error', { reason }),
+      error: (reason) => {
+        if (!signal.aborted) this.fire('error', { reason });
+      },
     }));
     this.app = app;
+    this.watchContext(app, signal);
     this.api = createPlayground(app);
     const version = this.shadow.getElementById('version');
     if (version) version.textContent = `v${this.api.version}`;
@@ -134,12 +173,13 @@ export class MotionPlaygroundElement extends HTMLElement {
       }
     });
     this.watchProgress();
-    this.shadow.addEventListener('change', () => this.linkSoon());
+    this.shadow.addEventListener('change', () => this.linkSoon(), { signal });
     for (const m of ['clip', 'walk', 'dance', 'path', 'steer']) this.shadow.getElementById(`mode-${m}`)?.addEventListener('click', () => this.linkSoon());
     this.installShare();
     this.markStarted();
     this.preloadFirstModel(app);
     void this.api.ready.then(async () => {
+      if (signal.aborted) return; // taken off the page before its model list came
       const fromLink = this.hasAttribute('link') ? this.linkView() : null;
       const attrs = this.attributeView();
       // No mode from the attributes or the link (none, or a bad one) and no src: the first view (something
@@ -148,9 +188,31 @@ export class MotionPlaygroundElement extends HTMLElement {
       const view: ViewState = given.mode === undefined && !this.hasAttribute('src') ? { ...FIRST_VIEW, ...given } : given;
       if (this.hasAttribute('src') && view.mode === undefined) view.mode = 'clip';
       this.applyView(view, true);
+      if (kept && app.currentMode === 'clip' && !this.hasAttribute('src')) {
+        app.show(kept.motion, kept.name);
+        if (!this.hasAttribute('autoplay')) app.viewer.pause();
+      }
       if (this.hasAttribute('src')) await this.loadSource();
-      this.fire('load');
+      if (!signal.aborted) this.fire('load');
     });
+  }
+
+  /**
+   * The viewer's WebGL context: one that cannot be made, or that the browser takes (too many on the page),
+   * fires `error` with the reason and shows the poster (when there is one) until it comes back.
+   */
+  private watchContext(app: App, signal: AbortSignal): void {
+    app.viewer.onContextLost = (reason) => {
+      if (signal.aborted) return;
+      if (this.posterImage.getAttribute('src')) this.posterImage.hidden = false;
+      this.frame.dataset.context = 'lost';
+      this.fire('error', { reason });
+    };
+    app.viewer.onContextRestored = () => {
+      if (signal.aborted) return;
+      delete this.frame.dataset.context;
+      this.posterImage.hidden = app.current != null || !this.posterImage.getAttribute('src');
+    };
   }
 
   /**
@@ -401,7 +463,7 @@ export class MotionPlaygroundElement extends HTMLElement {
   /** Progress bars and the model indicator inside the shadow root, as `progress` events. */
   private watchProgress(): void {
     const kinds: Record<string, string> = { 'path-progress': 'path', 'cleanup-progress': 'cleanup', 'import-progress': 'import', 'model-status': 'model' };
-    new MutationObserver((records) => {
+    this.progressObserver = new MutationObserver((records) => {
       for (const r of records) {
         const el = r.target as HTMLElement;
         const what = kinds[el.id];
@@ -409,7 +471,8 @@ export class MotionPlaygroundElement extends HTMLElement {
         if (el instanceof HTMLProgressElement) this.fire('progress', { what, fraction: el.value / (el.max || 1) });
         else this.fire('progress', { what, loading: !el.hidden });
       }
-    }).observe(this.shadow, { subtree: true, attributes: true, attributeFilter: ['value', 'hidden'] });
+    });
+    this.progressObserver.observe(this.shadow, { subtree: true, attributes: true, attributeFilter: ['value', 'hidden'] });
   }
 
   /** Keys and drops: from inside this element, or on the bare page when this is its only playground. */

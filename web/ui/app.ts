@@ -83,6 +83,8 @@ export class App implements ModeHost {
   private mode: Mode = 'clip';
   /** The clip shown before another mode (Random walk, Dance, Path, Steer), restored when switching back. */
   private clip: { motion: Motion; name: string } | null = null;
+  /** Taken down for good (dispose): nothing starts again. */
+  private disposed = false;
 
   /** Build it inside `buildIn(scope, …)` (dom.ts): its parts look up their elements in `scope` as they are made. */
   constructor(
@@ -159,6 +161,7 @@ export class App implements ModeHost {
       if (!model) throw new Error(`model "${id}" is not listed in models/index.json`);
       host = new ModelHost(() => model.descriptor.createClient(model.info, pageThreads()), this.busy);
       this.hosts.set(id, host);
+      if (this.disposed) host.dispose(); // taken down: its loads reject, no worker starts
     }
     return host;
   }
@@ -182,8 +185,30 @@ export class App implements ModeHost {
   }
 
   resume(): void {
+    if (this.disposed) return;
     this.viewer.setRunning(true);
     void this.liveMode(this.mode)?.begin();
+  }
+
+  /**
+   * Taken down for good (its element was removed from the page, web/api/element.ts): the live stream ends, a path
+   * optimisation or clean-up under way is aborted, every model's worker and the import worker are stopped and the
+   * viewer lets go of its WebGL context, frame loop and observers. Listeners on window and document go with the
+   * scope's signal, which the element aborts. Nothing of it starts again: the element builds a new App.
+   */
+  dispose(): void {
+    if (this.disposed) return;
+    this.disposed = true;
+    for (const m of MODES) this.liveMode(m)?.stop();
+    if (this.mode === 'path') this.pathMode.leave();
+    if (this.mode === 'clip') this.cleanup.leave();
+    for (const host of this.hosts.values()) host.dispose();
+    this.importer.dispose();
+    this.viewer.dispose();
+  }
+
+  get isDisposed(): boolean {
+    return this.disposed;
   }
 
   private liveMode(mode: Mode): LiveMode<LiveChunk> | null {
@@ -196,7 +221,7 @@ export class App implements ModeHost {
    * restores the clip shown before.
    */
   setMode(mode: Mode): void {
-    if (mode === this.mode) return;
+    if (mode === this.mode || this.disposed) return;
     const previous = this.mode;
     this.mode = mode;
     for (const m of MODES) this.modeButtons.get(m)!.setAttribute('aria-pressed', String(mode === m));

@@ -51,7 +51,7 @@ export class Capture {
 
   /** Saves the view as `<name>.png`. */
   async snapshot(): Promise<void> {
-    const canvas = this.host.viewer.renderer.domElement;
+    const canvas = this.host.viewer.canvas;
     this.host.viewer.renderNow(); // the drawing buffer is not kept between frames: draw and read in one task
     const blob = await new Promise<Blob | null>((resolve) => canvas.toBlob(resolve, 'image/png'));
     if (!blob) {
@@ -65,7 +65,7 @@ export class Capture {
   start(): void {
     const type = webmType();
     if (!type || this.recorder) return;
-    const canvas = this.host.viewer.renderer.domElement;
+    const canvas = this.host.viewer.canvas;
     let recorder: MediaRecorder;
     try {
       recorder = new MediaRecorder(canvas.captureStream(30), { mimeType: type, videoBitsPerSecond: 4_000_000 });

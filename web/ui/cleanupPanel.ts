@@ -21,7 +21,7 @@ import type { CleanupMethod, CleanupStats } from '../runtime/cleanup/cleanup';
 import { baseName } from '../runtime/import/motionFiles';
 import type { PlaybackState } from '../viewer/playback';
 import { AnglePlot } from './anglePlot';
-import { $, $all, downloadText, errorMessage, setSliderFill } from './dom';
+import { $, $all, currentScope, downloadText, errorMessage, setSliderFill } from './dom';
 import type { ModeHost } from './modes/host';
 
 /** What each method does, in one line under the select. */
@@ -119,7 +119,9 @@ export class CleanupPanel {
       if (s) this.pickedJoint = s.clip.joints[Number(this.jointSelect.value)] ?? null;
       this.showPlot();
     });
-    new ResizeObserver(() => this.plot.draw()).observe($('cleanup-plot'));
+    const plotSize = new ResizeObserver(() => this.plot.draw());
+    plotSize.observe($('cleanup-plot'));
+    currentScope().signal?.addEventListener('abort', () => plotSize.disconnect());
     this.showHint();
     this.showNoise();
     this.render();

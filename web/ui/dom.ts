@@ -12,6 +12,8 @@ export interface DomScope {
   frame: HTMLElement;
   /** Whether a keyboard event is for this element: from inside it, or on the bare page when it owns the page. */
   ownsEvent(e: Event): boolean;
+  /** Aborted when the element's playground is taken down: listeners put on window or document go with it. */
+  signal?: AbortSignal;
 }
 
 let building: DomScope | null = null;

@@ -27,7 +27,7 @@ export class ExportMenu {
       if (!path.includes(this.menu) && !path.includes(this.button)) this.setOpen(false);
     };
     this.root.addEventListener('pointerdown', outside);
-    document.addEventListener('pointerdown', outside);
+    document.addEventListener('pointerdown', outside, { signal: currentScope().signal });
   }
 
   get open(): boolean {

@@ -51,16 +51,22 @@ export interface LoadedModel<C, Info> {
 /** One model's client, loaded once on first use; a failed load is retried on the next call. */
 export class ModelHost<C extends Client<Info>, Info> {
   private loading: Promise<LoadedModel<C, Info>> | null = null;
+  /** Every client made and not yet disposed (one, unless a failed one is being replaced). */
+  private readonly clients = new Set<C>();
+  private disposed = false;
 
   constructor(private readonly make: () => C, private readonly indicator: BusyIndicator) {}
 
   load(): Promise<LoadedModel<C, Info>> {
+    if (this.disposed) return Promise.reject(new WorkerFailedError('the model was unloaded (its element was taken off the page)'));
     if (!this.loading) {
       const client = this.make();
+      this.clients.add(client);
       this.indicator.add(+1);
       const loading = client.init().then(
         (info) => ({ client, info }),
         (e: unknown) => {
+          this.clients.delete(client);
           client.dispose();
           if (this.loading === loading) this.loading = null;
           throw e;
@@ -72,6 +78,13 @@ export class ModelHost<C extends Client<Info>, Info> {
     return this.loading;
   }
 
+  /** Stops every worker it started (a load under way rejects); later loads reject. */
+  dispose(): void {
+    this.disposed = true;
+    this.loading = null;
+    for (const client of [...this.clients]) client.dispose();
+  }
+
   /** Forgets a client whose worker failed, so the next `load` starts a fresh one. */
   reset(client?: C): void {
     if (!this.loading) return;
@@ -79,6 +92,7 @@ export class ModelHost<C extends Client<Info>, Info> {
     void loading.then(({ client: c }) => {
       if (client && c !== client) return;
       if (this.loading === loading) this.loading = null;
+      this.clients.delete(c);
       c.dispose();
     }, () => undefined);
   }

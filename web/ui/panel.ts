@@ -52,7 +52,7 @@ export class Panel {
     });
     this.syncLayers();
 
-    window.addEventListener('keydown', (e) => this.onKey(e));
+    window.addEventListener('keydown', (e) => this.onKey(e), { signal: currentScope().signal });
   }
 
   syncLayers(): void {

@@ -42,8 +42,23 @@ export interface Companion {
   labels: { main: string; companion: string };
 }
 
+/** The GPU probe, made once for the page (each probe costs a WebGL context of its own). */
+let probed: GLInfo | null = null;
+
+/** How far outside the viewport (CSS px) an element keeps its WebGL context. */
+const CONTEXT_MARGIN = '200px';
+
+/**
+ * The WebGL context's state. A viewer holds a context only while it is near the viewport (browsers keep about 16
+ * per page and drop the oldest beyond that): 'none' until first seen; 'releasing'/'released' while out of view
+ * (lost on purpose through WEBGL_lose_context); 'restoring' on its way back; 'lost' when the browser took it;
+ * 'failed' when none could be made.
+ */
+type ContextState = 'none' | 'live' | 'releasing' | 'released' | 'restoring' | 'lost' | 'failed';
+
 export class Viewer {
-  readonly renderer: THREE.WebGLRenderer;
+  /** The canvas drawn on (kept for the viewer's life; its WebGL context comes and goes with visibility). */
+  readonly canvas: HTMLCanvasElement;
   readonly scene = new THREE.Scene();
   readonly camera = new THREE.PerspectiveCamera(38, 1, 0.1, 200);
   readonly controls: OrbitControls;
@@ -80,23 +95,36 @@ export class Viewer {
   private readonly quality: Quality;
   private readonly basePixelRatio: number;
   private readonly resolution: DynamicResolution;
+  private webgl: THREE.WebGLRenderer | null = null;
+  private contextState: ContextState = 'none';
+  /** Near the viewport (CONTEXT_MARGIN): only then is a WebGL context held and the scene drawn. */
+  private visible = false;
+  private running = false;
+  private frameRequest = 0;
+  private disposed = false;
+  private readonly resizeObserver: ResizeObserver;
+  private readonly visibility: IntersectionObserver | null = null;
+  /** The browser took the context (or none could be made): `reason` says so in a few words. */
+  onContextLost: ((reason: string) => void) | null = null;
+  /** A context lost by the browser came back (drawing again). */
+  onContextRestored: (() => void) | null = null;
 
   constructor(private readonly container: HTMLElement) {
-    this.gl = probeGL();
+    this.gl = probed ??= probeGL();
     this.quality = chooseQuality(this.gl);
     const high = this.quality === 'high';
-    this.renderer = new THREE.WebGLRenderer({ antialias: high, alpha: false, powerPreference: 'high-performance' });
     this.basePixelRatio = high ? Math.min(window.devicePixelRatio || 1, 2) : 1;
     this.resolution = new DynamicResolution(0.5, 1, high ? 1 : 0.75, fixedResolution());
-    this.renderer.setPixelRatio(this.basePixelRatio * this.resolution.scale);
+    this.canvas = document.createElement('canvas');
+    this.canvas.addEventListener('webglcontextlost', (e) => this.contextLost(e));
+    this.canvas.addEventListener('webglcontextrestored', () => this.contextRestored());
     this.scene.background = BACKGROUND;
     // A GPU can afford a wider grid reaching further before the fog; software GL gets a smaller stage.
     this.floor = new Floor(high ? 24 : 12);
     this.fog = high ? new THREE.Fog(BACKGROUND, 8, 26) : new THREE.Fog(BACKGROUND, 5, 14);
     this.scene.fog = this.fog;
-    this.renderer.outputColorSpace = THREE.LinearSRGBColorSpace; // colours are used as given (see palette.ts)
-    this.renderer.domElement.classList.add('viewer-canvas');
-    container.appendChild(this.renderer.domElement);
+    this.canvas.classList.add('viewer-canvas');
+    container.appendChild(this.canvas);
 
     // No lights: the figure shades itself (figure.ts) and the ground layers are unlit.
     // The floor glow is a large filled area: only worth its pixels with a GPU.
@@ -104,7 +132,7 @@ export class Viewer {
     this.scene.add(this.floor.group, this.marks.mesh, this.companionShadow.mesh);
 
     this.camera.position.set(3.2, 1.9, 4.6);
-    this.controls = new OrbitControls(this.camera, this.renderer.domElement);
+    this.controls = new OrbitControls(this.camera, this.canvas);
     this.controls.target.set(0, 0.9, 0);
     this.controls.enableDamping = true;
     this.controls.dampingFactor = 0.12;
@@ -113,13 +141,136 @@ export class Viewer {
     this.controls.maxPolarAngle = Math.PI * 0.495; // stay above the floor
     this.controls.update();
 
-    new ResizeObserver(() => this.resize()).observe(container);
+    this.resizeObserver = new ResizeObserver(() => this.resize());
+    this.resizeObserver.observe(container);
+    if ('IntersectionObserver' in window) {
+      this.visibility = new IntersectionObserver((entries) => this.setVisible(entries[entries.length - 1].isIntersecting), { rootMargin: CONTEXT_MARGIN });
+      this.visibility.observe(container);
+    } else {
+      this.setVisible(true);
+    }
     this.resize();
     this.setRunning(true);
+  }
+
+  /**
+   * The three.js renderer, made on first use (a viewer makes its WebGL context when it first comes near the
+   * viewport). Throws when no WebGL context can be made.
+   */
+  get renderer(): THREE.WebGLRenderer {
+    if (this.webgl) return this.webgl;
+    const high = this.quality === 'high';
+    let renderer: THREE.WebGLRenderer;
+    try {
+      renderer = new THREE.WebGLRenderer({ canvas: this.canvas, antialias: high, alpha: false, powerPreference: 'high-performance' });
+    } catch (e) {
+      if (this.contextState !== 'failed') {
+        this.contextState = 'failed';
+        this.onContextLost?.(`WebGL: no context could be made (${e instanceof Error ? e.message : String(e)})`);
+      }
+      throw e;
+    }
+    this.webgl = renderer;
+    this.contextState = 'live';
+    renderer.setPixelRatio(this.basePixelRatio * this.resolution.scale);
+    renderer.outputColorSpace = THREE.LinearSRGBColorSpace; // colours are used as given (see palette.ts)
+    this.resize();
     // Compile the figure's shader while the page waits for its first motion (models loading), not in the
     // frame that first draws one: under software GL that compile costs tens of milliseconds.
     const idle = (globalThis.requestIdleCallback as ((cb: () => void, o?: { timeout: number }) => number) | undefined) ?? ((cb: () => void) => setTimeout(cb, 50));
     idle(() => this.compileFigureShader(), { timeout: 500 });
+    return renderer;
+  }
+
+  /** Whether the viewer holds a live WebGL context now (near the viewport, not lost). */
+  get hasContext(): boolean {
+    return this.contextState === 'live';
+  }
+
+  /** Near the viewport: make (or get back) the WebGL context; away from it: let it go, so others can have one. */
+  private setVisible(visible: boolean): void {
+    if (this.disposed || visible === this.visible) return;
+    this.visible = visible;
+    this.dirty = true;
+    if (visible) {
+      if (this.contextState === 'none') {
+        try {
+          void this.renderer;
+        } catch {
+          // reported through onContextLost
+        }
+      } else if (this.contextState === 'released') {
+        this.contextState = 'restoring';
+        this.webgl!.forceContextRestore();
+      }
+      // 'releasing': restored once the loss arrives (contextLost); 'restoring' and 'live': nothing to do.
+    } else if (this.contextState === 'live') {
+      this.contextState = 'releasing';
+      this.webgl!.forceContextLoss();
+    }
+  }
+
+  private contextLost(e: Event): void {
+    e.preventDefault(); // (three.js does too) so that the context can be restored
+    if (this.disposed) return;
+    if (this.contextState === 'releasing') {
+      this.contextState = 'released';
+      if (this.visible) {
+        this.contextState = 'restoring';
+        this.webgl!.forceContextRestore();
+      }
+      return;
+    }
+    this.contextState = 'lost';
+    this.onContextLost?.('WebGL: the context was lost (too many on the page, or the GPU was reset)');
+  }
+
+  private contextRestored(): void {
+    if (this.disposed) return;
+    const wasLost = this.contextState === 'lost';
+    this.contextState = 'live';
+    this.dirty = true;
+    this.resize();
+    if (!this.visible) {
+      this.contextState = 'releasing';
+      this.webgl!.forceContextLoss();
+    }
+    if (wasLost) this.onContextRestored?.();
+  }
+
+  /**
+   * Stops everything for good (its element was taken off the page): the frame loop, the observers, the camera
+   * controls' listeners, every geometry, material and texture, and the WebGL context (lost at once, so the
+   * browser frees it rather than waiting for garbage collection).
+   */
+  dispose(): void {
+    if (this.disposed) return;
+    this.setRunning(false);
+    this.disposed = true;
+    this.resizeObserver.disconnect();
+    this.visibility?.disconnect();
+    this.controls.dispose();
+    this.setCompanion(null);
+    const textures = new Set<THREE.Texture>();
+    this.scene.traverse((object) => {
+      const mesh = object as THREE.Mesh;
+      mesh.geometry?.dispose();
+      const materials = Array.isArray(mesh.material) ? mesh.material : mesh.material ? [mesh.material] : [];
+      for (const material of materials) {
+        for (const value of Object.values(material)) if (value instanceof THREE.Texture) textures.add(value);
+        material.dispose();
+      }
+    });
+    for (const texture of textures) texture.dispose();
+    this.figure = null;
+    this.scene.clear();
+    if (this.webgl) {
+      this.webgl.dispose();
+      if (this.contextState === 'live' || this.contextState === 'restoring') this.webgl.forceContextLoss();
+      this.webgl = null;
+    }
+    this.contextState = 'released';
+    this.canvas.remove();
   }
 
   /**
@@ -127,7 +278,7 @@ export class Viewer {
    * once no material uses it; every Figure's material shares this one's program).
    */
   private compileFigureShader(): void {
-    if (this.figure) return;
+    if (this.figure || this.contextState !== 'live') return;
     const standIn = new Figure({ fps: 30, frames: 1, joints: ['Hips', 'Head'], parents: [-1, 0], positions: new Float32Array([0, 1, 0, 0, 1.5, 0]) });
     this.scene.add(standIn.mesh);
     this.renderer.compile(this.scene, this.camera);
@@ -136,9 +287,18 @@ export class Viewer {
 
   /** Starts or stops the frame loop (an element taken off the page draws nothing and costs nothing). */
   setRunning(running: boolean): void {
+    if (this.disposed) return;
     this.last = performance.now();
-    this.renderer.setAnimationLoop(running ? (t) => this.tick(t) : null);
+    this.running = running;
+    cancelAnimationFrame(this.frameRequest);
+    this.frameRequest = running ? requestAnimationFrame(this.loop) : 0;
   }
+
+  private readonly loop = (now: number): void => {
+    if (!this.running) return;
+    this.frameRequest = requestAnimationFrame(this.loop);
+    this.tick(now);
+  };
 
   get current(): Motion | null {
     return this.motion;
@@ -291,7 +451,7 @@ export class Viewer {
   stats(): RenderStats {
     return {
       fps: this.displayFps,
-      pixelRatio: this.renderer.getPixelRatio(),
+      pixelRatio: this.basePixelRatio * this.resolution.scale,
       quality: this.quality,
       renderer: this.gl.renderer,
       software: this.gl.software,
@@ -383,7 +543,7 @@ export class Viewer {
    * `maxReach` metres from the view's centre (rays grazing the horizon).
    */
   groundAt(clientX: number, clientY: number, maxReach = 80): [number, number] | null {
-    const rect = this.renderer.domElement.getBoundingClientRect();
+    const rect = this.canvas.getBoundingClientRect();
     const ndc = new THREE.Vector2(((clientX - rect.left) / rect.width) * 2 - 1, -((clientY - rect.top) / rect.height) * 2 + 1);
     this.raycaster.setFromCamera(ndc, this.camera);
     const hit = this.raycaster.ray.intersectPlane(GROUND_PLANE, new THREE.Vector3());
@@ -465,7 +625,8 @@ export class Viewer {
   /** Asks for a render: for things other modules add to the scene (ground overlays). */
   /** Draws the scene now (so the canvas holds a fresh image for toBlob or a capture stream in this task). */
   renderNow(): void {
-    this.renderer.render(this.scene, this.camera);
+    if (this.disposed) return;
+    if (this.contextState === 'live' || this.contextState === 'none') this.renderer.render(this.scene, this.camera);
     this.placeLabels();
   }
 
@@ -538,7 +699,7 @@ export class Viewer {
     if (this.renderedLast && dt > 0) {
       this.displayFps = this.displayFps ? this.displayFps * 0.95 + (1 / dt) * 0.05 : 1 / dt;
       if (this.resolution.sample(dt, now)) {
-        this.renderer.setPixelRatio(this.basePixelRatio * this.resolution.scale);
+        this.webgl?.setPixelRatio(this.basePixelRatio * this.resolution.scale);
         this.resize();
       }
     }
@@ -562,9 +723,10 @@ export class Viewer {
     }
     this.snap = false;
     if (this.controls.update()) this.dirty = true;
-    // Render on demand: a paused, still scene costs nothing.
-    this.renderedLast = this.dirty;
-    if (this.dirty) {
+    // Render on demand: a paused, still scene costs nothing; nor does one scrolled away (no context then).
+    const drawable = this.contextState === 'live';
+    this.renderedLast = this.dirty && drawable;
+    if (this.dirty && drawable) {
       this.dirty = false;
       this.floor.setCenter(this.controls.target.x, this.controls.target.z);
       this.marks.drawFor(this.camera, Math.min(this.fog.far, this.camera.far));
@@ -576,7 +738,7 @@ export class Viewer {
 
   private resize(): void {
     const w = Math.max(this.container.clientWidth, 1), h = Math.max(this.container.clientHeight, 1);
-    this.renderer.setSize(w, h, false);
+    if (this.webgl && this.contextState === 'live') this.webgl.setSize(w, h, false);
     this.camera.aspect = w / h;
     this.camera.updateProjectionMatrix();
     this.dirty = true;

@@ -20,7 +20,7 @@ export type ModeViewer = Pick<
   Viewer,
   | 'controls' | 'frameGround' | 'invalidate' | 'groundAt' | 'setRightDragRotates' | 'lookAtGround' | 'lowerView'
   | 'placeBehind' | 'swingBehind' | 'viewHeading'
-  | 'scene' | 'renderer' | 'playback' | 'current' | 'footprintCount' | 'rootPosition' | 'setCompanion'
+  | 'scene' | 'renderer' | 'canvas' | 'playback' | 'current' | 'footprintCount' | 'rootPosition' | 'setCompanion'
   | 'layers' | 'setLayers'
 >;
 

@@ -141,7 +141,7 @@ export class PathMode {
     this.clearBtn.addEventListener('click', () => this.clear());
 
     // Capture phase on the stage, so a drawing press turns the orbit controls off before they see it.
-    const canvas = app.viewer.renderer.domElement;
+    const canvas = app.viewer.canvas;
     canvas.parentElement!.addEventListener('pointerdown', (e) => this.onDown(e), { capture: true });
     canvas.addEventListener('pointermove', (e) => this.onMove(e));
     canvas.addEventListener('pointerup', (e) => this.onUp(e, false));
@@ -240,7 +240,7 @@ export class PathMode {
     if (!p) return; // off the ground: let the controls turn the view
     const viewer = this.app.viewer;
     viewer.controls.enabled = false;
-    viewer.renderer.domElement.setPointerCapture(e.pointerId);
+    viewer.canvas.setPointerCapture(e.pointerId);
     // The camera holds still while drawing.
     const follow = viewer.layers().follow;
     if (follow) viewer.setLayers({ follow: false });
@@ -308,7 +308,7 @@ export class PathMode {
     const viewer = this.app.viewer;
     viewer.controls.enabled = true;
     if (s.follow) viewer.setLayers({ follow: true });
-    const canvas = viewer.renderer.domElement;
+    const canvas = viewer.canvas;
     if (canvas.hasPointerCapture(s.id)) canvas.releasePointerCapture(s.id);
   }
 

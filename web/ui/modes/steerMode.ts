@@ -123,9 +123,10 @@ export class SteerMode extends LiveMode<SteerChunk> {
       if (app.controlModel.steerable !== this.model) this.restartIfActive();
     });
     // On the document, so it runs before the page's own shortcuts (on window), which it then skips.
-    document.addEventListener('keydown', (e) => this.onKey(e, true));
-    document.addEventListener('keyup', (e) => this.onKey(e, false));
-    window.addEventListener('blur', () => this.held.clear());
+    const signal = currentScope().signal; // the page's listeners go with the element's playground
+    document.addEventListener('keydown', (e) => this.onKey(e, true), { signal });
+    document.addEventListener('keyup', (e) => this.onKey(e, false), { signal });
+    window.addEventListener('blur', () => this.held.clear(), { signal });
     app.viewer.controls.addEventListener('start', () => (this.chasePausedUntil = Infinity));
     app.viewer.controls.addEventListener('end', () => (this.chasePausedUntil = performance.now() + CHASE_PAUSE));
     this.joystick.addEventListener('pointerdown', (e) => this.onPad(e, 'down'));

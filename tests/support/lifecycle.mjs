@@ -1,0 +1,123 @@
+// Helpers for counting what <motion-playground> elements hold (issue 43): live Workers and WebGL contexts
+// (counted by an init script that wraps the constructors), and the memory of the page: its JS heap after a
+// forced collection (CDP Performance.getMetrics JSHeapUsedSize) and the resident memory of this browser's
+// renderer and GPU processes (ps, the browser being a child of this node process). Used by
+// tests/e2e/lifecycle.test.mjs and tests/bench/memory.mjs.
+import { execFileSync } from 'node:child_process';
+
+/** A page of the site (served at /site/… by `serveSite`) that loads the element's module. */
+export function sitePage(body, style = 'motion-playground { width: 320px; height: 240px; display: block; }') {
+  return `<!doctype html><html><head><meta charset="utf-8"><title>lifecycle</title>
+<script type="module" src="/@vite/env"></script>
+<script type="module" src="/motion-playground.ts"></script>
+<style>body { margin: 0; } ${style}</style></head>
+<body>${body}</body></html>`;
+}
+
+export const ISOLATION = { 'Cross-Origin-Opener-Policy': 'same-origin', 'Cross-Origin-Embedder-Policy': 'require-corp' };
+
+/** Serves `pages` (name → html) at `${url}site/<name>` in `context`, cross-origin isolated like the dev server. */
+export async function serveSite(context, url, pages) {
+  await context.route(`${url}site/**`, (route) => {
+    const file = new URL(route.request().url()).pathname.replace(/^\/site\//, '');
+    if (pages[file]) return route.fulfill({ status: 200, contentType: 'text/html', headers: ISOLATION, body: pages[file] });
+    return route.fulfill({ status: 404, body: 'not here' });
+  });
+}
+
+/**
+ * Runs in the page before its scripts: window.__live.workers() is the number of Workers created and not
+ * terminated; window.__live.contexts() the number of WebGL contexts made and not lost; window.__live.made the
+ * number of contexts ever made.
+ */
+export function installCounters() {
+  const NativeWorker = window.Worker;
+  const live = new Set();
+  class CountedWorker extends NativeWorker {
+    constructor(...args) {
+      super(...args);
+      live.add(this);
+    }
+    terminate() {
+      live.delete(this);
+      super.terminate();
+    }
+  }
+  window.Worker = CountedWorker;
+  const contexts = new Set();
+  const getContext = HTMLCanvasElement.prototype.getContext;
+  const counters = { made: 0, workers: () => live.size, contexts: () => [...contexts].filter((gl) => !gl.isContextLost()).length };
+  HTMLCanvasElement.prototype.getContext = function (type, ...rest) {
+    const gl = getContext.call(this, type, ...rest);
+    if (gl && /webgl/.test(String(type)) && !contexts.has(gl)) {
+      contexts.add(gl);
+      counters.made++;
+    }
+    return gl;
+  };
+  window.__live = counters;
+}
+
+/** Resident memory (MB) of this node process's Chromium renderer and GPU processes. */
+export function rendererMemoryMB() {
+  let out;
+  try {
+    out = execFileSync('ps', ['-eo', 'pid=,ppid=,rss=,args='], { encoding: 'utf8', maxBuffer: 16 << 20 });
+  } catch {
+    return null;
+  }
+  const procs = out.trim().split('\n').map((line) => {
+    const m = line.trim().match(/^(\d+)\s+(\d+)\s+(\d+)\s+(.*)$/);
+    return m && { pid: +m[1], ppid: +m[2], rss: +m[3], args: m[4] };
+  }).filter(Boolean);
+  const mine = new Set([process.pid]);
+  let grew = true;
+  while (grew) {
+    grew = false;
+    for (const p of procs) if (!mine.has(p.pid) && mine.has(p.ppid)) { mine.add(p.pid); grew = true; }
+  }
+  const kb = procs.filter((p) => mine.has(p.pid) && /--type=(renderer|gpu-process)/.test(p.args)).reduce((s, p) => s + p.rss, 0);
+  return Math.round(kb / 1024);
+}
+
+/** The page's JS heap in use (MB) after a forced garbage collection, through CDP session `cdp`. */
+export async function heapMB(cdp) {
+  await cdp.send('HeapProfiler.collectGarbage');
+  await cdp.send('HeapProfiler.collectGarbage');
+  const { metrics } = await cdp.send('Performance.getMetrics');
+  const used = metrics.find((m) => m.name === 'JSHeapUsedSize')?.value ?? 0;
+  return +(used / 2 ** 20).toFixed(1);
+}
+
+/** Workers, WebGL contexts, heap and renderer memory now. */
+export async function sample(page, cdp) {
+  const heap = await heapMB(cdp);
+  const counts = await page.evaluate(() => ({ workers: window.__live.workers(), contexts: window.__live.contexts(), elements: document.querySelectorAll('motion-playground').length }));
+  return { ...counts, heapMB: heap, rendererMB: rendererMemoryMB() };
+}
+
+/**
+ * Adds `n` elements (default view: Random walk, but one in Path mode walking a path and one dancing), waits
+ * until each shows motion (or `timeout` ms), then removes them all and waits `settle` ms.
+ */
+export async function addAndRemove(page, n, { timeout = 60_000, settle = 500 } = {}) {
+  const shown = await page.evaluate(async ({ n, timeout }) => {
+    const made = [];
+    for (let i = 0; i < n; i++) {
+      const el = document.createElement('motion-playground');
+      el.setAttribute('controls', 'minimal');
+      if (i === 1) { el.setAttribute('mode', 'path'); el.setAttribute('path', '0,0;3,1.5;6,0;9,-1.5'); }
+      if (i === 2) { el.setAttribute('mode', 'dance'); el.setAttribute('model', 'aclstm'); el.setAttribute('autoplay', ''); }
+      made.push(new Promise((resolve) => {
+        el.addEventListener('motion', () => resolve(true), { once: true });
+        setTimeout(() => resolve(false), timeout);
+      }));
+      document.body.append(el);
+    }
+    const shown = (await Promise.all(made)).filter(Boolean).length;
+    for (const el of [...document.querySelectorAll('motion-playground')]) el.remove();
+    return shown;
+  }, { n, timeout });
+  await page.waitForTimeout(settle);
+  return shown;
+}
