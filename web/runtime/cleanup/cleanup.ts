@@ -67,6 +67,23 @@ export interface CleanupResult {
 
 const OPTION_RANGES = { sigmaRoot: [0.001, 1, 'metres'], sigmaAngle: [0.001, 1.5, 'radians'], cutoffHz: [0.5, 14, 'Hz'] } as const;
 
+/** Frames of canonical rotations solved between two checkpoints (about 40 ms of work). */
+const ROTATION_CHUNK = 128;
+
+/** canonicalRotations in chunks of frames with a checkpoint between: every frame is solved on its own, so the result is the same. */
+async function rotationsWithPauses(info: GeneratorInfo, points: Float32Array, signal: AbortSignal | undefined): Promise<Float32Array> {
+  if (!signal) return canonicalRotations(info, points);
+  const J = info.skeleton.parents.length;
+  const frames = points.length / (J * 3);
+  const out = new Float32Array(frames * J * 4);
+  for (let f = 0; f < frames; f += ROTATION_CHUNK) {
+    const end = Math.min(frames, f + ROTATION_CHUNK);
+    out.set(canonicalRotations(info, points.subarray(f * J * 3, end * J * 3)), f * J * 4);
+    await pause(signal);
+  }
+  return out;
+}
+
 /** Checks clean-up options (the API and the worker both do); throws with a short reason naming the option. */
 export function checkCleanupOptions(options: unknown): CleanupOptions {
   if (typeof options !== 'object' || options === null || Array.isArray(options)) throw new Error(`options must be an object like { method: 'map' }, got ${describeValue(options)}`);
@@ -280,22 +297,25 @@ export async function cleanUpOnCanonical(
   const began = performance.now();
   await pause(signal);
   const mapping = mapSkeleton(motion, legLength(info));
+  await pause(signal);
   const K = CANONICAL_JOINTS.length;
   const fps = info.fps;
   // Before: the imported motion's canonical points at its own fps and at the model's, and their segment rotations
   // (the IK runs at the model's fps; rotations at the motion's own are interpolated).
   const beforePoints = toCanonical(motion, mapping);
+  await pause(signal);
   const frames = resampledFrames(motion.frames, motion.fps, fps);
   // Down to the model's rate with the dropped frames averaged in, their extremes left out (a 120 fps capture gives 30 fps
   // frames of about half the jitter, and a one-frame glitch is gone; the mean of 3 of 5 sorted values has about the
   // jitter of a mean of 4, a median of w that of a mean of 2w/π).
   const { values: points, window } = resampleRobust(beforePoints, K * 3, motion.fps, fps, frames);
+  await pause(signal);
   // The models stand on y = 0; imported clips need not (CMU AMC floors sit a few centimetres off).
   const floor = floorHeight(points);
   for (let i = 1; i < points.length; i += 3) points[i] -= floor;
   const jitter = medianJitter(beforePoints);
   await pause(signal);
-  const rotations = canonicalRotations(info, points);
+  const rotations = await rotationsWithPauses(info, points, signal);
   const beforeRotations = resampleQuaternions(rotations, K, fps, motion.fps, motion.frames);
   await pause(signal);
   const slowHz = belowNyquist(slowBandHz(jitter), motion.fps);
@@ -314,7 +334,7 @@ export async function cleanUpOnCanonical(
   const contacts30 = labelContacts(cleaned.positions, cleaned.bits, skeleton.joints, fps);
   const planted = { positions: pinFeet(cleaned.positions, contacts30, skeleton.joints, PIN_TOLERANCE), contacts: contacts30 };
   for (let i = 1; i < planted.positions.length; i += 3) planted.positions[i] += floor;
-  const afterRotations = canonicalRotations(info, planted.positions);
+  const afterRotations = await rotationsWithPauses(info, planted.positions, signal);
   await pause(signal);
   // After: back at the imported motion's frame times.
   const afterPoints = resampleLinear(planted.positions, K * 3, fps, motion.fps, motion.frames);
