@@ -44,13 +44,28 @@ export function installCounters() {
     }
   }
   window.Worker = CountedWorker;
+  // Weakly held: the counter must not keep a removed element's canvas (and so the element) alive.
   const contexts = new Set();
+  const seen = new WeakSet();
   const getContext = HTMLCanvasElement.prototype.getContext;
-  const counters = { made: 0, workers: () => live.size, contexts: () => [...contexts].filter((gl) => !gl.isContextLost()).length };
+  const counters = {
+    made: 0,
+    workers: () => live.size,
+    contexts: () => {
+      let n = 0;
+      for (const ref of contexts) {
+        const gl = ref.deref();
+        if (!gl) contexts.delete(ref);
+        else if (!gl.isContextLost()) n++;
+      }
+      return n;
+    },
+  };
   HTMLCanvasElement.prototype.getContext = function (type, ...rest) {
     const gl = getContext.call(this, type, ...rest);
-    if (gl && /webgl/.test(String(type)) && !contexts.has(gl)) {
-      contexts.add(gl);
+    if (gl && /webgl/.test(String(type)) && !seen.has(gl)) {
+      seen.add(gl);
+      contexts.add(new WeakRef(gl));
       counters.made++;
     }
     return gl;
@@ -102,16 +117,21 @@ export async function sample(page, cdp) {
  */
 export async function addAndRemove(page, n, { timeout = 60_000, settle = 500 } = {}) {
   const shown = await page.evaluate(async ({ n, timeout }) => {
+    // Whether `el` shows motion within `timeout` ms; the timer is cleared, so that nothing here keeps a removed element.
+    const shows = (el, timeout) => new Promise((resolve) => {
+      const timer = setTimeout(() => resolve(false), timeout);
+      el.addEventListener('motion', () => {
+        clearTimeout(timer);
+        resolve(true);
+      }, { once: true });
+    });
     const made = [];
     for (let i = 0; i < n; i++) {
       const el = document.createElement('motion-playground');
       el.setAttribute('controls', 'minimal');
       if (i === 1) { el.setAttribute('mode', 'path'); el.setAttribute('path', '0,0;3,1.5;6,0;9,-1.5'); }
       if (i === 2) { el.setAttribute('mode', 'dance'); el.setAttribute('model', 'aclstm'); el.setAttribute('autoplay', ''); }
-      made.push(new Promise((resolve) => {
-        el.addEventListener('motion', () => resolve(true), { once: true });
-        setTimeout(() => resolve(false), timeout);
-      }));
+      made.push(shows(el, timeout));
       document.body.append(el);
     }
     const shown = (await Promise.all(made)).filter(Boolean).length;
