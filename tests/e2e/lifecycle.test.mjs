@@ -189,6 +189,18 @@ describe('the element lifecycle', { timeout: 900_000 }, () => {
     assert.equal(await posterHidden(), false, 'the poster is shown instead');
     await page.evaluate(() => window.loser.restoreContext());
     await waitUntil(page, () => document.getElementById('a').shadowRoot.querySelector('.poster').hidden, null, { message: 'restored, the poster goes' });
+    // Taken again and not given back: the element asks for it when it is next scrolled into view.
+    await page.evaluate(() => {
+      window.loser.loseContext();
+      const spacer = document.createElement('div');
+      spacer.style.height = '3000px';
+      document.body.append(spacer);
+    });
+    await waitUntil(page, () => window.errors.filter((r) => /WebGL/.test(r)).length === 2 && !document.getElementById('a').shadowRoot.querySelector('.poster').hidden, null, { message: 'lost again: error and poster' });
+    await page.evaluate(() => window.scrollTo(0, 2500));
+    await page.waitForTimeout(500);
+    await page.evaluate(() => window.scrollTo(0, 0));
+    await waitUntil(page, () => document.getElementById('a').shadowRoot.querySelector('.poster').hidden && window.__live.contexts() === 1, null, { message: 'scrolled back, the element has its context again and the poster goes' });
 
     // A new element that can get no context at all.
     await page.evaluate((poster) => {

@@ -97,6 +97,9 @@ export class Viewer {
   private readonly resolution: DynamicResolution;
   private webgl: THREE.WebGLRenderer | null = null;
   private contextState: ContextState = 'none';
+  /** A loss the browser caused was reported (onContextLost): its restoring is reported too. */
+  private lossReported = false;
+  private loser: WEBGL_lose_context | null = null;
   /** Near the viewport (CONTEXT_MARGIN): only then is a WebGL context held and the scene drawn. */
   private visible = false;
   private running = false;
@@ -171,6 +174,8 @@ export class Viewer {
       throw e;
     }
     this.webgl = renderer;
+    // Kept from the start: a context already lost gives out no extensions (three.js asks only when told to).
+    this.loser = renderer.getContext().getExtension('WEBGL_lose_context');
     this.contextState = 'live';
     renderer.setPixelRatio(this.basePixelRatio * this.resolution.scale);
     renderer.outputColorSpace = THREE.LinearSRGBColorSpace; // colours are used as given (see palette.ts)
@@ -199,14 +204,15 @@ export class Viewer {
         } catch {
           // reported through onContextLost
         }
-      } else if (this.contextState === 'released') {
+      } else if (this.contextState === 'released' || this.contextState === 'lost') {
+        // (A context the browser took, e.g. the oldest of too many, is asked back when its element is seen again.)
         this.contextState = 'restoring';
-        this.webgl!.forceContextRestore();
+        this.loser?.restoreContext();
       }
       // 'releasing': restored once the loss arrives (contextLost); 'restoring' and 'live': nothing to do.
     } else if (this.contextState === 'live') {
       this.contextState = 'releasing';
-      this.webgl!.forceContextLoss();
+      this.loser?.loseContext();
     }
   }
 
@@ -217,23 +223,25 @@ export class Viewer {
       this.contextState = 'released';
       if (this.visible) {
         this.contextState = 'restoring';
-        this.webgl!.forceContextRestore();
+        this.loser?.restoreContext();
       }
       return;
     }
     this.contextState = 'lost';
+    this.lossReported = true;
     this.onContextLost?.('WebGL: the context was lost (too many on the page, or the GPU was reset)');
   }
 
   private contextRestored(): void {
     if (this.disposed) return;
-    const wasLost = this.contextState === 'lost';
+    const wasLost = this.lossReported;
+    this.lossReported = false;
     this.contextState = 'live';
     this.dirty = true;
     this.resize();
     if (!this.visible) {
       this.contextState = 'releasing';
-      this.webgl!.forceContextLoss();
+      this.loser?.loseContext();
     }
     if (wasLost) this.onContextRestored?.();
   }
@@ -266,7 +274,7 @@ export class Viewer {
     this.scene.clear();
     if (this.webgl) {
       this.webgl.dispose();
-      if (this.contextState === 'live' || this.contextState === 'restoring') this.webgl.forceContextLoss();
+      if (this.contextState === 'live' || this.contextState === 'restoring') this.loser?.loseContext();
       this.webgl = null;
     }
     this.contextState = 'released';
