@@ -6,28 +6,10 @@
 // snippet; a file or joint name holding markup is shown as text.
 import assert from 'node:assert/strict';
 import { after, before, describe, test } from 'node:test';
-import { corpusText, installUiLookups, launchBrowser, nextFrames, startServer, waitUntil } from './harness.mjs';
+import { corpusText, installUiLookups, launchBrowser, nextFrames, startServer, waitUntil, sitePage } from './harness.mjs';
 
 const ISOLATION = { 'Cross-Origin-Opener-Policy': 'same-origin', 'Cross-Origin-Embedder-Policy': 'require-corp' };
 const PATH = '0,0;3,1.5;6,0;9,-1.5';
-
-/** A page of the site holding `body`, which may use the element (its module is loaded first; /@vite/env defines what the dev server's own pages get). */
-function sitePage(body) {
-  return `<!doctype html><html><head><meta charset="utf-8"><title>element test</title>
-<script type="module" src="/@vite/env"></script>
-<script type="module" src="/motion-playground.ts"></script>
-<style>body { margin: 0; } motion-playground { width: 480px; height: 320px; display: block; }</style></head>
-<body>${body}
-<script>
-  // Every event of every element, in order (listeners go on before the module defines the element).
-  window.events = [];
-  for (const el of document.querySelectorAll('motion-playground')) {
-    for (const type of ['load', 'error', 'progress', 'play', 'pause', 'motion']) {
-      el.addEventListener(type, (e) => window.events.push({ id: el.id, type, detail: e.detail ?? null }));
-    }
-  }
-</script></body></html>`;
-}
 
 describe('the <motion-playground> element', { timeout: 240_000 }, () => {
   let server, url, browser;

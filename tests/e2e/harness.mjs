@@ -15,6 +15,7 @@ export {
   MOCAP,
   openPlayground,
   ROOT,
+  sitePage,
   startServer,
 } from '../support/browser.mjs';
 

@@ -8,28 +8,11 @@ import assert from 'node:assert/strict';
 import http from 'node:http';
 import { after, before, describe, test } from 'node:test';
 import { chromium } from 'playwright-core';
-import { CHROMIUM, CHROMIUM_ARGS, corpusText, freePort, installUiLookups, openPlayground, startServer, waitUntil } from './harness.mjs';
+import { CHROMIUM, CHROMIUM_ARGS, corpusText, freePort, installUiLookups, openPlayground, startServer, waitUntil, sitePage } from './harness.mjs';
 
 const MAX_MESSAGE = 300;
 const WALK = corpusText('cmu/bvh/07_04.bvh.gz');
 const LONG = 100_000;
-
-/** A page of the site holding `body` (as in element.test.mjs): every event of every element is kept in window.events. */
-function sitePage(body) {
-  return `<!doctype html><html><head><meta charset="utf-8"><title>robust element test</title>
-<script type="module" src="/@vite/env"></script>
-<script type="module" src="/motion-playground.ts"></script>
-<style>body { margin: 0; } motion-playground { width: 480px; height: 320px; display: block; }</style></head>
-<body>${body}
-<script>
-  window.events = [];
-  for (const el of document.querySelectorAll('motion-playground')) {
-    for (const type of ['load', 'error', 'motion']) {
-      el.addEventListener(type, (e) => window.events.push({ id: el.id, type, detail: e.detail ?? null }));
-    }
-  }
-</script></body></html>`;
-}
 
 /** A plain HTTP server on `host` (all interfaces when left out) answering with `handler`; `close` ends it and its open requests. */
 async function listen(handler, host) {

@@ -109,3 +109,25 @@ export function installUiLookups() {
     $uiActive: () => root()?.activeElement ?? null,
   });
 }
+
+/**
+ * A page of a site holding `body`, which may use the element (its module is loaded first; /@vite/env defines
+ * what the dev server's own pages get). `style` sizes the elements; with `recordEvents` every event of every
+ * element in `body` is kept, in order, in window.events (listeners go on before the module defines the element).
+ */
+export function sitePage(body, { title = 'site', style = 'motion-playground { width: 480px; height: 320px; display: block; }', recordEvents = true } = {}) {
+  const recorder = `<script>
+  window.events = [];
+  for (const el of document.querySelectorAll('motion-playground')) {
+    for (const type of ['load', 'error', 'progress', 'play', 'pause', 'motion']) {
+      el.addEventListener(type, (e) => window.events.push({ id: el.id, type, detail: e.detail ?? null }));
+    }
+  }
+</script>`;
+  return `<!doctype html><html><head><meta charset="utf-8"><title>${title}</title>
+<script type="module" src="/@vite/env"></script>
+<script type="module" src="/motion-playground.ts"></script>
+<style>body { margin: 0; } ${style}</style></head>
+<body>${body}
+${recordEvents ? recorder : ''}</body></html>`;
+}

@@ -4,14 +4,11 @@
 // renderer and GPU processes (ps, the browser being a child of this node process). Used by
 // tests/e2e/lifecycle.test.mjs and tests/bench/memory.mjs.
 import { execFileSync } from 'node:child_process';
+import { sitePage as browserSitePage } from './browser.mjs';
 
-/** A page of the site (served at /site/… by `serveSite`) that loads the element's module. */
+/** A page of the site (served at /site/… by `serveSite`) that loads the element's module; it keeps no events. */
 export function sitePage(body, style = 'motion-playground { width: 320px; height: 240px; display: block; }') {
-  return `<!doctype html><html><head><meta charset="utf-8"><title>lifecycle</title>
-<script type="module" src="/@vite/env"></script>
-<script type="module" src="/motion-playground.ts"></script>
-<style>body { margin: 0; } ${style}</style></head>
-<body>${body}</body></html>`;
+  return browserSitePage(body, { title: 'lifecycle', style, recordEvents: false });
 }
 
 export const ISOLATION = { 'Cross-Origin-Opener-Policy': 'same-origin', 'Cross-Origin-Embedder-Policy': 'require-corp' };
