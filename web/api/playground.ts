@@ -20,7 +20,7 @@ import { capMessage } from '../motion/text';
 import { loadManifest, type ModelInfo } from '../model/manifest';
 import { assetUrl } from '../runtime/worker/assetBase';
 import { checkCleanupMotion, checkCleanupOptions, type CleanupMethod, type CleanupStats } from '../runtime/cleanup/cleanup';
-import type { Capability, GenerateCall, ModelDescriptor, PathStats } from '../runtime/descriptor';
+import type { Capability, GenerateCall, PathStats } from '../runtime/descriptor';
 import { Registry, type RegisteredModel } from '../runtime/registry';
 import { mapSkeleton } from '../motion/skeletonMap';
 import { addNoise as addNoiseTo, checkNoiseOptions, type NoiseOptions } from '../motion/noise';
@@ -221,7 +221,7 @@ export function checkGenerate(options: unknown, models: ModelInfo[]): GenerateCa
   }
   const o = options as Record<string, unknown>;
   const registry = new Registry(models);
-  const { entry, descriptor } = pickModel(registry, 'generate', o.model, `a model id string (available: ${registry.ids('generate').join(', ') || 'none'})`);
+  const { info: entry, descriptor } = pickModel(registry, 'generate', o.model, `a model id string (available: ${registry.ids('generate').join(', ') || 'none'})`);
   const generate = descriptor.generate!;
   for (const [key, reason] of Object.entries(generate.refused ?? {})) if (key in o) throw new TypeError(reason);
   const known = [...generate.options, 'signal'];
@@ -239,7 +239,7 @@ export function checkGenerate(options: unknown, models: ModelInfo[]): GenerateCa
  * The model a call names (`value`) among those that can do `capability`: its manifest entry and
  * descriptor. `what` says what a model must be, for the refusal of a non-string.
  */
-function pickModel(registry: Registry, capability: Capability, value: unknown, what: string): { entry: ModelInfo; descriptor: ModelDescriptor } {
+function pickModel(registry: Registry, capability: Capability, value: unknown, what: string): RegisteredModel {
   const usable = registry.with(capability);
   const available = usable.map((m) => m.info.id).join(', ');
   if (typeof value !== 'string') throw new TypeError(`model must be ${what}, got ${describeValue(value)}`);
@@ -249,7 +249,7 @@ function pickModel(registry: Registry, capability: Capability, value: unknown, w
     if (refusal) throw new Error(refusal);
     throw new Error(`unknown model ${describeValue(value)} (available: ${available || 'none — the model list did not load'})`);
   }
-  return { entry: found.info, descriptor: found.descriptor };
+  return found;
 }
 
 /** Throws unless `options` is a plain object whose keys are all in `known`. */
@@ -344,8 +344,7 @@ function controlModel(registry: Registry, capability: 'followPath' | 'liveContro
   if (value === undefined && fallback) return fallback;
   const ids = registry.ids(capability).map((id) => `"${id}"`);
   const what = ids.length === 0 ? 'a listed model id (none is listed)' : ids.length === 1 ? ids[0] : ids.length === 2 ? ids.join(' or ') : `one of ${ids.join(', ')}`;
-  const { entry } = pickModel(registry, capability, value, what);
-  return registry.find(entry.id)!;
+  return pickModel(registry, capability, value, what);
 }
 
 /** followPath's options every model takes; each model adds its own (its descriptor's followPath.options). */

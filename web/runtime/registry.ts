@@ -20,6 +20,13 @@ export function descriptorsByKind(found: Record<string, { descriptor: ModelDescr
   return byKind;
 }
 
+let shipped: Map<string, ModelDescriptor> | undefined;
+
+/** The descriptors of the model folders, found once. */
+function shippedKinds(): Map<string, ModelDescriptor> {
+  return (shipped ??= descriptorsByKind());
+}
+
 /** A manifest entry the page can run, with its descriptor. */
 export interface RegisteredModel {
   info: ModelInfo;
@@ -30,7 +37,7 @@ export class Registry {
   private readonly models: RegisteredModel[];
 
   /** `entries`: the manifest, in its order (the first model with a capability is that capability's default). */
-  constructor(entries: readonly ModelInfo[] = [], kinds: Map<string, ModelDescriptor> = descriptorsByKind()) {
+  constructor(entries: readonly ModelInfo[] = [], kinds: Map<string, ModelDescriptor> = shippedKinds()) {
     this.models = entries.flatMap((info) => {
       const descriptor = kinds.get(info.kind);
       return descriptor ? [{ info, descriptor }] : [];
