@@ -41,21 +41,21 @@ describe('pathCoverage', () => {
     expect(pathCoverage(straight, twoHalves)).toBeLessThan(0.52);
   });
 
-  it('on the back-and-forth path: 1 walked as drawn, the first leg alone about a fifth, and a corner cut loses the tip', () => {
-    const legs = [3, Math.hypot(0.5, 2.7), 3, Math.hypot(0.5, 2.7), 3];
-    const total = legs.reduce((a, b) => a + b);
+  it('on the back-and-forth path: 1 walked as drawn, the first leg alone a fifth, and a corner cut loses the tip', () => {
+    const total = 3 + 2.5 + Math.hypot(0.3, 3) + 2.5 + 3;
     expect(pathCoverage(BACK_AND_FORTH, walkAlong(BACK_AND_FORTH))).toBeCloseTo(1, 6);
+    // The first leg; the second runs back over it, but after its tip, so it is not covered but for ~0.3 m: a walk
+    // standing 0.15 m before the tip is within 0.15 m of the path from 0.3 m before the tip on the way back.
     const firstLeg = pathCoverage(BACK_AND_FORTH, walkAlong(BACK_AND_FORTH.slice(0, 2)));
-    // The first leg, and the start of the second, which leaves its tip at 10.5° and so stays within 0.15 m for ~0.8 m.
-    expect(firstLeg).toBeGreaterThan(legs[0] / total);
-    expect(firstLeg).toBeLessThan((legs[0] + 0.9) / total);
-    // Turning back 0.6 m before each upper tip (z 2.4 instead of 3, 2.7 instead of 3.3) skips that tip.
-    const cut: GroundXZ[] = [[0, 0], [0, 2.4], [0.5, 0.3], [0.5, 2.7], [1, 0.6], [1, 3.6]];
+    expect(firstLeg).toBeGreaterThan((3 + 0.15) / total);
+    expect(firstLeg).toBeLessThan((3 + 0.35) / total);
+    // Turning back 0.6 m before the first two upper tips (z 2.4 instead of 3, 2.9 instead of 3.5) skips them.
+    const cut: GroundXZ[] = [[0, 0], [0, 2.4], [0, 0.5], [0.3 * 0.8, 2.9], [0.3, 1], [0.3, 4]];
     const cutCoverage = pathCoverage(BACK_AND_FORTH, walkAlong(cut));
-    expect(cutCoverage).toBeLessThan(0.95);
+    expect(cutCoverage).toBeLessThan(1 - (2 * 2 * 0.45) / total);
     expect(cutCoverage).toBeGreaterThan(0.7);
     // The same walk, and then the skipped tips visited at the end, out of order: no better.
-    const lateTips = [...walkAlong(cut), ...walkAlong([[1, 3.6], [0.5, 3.3], [0, 3]])];
+    const lateTips = [...walkAlong(cut), ...walkAlong([[0.3, 4], [0.3, 3.5], [0, 3]])];
     expect(pathCoverage(BACK_AND_FORTH, lateTips)).toBeCloseTo(cutCoverage, 2);
   });
 
