@@ -68,15 +68,21 @@ describe('clean-up', () => {
   });
 
   it('refuses a skeleton it cannot map before running any model, naming what is missing', async () => {
-    const knees = new Set(['lfemur', 'rfemur']);
-    const renamed = { ...clip, joints: clip.joints.map((n) => (knees.has(n) ? `${n}_x` : n)) };
+    // The clip without its right leg (every joint below rhipjoint dropped).
+    const cut = new Set<number>();
+    clip.parents.forEach((p, j) => (clip.joints[j] === 'rhipjoint' || cut.has(p)) && cut.add(j));
+    const kept = clip.joints.flatMap((_, j) => (cut.has(j) ? [] : [j]));
+    const J = clip.joints.length;
+    const positions = new Float32Array(clip.frames * kept.length * 3);
+    for (let f = 0; f < clip.frames; f++) kept.forEach((j, k) => positions.set(clip.positions.subarray((f * J + j) * 3, (f * J + j) * 3 + 3), (f * kept.length + k) * 3));
+    const oneLegged = { ...clip, joints: kept.map((j) => clip.joints[j]), parents: kept.map((j) => kept.indexOf(clip.parents[j])), positions };
     let called = false;
-    const run = cleanUpOnCanonical(info, renamed, 'map', async () => {
+    const run = cleanUpOnCanonical(info, oneLegged, 'map', async () => {
       called = true;
       throw new Error('not reached');
     });
     await expect(run).rejects.toThrow(SkeletonMapError);
-    await expect(run).rejects.toThrow(/left knee, right knee/);
+    await expect(run).rejects.toThrow(/no two legs/);
     expect(called).toBe(false);
   });
 

@@ -2,7 +2,7 @@
 //
 //   exportGLB(motion: Motion, options?: GLBExportOptions): Uint8Array
 //     options.restPose  'tpose' (default) or 'clip': the bind pose (restPose.ts). 'tpose' throws an Error
-//                       when the skeleton's legs and arms cannot be named ("T-pose rest needs …").
+//                       when the skeleton is not a humanoid the mapper can read ("T-pose rest needs …").
 //     options.name      the scene's, figure's and animation's name (default 'motion').
 //   gltfJointNames(joints: readonly string[]): string[]
 //     the node name each joint gets: a name of letters, digits and other characters glTF readers keep is kept

@@ -7,10 +7,10 @@
 //            straight out sideways (left +x, right −x: CMU's rest pose faces +z with the left side at +x) with the
 //            hands and fingers continuing them. Bones between those (pelvis → hips, chest → shoulders) and any the
 //            T-pose does not name (props) keep their direction in the tallest frame, turned about y so that the
-//            figure faces +z. Which joints are legs, arms and head comes from skeletonMap's naming schemes.
+//            figure faces +z. Which joints are legs, arms and head comes from the humanoid mapper (humanoid.ts).
 import { quatAboutAxis, quatRotate, length, normalize, type Vec3 } from './math';
 import { boneVector, jointAt, type RigClip } from './jointRotations';
-import { CANONICAL_JOINTS, DESCRIPTIONS, NAME_SCHEMES, matchSchemes, type CanonicalJoint } from './skeletonMap';
+import { CANONICAL_JOINTS, mapHumanoid, type CanonicalJoint } from './humanoid';
 
 export type RestPose = 'clip' | 'tpose';
 export const REST_POSES: readonly RestPose[] = ['clip', 'tpose'];
@@ -82,33 +82,22 @@ function clipDirections(clip: RigClip, restFrame: number): Vec3[] {
 }
 
 /**
- * The T-pose points of a skeleton, by the naming scheme that places the most of them; throws an Error naming the
- * points no scheme finds.
+ * The T-pose points of a skeleton, by the humanoid mapper (humanoid.ts); throws an Error naming what is missing
+ * ("T-pose rest needs a humanoid skeleton: …").
  */
-function tposePoints(joints: readonly string[]): Record<TposePoint, number> {
-  let best: { scheme: string; found: Partial<Record<TposePoint, number>>; missing: TposePoint[] } | undefined;
-  for (const { scheme, source } of matchSchemes(joints)) {
-    const found: Partial<Record<TposePoint, number>> = {};
-    const missing: TposePoint[] = [];
-    for (const point of TPOSE_POINTS) {
-      const j = source[CANONICAL_JOINTS.indexOf(point)];
-      if (j >= 0) found[point] = j;
-      else missing.push(point);
-    }
-    if (!best || missing.length < best.missing.length) best = { scheme, found, missing };
+function tposePoints(clip: RigClip): Record<TposePoint, number> {
+  let source: number[];
+  try {
+    source = mapHumanoid(clip).source;
+  } catch (e) {
+    throw new Error(`T-pose rest needs a humanoid skeleton: ${(e as Error).message.replace(/^this skeleton is not a humanoid the playground can map: /, '')}`);
   }
-  if (best!.missing.length > 0) {
-    const names = best!.missing.map((p) => DESCRIPTIONS[p] ?? p).join(', ');
-    throw new Error(
-      `T-pose rest needs a skeleton with named legs and arms: no joint for the ${names} (closest naming scheme: ${best!.scheme}; known: ${NAME_SCHEMES.map((s) => s.name).join(', ')})`,
-    );
-  }
-  return best!.found as Record<TposePoint, number>;
+  return Object.fromEntries(TPOSE_POINTS.map((point) => [point, source[CANONICAL_JOINTS.indexOf(point)]])) as Record<TposePoint, number>;
 }
 
 /** Unit direction of each bone in the T-pose (see the header); throws when the skeleton's limbs cannot be named. */
 function tposeDirections(clip: RigClip, restFrame: number): Vec3[] {
-  const at = tposePoints(clip.joints);
+  const at = tposePoints(clip);
   const { parents } = clip;
   /** Whether joint j lies strictly below joint a. */
   const below = (j: number, a: number) => {

@@ -1,37 +1,19 @@
-// Maps an imported skeleton onto the canonical one (training/mocap/canonical_skeleton.json) by joint names, and
-// carries motion cleaned on the canonical skeleton back onto the imported skeleton.
+// Maps an imported skeleton onto the canonical one (training/mocap/canonical_skeleton.json) with the humanoid
+// mapper (humanoid.ts: any humanoid skeleton, by its tree and bone lengths, names as hints), and carries motion
+// cleaned on the canonical skeleton back onto the imported skeleton.
 //
-// One table holds every naming scheme. A Motion's joint sits where its bone starts (BVH) or ends (ASF: the joint
-// is named by the bone that ends there), so each scheme names, per canonical point, the joint found at that
-// place. A skeleton is matched against each scheme on its own (names clash across schemes: ASF's "lfoot" is the
-// toe base, a 3ds Max Biped's "L Foot" the ankle) and the scheme that places the most points wins.
-//
-// Canonical points that a scheme lacks but that lie between or beyond points it has (the spine and neck
-// segments, toe and hand tips) are placed along them at canonical proportions; the rest are required.
+// Canonical points that a skeleton lacks but that lie between or beyond points it has (the spine and neck
+// segments, toe and hand tips, the toes of a skeleton without any) are placed from them at canonical proportions.
 import { quatConjugate, quatMultiply, quatRotate, type Quat } from './math';
 import type { Motion } from './types';
+import { CANONICAL_JOINTS, CANONICAL_PARENTS, mapHumanoid, SkeletonMapError, type CanonicalJoint } from './humanoid';
 
-/** The canonical skeleton's points, in its order (parents: CANONICAL_PARENTS). */
-export const CANONICAL_JOINTS = [
-  'Hips', 'LeftUpLeg', 'LeftLeg', 'LeftFoot', 'LeftToeBase', 'LeftToeBase_end',
-  'RightUpLeg', 'RightLeg', 'RightFoot', 'RightToeBase', 'RightToeBase_end',
-  'Spine', 'Spine1', 'Neck', 'Neck1', 'Head', 'Head_end',
-  'LeftArm', 'LeftForeArm', 'LeftHand', 'LeftHand_end',
-  'RightArm', 'RightForeArm', 'RightHand', 'RightHand_end',
-] as const;
-export type CanonicalJoint = (typeof CANONICAL_JOINTS)[number];
-export const CANONICAL_PARENTS = [-1, 0, 1, 2, 3, 4, 0, 6, 7, 8, 9, 0, 11, 12, 13, 14, 15, 13, 17, 18, 19, 13, 21, 22, 23];
-
-/** What a person calls each required point, for messages. */
-export const DESCRIPTIONS: Partial<Record<CanonicalJoint, string>> = {
-  Hips: 'hips', LeftUpLeg: 'left hip', LeftLeg: 'left knee', LeftFoot: 'left ankle', LeftToeBase: 'left toe',
-  RightUpLeg: 'right hip', RightLeg: 'right knee', RightFoot: 'right ankle', RightToeBase: 'right toe',
-  Neck: 'neck base', Head: 'head', LeftArm: 'left shoulder', LeftForeArm: 'left elbow', LeftHand: 'left wrist',
-  RightArm: 'right shoulder', RightForeArm: 'right elbow', RightHand: 'right wrist',
-};
+export {
+  CANONICAL_JOINTS, CANONICAL_PARENTS, DESCRIPTIONS, NAME_SCHEMES, SkeletonMapError, matchSchemes, normaliseName, type CanonicalJoint,
+} from './humanoid';
 
 /**
- * Points placed from others when a scheme lacks them: at `t` along from → to (t > 1 extends beyond `to`).
+ * Points placed from others when a skeleton lacks them: at `t` along from → to (t > 1 extends beyond `to`).
  * The fractions are the canonical skeleton's own segment proportions.
  */
 const DERIVED: Partial<Record<CanonicalJoint, { from: CanonicalJoint; to: CanonicalJoint; t: number }>> = {
@@ -45,106 +27,22 @@ const DERIVED: Partial<Record<CanonicalJoint, { from: CanonicalJoint; to: Canoni
   RightHand_end: { from: 'RightForeArm', to: 'RightHand', t: 1.3 },
 };
 
-/** Per scheme, per canonical point, the (normalised, see normaliseName) joint names found there, best first. */
-type Scheme = { name: string; points: Partial<Record<CanonicalJoint, string[]>> };
-
-/** Both sides of a scheme from its left-side names: `L` in a name becomes the side's word. */
-function sided(left: Partial<Record<string, string[]>>, words: [string, string]): Partial<Record<CanonicalJoint, string[]>> {
-  const out: Partial<Record<CanonicalJoint, string[]>> = {};
-  for (const [point, names] of Object.entries(left)) {
-    out[point as CanonicalJoint] = names!.map((n) => n.replace('L', words[0]));
-    out[point.replace('Left', 'Right') as CanonicalJoint] = names!.map((n) => n.replace('L', words[1]));
-  }
-  return out;
-}
-
-export const NAME_SCHEMES: Scheme[] = [
-  {
-    name: 'CMU ASF',
-    points: {
-      Hips: ['root'], Spine: ['lowerback'], Spine1: ['upperback'], Neck: ['thorax'], Neck1: ['lowerneck'], Head: ['upperneck'], Head_end: ['head'],
-      ...sided({ LeftUpLeg: ['Lhipjoint'], LeftLeg: ['Lfemur'], LeftFoot: ['Ltibia'], LeftToeBase: ['Lfoot'], LeftToeBase_end: ['Ltoes'],
-        LeftArm: ['Lclavicle'], LeftForeArm: ['Lhumerus'], LeftHand: ['Lradius'], LeftHand_end: ['Lwrist'] }, ['l', 'r']),
-    },
-  },
-  {
-    name: 'CMU BVH',
-    points: {
-      Hips: ['hips'], Spine: ['spine'], Spine1: ['spine1'], Neck: ['neck'], Neck1: ['neck1'], Head: ['head'], Head_end: ['headend'],
-      ...sided({ LeftUpLeg: ['Lupleg'], LeftLeg: ['Lleg'], LeftFoot: ['Lfoot'], LeftToeBase: ['Ltoebase'], LeftToeBase_end: ['Ltoebaseend'],
-        LeftArm: ['Larm'], LeftForeArm: ['Lforearm'], LeftHand: ['Lhand'], LeftHand_end: ['Lfingerbase', 'Lhandend'] }, ['left', 'right']),
-    },
-  },
-  {
-    name: 'Mixamo',
-    points: {
-      Hips: ['hips'], Spine: ['spine1'], Spine1: ['spine2'], Neck: ['neck'], Head: ['head'], Head_end: ['headtopend'],
-      ...sided({ LeftUpLeg: ['Lupleg'], LeftLeg: ['Lleg'], LeftFoot: ['Lfoot'], LeftToeBase: ['Ltoebase'], LeftToeBase_end: ['Ltoeend'],
-        LeftArm: ['Larm'], LeftForeArm: ['Lforearm'], LeftHand: ['Lhand'], LeftHand_end: ['Lhandmiddle1'] }, ['left', 'right']),
-    },
-  },
-  {
-    name: '3ds Max Biped',
-    points: {
-      Hips: ['pelvis', ''], Spine: ['spine1', 'spine'], Spine1: ['spine2'], Neck: ['neck'], Head: ['head'], Head_end: ['headnub'],
-      ...sided({ LeftUpLeg: ['Lthigh'], LeftLeg: ['Lcalf'], LeftFoot: ['Lfoot'], LeftToeBase: ['Ltoe0'], LeftToeBase_end: ['Ltoe0nub'],
-        LeftArm: ['Lupperarm'], LeftForeArm: ['Lforearm'], LeftHand: ['Lhand'], LeftHand_end: ['Lfinger2', 'Lfinger1'] }, ['l', 'r']),
-    },
-  },
-  {
-    name: 'Daz',
-    points: {
-      Hips: ['hip', 'pelvis'], Spine: ['abdomenlower', 'abdomen'], Spine1: ['chestlower', 'chest'], Neck: ['necklower', 'neck'], Neck1: ['neckupper'], Head: ['head'],
-      ...sided({ LeftUpLeg: ['Lthighbend', 'Lthigh'], LeftLeg: ['Lshin'], LeftFoot: ['Lfoot'], LeftToeBase: ['Ltoe', 'Lmetatarsals'],
-        LeftArm: ['Lshldrbend', 'Lshldr'], LeftForeArm: ['Lforearmbend', 'Lforearm'], LeftHand: ['Lhand'], LeftHand_end: ['Lmid1'] }, ['l', 'r']),
-    },
-  },
-];
-
-/** A joint name without namespace (`mixamorig:`), Biped prefix (`Bip01 `), case, spaces, `_`, `-` or `.`. */
-export function normaliseName(name: string): string {
-  return name
-    .slice(name.lastIndexOf(':') + 1)
-    .toLowerCase()
-    .replace(/^bip0*1(?=$|[\s_.-])/, '')
-    .replace(/[\s_.-]/g, '');
-}
+/**
+ * The toe base of a skeleton without toes (canonical metres): ahead of the ankle, where the canonical skeleton's toe
+ * base lies from its ankle (training/mocap/canonical_skeleton.json: 0.114 forward, 0.029 down), forward being the
+ * hips' facing in that frame (left hip → right hip turned a quarter about y).
+ */
+const TOE_FORWARD = 0.114;
+const TOE_DOWN = 0.029;
 
 /** How an imported skeleton's joints become the canonical points. */
 export interface SkeletonMapping {
+  /** The naming scheme that gave the mapper its hints ('' when names did not help). */
   scheme: string;
   /** Per canonical point: the imported joint placed there, or -1 when the point is derived (DERIVED). */
   source: number[];
   /** Imported leg length (hip, knee, ankle) divided into the canonical one: canonical = imported × scale. */
   scale: number;
-}
-
-/** Raised when a skeleton cannot be mapped; the message names the joints that are missing. */
-export class SkeletonMapError extends Error {
-  constructor(message: string) {
-    super(message);
-    this.name = 'SkeletonMapError';
-  }
-}
-
-function matchScheme(scheme: Scheme, index: Map<string, number>): number[] {
-  return CANONICAL_JOINTS.map((point) => {
-    for (const n of scheme.points[point] ?? []) {
-      const j = index.get(n);
-      if (j !== undefined) return j;
-    }
-    return -1;
-  });
-}
-
-/** Per naming scheme (NAME_SCHEMES order), the joint it places at each canonical point (CANONICAL_JOINTS order; -1: none). */
-export function matchSchemes(joints: readonly string[]): Array<{ scheme: string; source: number[] }> {
-  const index = new Map<string, number>();
-  joints.forEach((name, j) => {
-    const n = normaliseName(name);
-    if (!index.has(n)) index.set(n, j);
-  });
-  return NAME_SCHEMES.map((scheme) => ({ scheme: scheme.name, source: matchScheme(scheme, index) }));
 }
 
 function legLength(motion: Motion, source: number[]): number {
@@ -160,24 +58,12 @@ function legLength(motion: Motion, source: number[]): number {
   return total / (2 * motion.frames);
 }
 
-/** The canonical mapping of `motion`'s skeleton (`canonicalLegLength`: hip → knee → ankle); throws SkeletonMapError naming what is missing. */
-export function mapSkeleton(motion: Pick<Motion, 'joints' | 'positions' | 'frames'>, canonicalLegLength: number): SkeletonMapping {
-  let best: { scheme: string; source: number[]; missing: CanonicalJoint[]; placed: number } | undefined;
-  for (const { scheme, source } of matchSchemes(motion.joints)) {
-    const missing = CANONICAL_JOINTS.filter((p, k) => source[k] < 0 && !DERIVED[p]);
-    // Spine points are derived from Hips and Neck, so a skeleton needs at least the Neck for them.
-    const placed = source.filter((j) => j >= 0).length;
-    if (!best || missing.length < best.missing.length || (missing.length === best.missing.length && placed > best.placed)) {
-      best = { scheme, source, missing, placed };
-    }
-  }
-  const { scheme, source, missing } = best!;
-  if (missing.length > 0) {
-    const names = missing.map((p) => DESCRIPTIONS[p] ?? p).join(', ');
-    throw new SkeletonMapError(
-      `this skeleton cannot be mapped to the canonical one: no joint for the ${names} (closest naming scheme: ${scheme}; known schemes: ${NAME_SCHEMES.map((s) => s.name).join(', ')})`,
-    );
-  }
+/**
+ * The canonical mapping of `motion`'s skeleton (`canonicalLegLength`: hip → knee → ankle) by the humanoid mapper
+ * (humanoid.ts); throws SkeletonMapError naming what is missing.
+ */
+export function mapSkeleton(motion: Pick<Motion, 'joints' | 'parents' | 'positions' | 'frames'>, canonicalLegLength: number): SkeletonMapping {
+  const { source, scheme } = mapHumanoid(motion);
   const mapping = { scheme, source, scale: 1 };
   const length = legLength(motion as Motion, source);
   if (!(length > 1e-4)) throw new SkeletonMapError('this skeleton cannot be mapped to the canonical one: its legs have no length');
@@ -197,6 +83,18 @@ export function toCanonical(motion: Motion, mapping: SkeletonMapping): Float32Ar
       if (j < 0) return;
       for (let a = 0; a < 3; a++) out[o + k * 3 + a] = motion.positions[(f * J + j) * 3 + a] * s;
     });
+    // Toes of a skeleton without any: ahead of the ankle along the hips' facing.
+    for (const side of ['Left', 'Right'] as const) {
+      const toe = CANONICAL_JOINTS.indexOf(`${side}ToeBase`);
+      if (mapping.source[toe] >= 0) continue;
+      const ankle = CANONICAL_JOINTS.indexOf(`${side}Foot`) * 3 + o;
+      const l = CANONICAL_JOINTS.indexOf('LeftUpLeg') * 3 + o, r = CANONICAL_JOINTS.indexOf('RightUpLeg') * 3 + o;
+      const lx = out[l] - out[r], lz = out[l + 2] - out[r + 2];
+      const n = Math.hypot(lx, lz) || 1;
+      out[o + toe * 3] = out[ankle] + (-lz / n) * TOE_FORWARD;
+      out[o + toe * 3 + 1] = out[ankle + 1] - TOE_DOWN;
+      out[o + toe * 3 + 2] = out[ankle + 2] + (lx / n) * TOE_FORWARD;
+    }
     // Derived points, in canonical order (a derived point only uses earlier or mapped ones).
     CANONICAL_JOINTS.forEach((point, k) => {
       const d = DERIVED[point];
