@@ -11,14 +11,14 @@ import torch
 
 from conftest import REPO
 from training.control import Rng
-from training.data.windows import ROW_DIM
+from training.data.windows import CONTACT_SLICE, CONTROL_SLICE, ROW_DIM
 from training.models.vae_lstm import POOLING, VaeLstm
 from training.vae_lstm.exporting import FILES, PRIOR_FIXTURE_SEED, check_parity, export_graphs, files_format, generate_rows
 from training.vae_lstm.generation import SEED_FRAMES, SEED_PAD, free_latents, prior_latents, seed_window
 from training.vae_lstm.measures import ShippedVae
 from training.models.losses import energy_loss
 from training.vae_lstm.recovery import vae_lstm_from_onnx
-from training.vae_lstm.stride import phase_start, stride_sway
+from training.vae_lstm.stride import fit_stride, phase_start, stride_sway
 from training.vae_lstm.training import kl_per_step, losses
 
 FIXTURE = REPO / "tests" / "fixtures" / "vae_lstm_reference.json"
@@ -148,6 +148,27 @@ def test_the_stride_sway_follows_its_bands_and_period():
     for seed, want in fixture["seeds"].items():
         assert phase_start(int(seed)) == want["phase"]
         np.testing.assert_allclose(stride_sway(control, info["fps"], info["stride"], want["phase"]).ravel(), want["sway"], atol=1e-12)
+
+
+def test_the_fitted_stride_swings_about_the_control_and_adds_no_speed():
+    """A clip that speeds up from 0.9 to 1.5 m/s (as the corpus's clips do from rest) with a stride's surge of
+    +-0.1 m/s every 30 frames: the fitted sway keeps the surge and none of the speeding up, which the slow smoothing
+    lags behind (before: +0.1 m/s added to the drawn control, so the model read a faster gait than asked)."""
+    frames, period = 600, 30
+    t = np.arange(frames)
+    rows = np.zeros((frames, ROW_DIM))
+    rows[:, CONTROL_SLICE.start] = 0.9 + 0.6 * np.clip(t / 400, 0, 1) + 0.1 * np.sin(2 * np.pi * t / period)
+    rows[:, CONTACT_SLICE.start] = (t % period) < period // 2
+    corpus = type("Corpus", (), {"train_clips": [type("Clip", (), {"rows": rows})()]})()
+    stride = fit_stride(corpus, control_sigma=3.0, fps=30.0)
+    for band in stride["bands"]:
+        sway = np.array(band["sway"])
+        np.testing.assert_allclose(sway.mean(axis=0), 0.0, atol=1e-4)
+        assert np.ptp(sway[:, 0]) > 0.1  # the surge is kept
+    # The shipped stride too: each band's sway averages to nothing over its stride.
+    info = json.loads((REPO / "public" / "models" / "vae-lstm.json").read_text())
+    for band in info["stride"]["bands"]:
+        np.testing.assert_allclose(np.mean(band["sway"], axis=0), 0.0, atol=1e-4)
 
 
 def test_the_shipped_graphs_reproduce_the_fixture_generation():

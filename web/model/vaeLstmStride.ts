@@ -1,8 +1,8 @@
 // The stride a drawn path lacks (training/vae_lstm/stride.py, the same numbers; vae-lstm.json "stride"). The VAE-LSTM
 // steps to the sway that a real root's velocity keeps after smoothing; a drawn path's control has none, and without it
 // the model stops stepping within seconds and glides. So the control it reads is the drawn control plus the training
-// clips' mean sway over one stride at that speed, the gait phase advancing by 1/period a second from a phase the
-// seed draws. The root still moves by the drawn control itself.
+// clips' mean sway over one stride at that speed (about the control: each stride's own mean removed), the gait phase
+// advancing by 1/period a second from a phase the seed draws. The root still moves by the drawn control itself.
 import { Rng } from '../motion/random';
 import type { VaeLstmStride } from './vaeLstmInfo';
 
