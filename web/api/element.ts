@@ -16,6 +16,7 @@ import { embedSnippet, FIRST_VIEW, formatViewValue, parseView, parseViewValue, v
 import { fetchMotionSource, sourceName } from '../runtime/import/motionSource';
 import { capMessage, quoteInput } from '../motion/text';
 import { prefetchRuntime } from '../runtime/worker/workerClient';
+import { DEFAULT_LOOK, type Look } from '../viewer/look';
 
 const OTHER_ATTRIBUTES = ['src', 'autoplay', 'camera-controls', 'controls', 'poster', 'loading', 'link'] as const;
 const CONTROLS = ['full', 'minimal', 'none'] as const;
@@ -125,6 +126,13 @@ export class MotionPlaygroundElement extends HTMLElement {
     if (name === 'loading') return void this.loadingMode(); // a bad value is reported; it counts when the element connects
     if (name === 'camera-controls' && this.app) this.app.viewer.controls.enabled = after !== null;
     if (!this.app || !this.api) return; // applied when it starts
+    if (name === 'look') {
+      // Removing the attribute goes back to the default look; a bad value fires `error` and changes nothing.
+      const r = after === null ? { value: DEFAULT_LOOK } : parseViewValue('look', after);
+      if ('error' in r) this.fire('error', { reason: `attribute ${r.error}` });
+      else this.showLook(r.value as Look);
+      return;
+    }
     if (name === 'src') {
       void this.loadSource();
       return;
@@ -287,8 +295,16 @@ export class MotionPlaygroundElement extends HTMLElement {
       if (mode === 'path' && view.seed !== undefined) app.pathMode.presetSeed(view.seed);
       if (mode === 'path' && view.path) app.pathMode.setPath(view.path);
     }
+    if (view.look !== undefined) this.showLook(view.look);
     if (view.mode !== undefined || initial) app.setMode(mode);
     if (!this.hasAttribute('autoplay') && mode === 'clip') app.viewer.pause();
+    this.linkSoon();
+  }
+
+  private showLook(look: Look): void {
+    if (!this.app) return;
+    this.app.viewer.setLook(look);
+    this.app.panel.syncLayers();
     this.linkSoon();
   }
 
@@ -311,6 +327,9 @@ export class MotionPlaygroundElement extends HTMLElement {
       view.model = app.controlModel.steerable;
     }
     if (!view.model) delete view.model; // no model chosen yet: the model list has not arrived (or listed none)
+    // The look only when it is not the default (links stay as they were), or when the attribute says it.
+    const look = app.viewer.currentLook;
+    if (look !== DEFAULT_LOOK || this.hasAttribute('look')) view.look = look;
     return view;
   }
 

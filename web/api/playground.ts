@@ -2,6 +2,7 @@
 // in step. Every method that takes user data checks it, and on bad input throws / rejects with an Error
 // whose message says what is wrong, shows the same message on the page, and leaves the scene as it was.
 
+import { LOOKS, type Look } from '../viewer/look';
 import { exportBVH as exportBVHText, type BVHExportOptions } from '../motion/bvh';
 import type { RestPose } from '../motion/restPose';
 import { exportGLB as exportGLBBytes, type GLBExportOptions } from '../motion/gltf';
@@ -37,6 +38,8 @@ export interface ViewOptions {
   trail?: boolean;
   footprints?: boolean;
   framing?: 'character' | 'all';
+  /** What is drawn: the stick figure ('skeleton'), the mannequin ('character', the default) or both. */
+  look?: Look;
 }
 
 /** Options of a request that can be cancelled (docs/api.md "Cancelling requests"). */
@@ -271,9 +274,13 @@ function checkExportOptions(options: unknown, withName: boolean): { restPose?: R
 /** Throws unless `options` are view options: layer switches true or false, framing "character" or "all". */
 function checkView(options: unknown): ViewOptions {
   if (typeof options !== 'object' || options === null) throw new TypeError(`options must be an object, got ${describeValue(options)}`);
-  const known = ['follow', 'trail', 'footprints', 'framing'];
+  const known = ['follow', 'trail', 'footprints', 'framing', 'look'];
   for (const [k, v] of Object.entries(options)) {
     if (!known.includes(k)) throw new TypeError(`unknown option ${describeValue(k)} (known: ${known.join(', ')})`);
+    if (k === 'look') {
+      if (!(LOOKS as readonly unknown[]).includes(v)) throw new TypeError(`look must be ${LOOKS.map((l) => `"${l}"`).join(', ')}, got ${describeValue(v)}`);
+      continue;
+    }
     if (k === 'framing' ? v !== 'character' && v !== 'all' : typeof v !== 'boolean') {
       throw new TypeError(`${k === 'framing' ? 'framing must be "character" or "all"' : `${k} must be true or false`}, got ${describeValue(v)}`);
     }
@@ -461,8 +468,13 @@ export function createPlayground(app: App): Playground {
     lastError: () => app.lastError,
     setView(options) {
       guarded('setView', () => {
-        const { framing, ...layers } = checkView(options);
+        const { framing, look, ...layers } = checkView(options);
         app.viewer.setLayers(layers);
+        if (look !== undefined) {
+          app.viewer.setLook(look);
+          app.panel.syncLayers();
+          app.panel.announceLook(); // links and the element's attributes follow
+        }
         if (framing === 'character') app.viewer.frameCharacter();
         if (framing === 'all') app.viewer.frameAll();
         app.panel.syncLayers();

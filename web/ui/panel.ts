@@ -1,6 +1,7 @@
 // The playback bar (play/pause, timeline, time, speed, layer toggles) and keyboard shortcuts.
 
 import type { Viewer, ViewerLayers } from '../viewer/viewer';
+import { LOOKS, type Look } from '../viewer/look';
 import type { PlaybackState } from '../viewer/playback';
 import { $, $all, currentScope, setSliderFill, type DomScope } from './dom';
 
@@ -13,6 +14,7 @@ export class Panel {
   private readonly speedOut = $('speed-out');
   private readonly fpsOut = $('fps-out');
   private readonly layerButtons = $all<HTMLButtonElement>('[data-layer]');
+  private readonly lookButtons = $all<HTMLButtonElement>('[data-look]');
   private readonly scope: DomScope = currentScope();
   private scrubbing = false;
   private wasPlaying = false;
@@ -46,6 +48,7 @@ export class Panel {
         this.syncLayers();
       });
     });
+    this.lookButtons.forEach((btn) => btn.addEventListener('click', () => this.setLook(btn.dataset.look as Look)));
     $('frame-all').addEventListener('click', () => {
       viewer.frameAll();
       this.syncLayers();
@@ -60,6 +63,21 @@ export class Panel {
     this.layerButtons.forEach((btn) => {
       btn.setAttribute('aria-pressed', String(l[btn.dataset.layer as keyof ViewerLayers]));
     });
+    const look = this.viewer.currentLook;
+    this.lookButtons.forEach((btn) => btn.setAttribute('aria-pressed', String(btn.dataset.look === look)));
+  }
+
+  /** Shows the look and tells the element (a `change` in its shadow root: links and attributes follow). */
+  private setLook(look: Look): void {
+    if (look === this.viewer.currentLook) return;
+    this.viewer.setLook(look);
+    this.syncLayers();
+    this.announceLook();
+  }
+
+  /** Tells the element that the look changed (a `change` in its shadow root: links and attributes follow). */
+  announceLook(): void {
+    this.lookButtons[0]?.dispatchEvent(new Event('change', { bubbles: true }));
   }
 
   private onKey(e: KeyboardEvent): void {
@@ -84,6 +102,10 @@ export class Panel {
         break;
       case 'End':
         v.seek(v.playback.frames - 1);
+        break;
+      case 'l':
+      case 'L':
+        this.setLook(LOOKS[(LOOKS.indexOf(v.currentLook) + 1) % LOOKS.length]);
         break;
       case 'f':
       case 'F':

@@ -6,6 +6,7 @@ import { checkPathPoints } from '../optimizer/path';
 import type { Capability } from '../runtime/descriptor';
 import type { Registry } from '../runtime/registry';
 import { errorMessage } from './dom';
+import { LOOKS, type Look } from '../viewer/look';
 
 export type Mode = 'clip' | 'walk' | 'dance' | 'path' | 'steer';
 export const MODES: readonly Mode[] = ['clip', 'walk', 'dance', 'path', 'steer'];
@@ -34,10 +35,12 @@ export interface ViewState {
   refine?: boolean;
   /** Ground points [x, z] in metres (Path mode). */
   path?: [number, number][];
+  /** What is drawn: the stick figure, the character (the default) or both. */
+  look?: Look;
 }
 
 /** The names, in the order links and snippets write them. */
-export const VIEW_KEYS = ['mode', 'model', 'style', 'seed', 'temperature', 'refine', 'path'] as const;
+export const VIEW_KEYS = ['mode', 'model', 'style', 'seed', 'temperature', 'refine', 'path', 'look'] as const;
 export type ViewKey = (typeof VIEW_KEYS)[number];
 
 /** The view a first visit opens on: something alive, not an empty clip view. */
@@ -71,6 +74,8 @@ export function parseViewValue(key: ViewKey, text: string): { value: ViewState[V
       if (text === '' || text === 'true') return { value: true };
       if (text === 'false') return { value: false };
       return refuse('must be true or false');
+    case 'look':
+      return (LOOKS as readonly string[]).includes(text) ? { value: text as Look } : refuse(`must be one of ${LOOKS.join(', ')}`);
     case 'path': {
       const pairs = text.split(/[;\s]+/).filter(Boolean).map((p) => p.split(',').map(Number));
       if (pairs.some((p) => p.length !== 2)) return refuse('must be x,z pairs separated by ";" (metres), e.g. 0,0;4,2;8,0');

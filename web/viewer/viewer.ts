@@ -6,6 +6,9 @@ import './palette'; // first: sets up colour handling
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import type { Motion } from '../motion/types';
 import { Figure } from './figure';
+import { CharacterDriver } from './character';
+import { DEFAULT_LOOK, type Look } from './look';
+import { COMPANION_MANNEQUIN_COLORS, restMannequin } from './mannequin';
 import { BACKGROUND, BlobShadow, Floor, FloorGlow, GroundMarks } from './ground';
 import { COMPANION_PALETTE } from './palette';
 import { Playback, type PlaybackState } from './playback';
@@ -29,6 +32,10 @@ export interface RenderStats {
   /** WebGL renderer string, e.g. "ANGLE (Google, Vulkan 1.3.0 (SwiftShader Device …))". */
   renderer: string;
   software: boolean;
+  /** The look chosen: the stick figure, the character, or both. */
+  look: Look;
+  /** Vertices of the character drawn now (0: none drawn, the look is 'skeleton' or the skeleton does not map to a humanoid). */
+  characterVertices: number;
 }
 
 /** How far (m) a companion figure is drawn beside the main one, towards the left of the screen. */
@@ -74,8 +81,18 @@ export class Viewer {
   private readonly glow = new FloorGlow();
   private readonly marks = new GroundMarks();
   private figure: Figure | null = null;
+  /** The shown motion as the mannequin; null when its skeleton does not map to the canonical one. */
+  private character: CharacterDriver | null = null;
+  private look: Look = DEFAULT_LOOK;
+  private readonly lights: CharacterLights;
+  /**
+   * The character is lit by the scene's lights and casts a shadow map on the ground (with a GPU); under software
+   * GL it is shaded by a baked studio matcap and has the blob shadow only, as the stick figure (every lit pixel
+   * and the shadow pass cost frames there).
+   */
+  private readonly lit: boolean;
   private motion: Motion | null = null;
-  private companion: { motion: Motion; figure: Figure; pose: Float32Array; dx: number; dz: number; labels: HTMLElement[] } | null = null;
+  private companion: { motion: Motion; figure: Figure; character: CharacterDriver | null; pose: Float32Array; dx: number; dz: number; labels: HTMLElement[] } | null = null;
   private readonly companionShadow = new BlobShadow();
   private pose = new Float32Array(0);
   private root = 0;
@@ -116,6 +133,7 @@ export class Viewer {
     this.gl = probed ??= probeGL();
     this.quality = chooseQuality(this.gl);
     const high = this.quality === 'high';
+    this.lit = high;
     this.basePixelRatio = high ? Math.min(window.devicePixelRatio || 1, 2) : 1;
     this.resolution = new DynamicResolution(0.5, 1, high ? 1 : 0.75, fixedResolution());
     this.canvas = document.createElement('canvas');
@@ -129,10 +147,12 @@ export class Viewer {
     this.canvas.classList.add('viewer-canvas');
     container.appendChild(this.canvas);
 
-    // No lights: the figure shades itself (figure.ts) and the ground layers are unlit.
+    // The stick figure shades itself (figure.ts) and the ground layers are unlit; the lights are the character's.
     // The floor glow is a large filled area: only worth its pixels with a GPU.
     if (high) this.scene.add(this.glow.mesh);
     this.scene.add(this.floor.group, this.marks.mesh, this.companionShadow.mesh);
+    this.lights = new CharacterLights(this.camera);
+    this.scene.add(this.lights.group);
 
     this.camera.position.set(3.2, 1.9, 4.6);
     this.controls = new OrbitControls(this.camera, this.canvas);
@@ -179,6 +199,8 @@ export class Viewer {
     this.contextState = 'live';
     renderer.setPixelRatio(this.basePixelRatio * this.resolution.scale);
     renderer.outputColorSpace = THREE.LinearSRGBColorSpace; // colours are used as given (see palette.ts)
+    renderer.shadowMap.enabled = this.lit; // the character's shadow on the ground (CharacterLights)
+    renderer.shadowMap.type = THREE.PCFSoftShadowMap;
     this.resize();
     // Compile the figure's shader while the page waits for its first motion (models loading), not in the
     // frame that first draws one: under software GL that compile costs tens of milliseconds.
@@ -271,6 +293,7 @@ export class Viewer {
     });
     for (const texture of textures) texture.dispose();
     this.figure = null;
+    this.character = null;
     this.scene.clear();
     if (this.webgl) {
       this.webgl.dispose();
@@ -289,8 +312,12 @@ export class Viewer {
     if (this.figure || this.contextState !== 'live') return;
     const standIn = new Figure({ fps: 30, frames: 1, joints: ['Hips', 'Head'], parents: [-1, 0], positions: new Float32Array([0, 1, 0, 0, 1.5, 0]) });
     this.scene.add(standIn.mesh);
+    // The character's program too (a lit, skinned, shadowed material: the slowest to compile).
+    const mannequin = restMannequin({ lit: this.lit });
+    this.scene.add(mannequin.mesh);
     this.renderer.compile(this.scene, this.camera);
     standIn.mesh.visible = false;
+    mannequin.mesh.visible = false;
   }
 
   /** Starts or stops the frame loop (an element taken off the page draws nothing and costs nothing). */
@@ -317,12 +344,12 @@ export class Viewer {
     const J = motion.joints.length;
     this.setCompanion(null);
     const figure = new Figure(motion);
-    if (this.figure) {
-      this.scene.remove(this.figure.mesh);
-      this.figure.dispose();
-    }
+    this.removeFigures();
     this.figure = figure;
     this.scene.add(figure.mesh);
+    this.character = CharacterDriver.for(motion, { lit: this.lit });
+    if (this.character) this.scene.add(this.character.mannequin.mesh);
+    this.showLook();
     this.motion = motion;
     this.pose = new Float32Array(J * 3);
     this.root = Math.max(0, motion.parents.indexOf(-1));
@@ -364,6 +391,12 @@ export class Viewer {
     }
     const time = this.playback.time - dropped / this.playback.fps;
     this.motion = motion;
+    if (this.character && !this.character.setMotion(motion)) {
+      this.scene.remove(this.character.mannequin.mesh);
+      this.character.dispose();
+      this.character = null;
+      this.showLook();
+    }
     this.marks.build(motion, contacts, this.root);
     this.playback.frames = motion.frames;
     this.playback.fps = motion.fps;
@@ -382,6 +415,10 @@ export class Viewer {
       if (this.companion) {
         this.scene.remove(this.companion.figure.mesh);
         this.companion.figure.dispose();
+        if (this.companion.character) {
+          this.scene.remove(this.companion.character.mannequin.mesh);
+          this.companion.character.dispose();
+        }
         this.companion.labels.forEach((l) => l.remove());
         this.companion = null;
         this.companionShadow.mesh.visible = false;
@@ -396,6 +433,8 @@ export class Viewer {
     if (!this.companion) {
       const figure = new Figure(companion.motion, COMPANION_PALETTE);
       this.scene.add(figure.mesh);
+      const character = CharacterDriver.for(companion.motion, { colors: COMPANION_MANNEQUIN_COLORS, lit: this.lit });
+      if (character) this.scene.add(character.mannequin.mesh);
       // Offset towards the screen's left: minus the camera's horizontal right vector (−dz, dx of the view direction).
       const vx = this.controls.target.x - this.camera.position.x, vz = this.controls.target.z - this.camera.position.z;
       const l = Math.hypot(vx, vz) || 1;
@@ -405,27 +444,32 @@ export class Viewer {
         this.container.appendChild(el);
         return el;
       });
-      this.companion = { motion: companion.motion, figure, pose: new Float32Array(m.joints.length * 3), dx: (vz / l) * COMPANION_OFFSET, dz: (-vx / l) * COMPANION_OFFSET, labels };
+      this.companion = { motion: companion.motion, figure, character, pose: new Float32Array(m.joints.length * 3), dx: (vz / l) * COMPANION_OFFSET, dz: (-vx / l) * COMPANION_OFFSET, labels };
       this.companionShadow.mesh.visible = true;
       this.companion.labels[0].textContent = companion.labels.main;
       this.companion.labels[1].textContent = companion.labels.companion;
+      this.showLook();
       this.applyPose();
       this.frameCharacter(); // both in view, a little further back
       return;
     }
     this.companion.motion = companion.motion;
+    const c = this.companion;
+    if (c.character && !c.character.setMotion(companion.motion)) {
+      this.scene.remove(c.character.mannequin.mesh);
+      c.character.dispose();
+      c.character = null;
+      this.showLook();
+    }
     this.applyPose();
   }
 
   /** Removes the motion: an empty stage. */
   clear(): void {
     this.setCompanion(null);
-    if (this.figure) {
-      this.scene.remove(this.figure.mesh);
-      this.figure.dispose();
-    }
-    this.figure = null;
+    this.removeFigures();
     this.motion = null;
+    this.showLook();
     this.live = false;
     this.playback.hold = false;
     this.playback.reset(0, 30);
@@ -463,7 +507,48 @@ export class Viewer {
       quality: this.quality,
       renderer: this.gl.renderer,
       software: this.gl.software,
+      look: this.look,
+      characterVertices: this.character && this.look !== 'skeleton' ? this.character.mannequin.vertexCount : 0,
     };
+  }
+
+  /** The look chosen (what is drawn for a motion whose skeleton maps to a humanoid; others always get the stick figure). */
+  get currentLook(): Look {
+    return this.look;
+  }
+
+  /** Draws the stick figure, the character, or both (the character see-through, the skeleton inside it). */
+  setLook(look: Look): void {
+    this.look = look;
+    this.showLook();
+  }
+
+  /** The figures' visibility for the look: the stick figure wherever there is no character. */
+  private showLook(): void {
+    const pairs: Array<[Figure | null, CharacterDriver | null]> = [[this.figure, this.character]];
+    if (this.companion) pairs.push([this.companion.figure, this.companion.character]);
+    for (const [figure, character] of pairs) {
+      if (figure) figure.mesh.visible = this.look !== 'character' || !character;
+      if (character) {
+        character.mannequin.mesh.visible = this.look !== 'skeleton';
+        character.mannequin.setSeeThrough(this.look === 'both');
+      }
+    }
+    this.lights.setShadows(this.lit && this.look !== 'skeleton' && this.character !== null);
+    this.dirty = true;
+  }
+
+  private removeFigures(): void {
+    if (this.figure) {
+      this.scene.remove(this.figure.mesh);
+      this.figure.dispose();
+    }
+    if (this.character) {
+      this.scene.remove(this.character.mannequin.mesh);
+      this.character.dispose();
+    }
+    this.figure = null;
+    this.character = null;
   }
 
   layers(): ViewerLayers {
@@ -680,6 +765,7 @@ export class Viewer {
     const P = m.positions, o0 = i0 * n, o1 = i1 * n;
     for (let k = 0; k < n; k++) this.pose[k] = P[o0 + k] + (P[o1 + k] - P[o0 + k]) * a;
     this.figure.update(this.pose);
+    this.character?.update(i0, i1, a);
     const c = this.companion;
     if (c && c.motion.frames === m.frames) {
       // (a live window replaced by setLive has its companion window replaced right after)
@@ -690,10 +776,12 @@ export class Viewer {
         c.pose[k + 2] = C[o0 + k + 2] + (C[o1 + k + 2] - C[o0 + k + 2]) * a + c.dz;
       }
       c.figure.update(c.pose);
+      c.character?.update(i0, i1, a, c.dx, c.dz);
       const r = this.root * 3;
       this.companionShadow.set(c.pose[r], c.pose[r + 2], this.figureHeight * 0.55);
     }
     const root = this.rootNow();
+    this.lights.follow(root.x, root.z, this.figureHeight);
     this.marks.setShadow(root.x, root.z, this.figureHeight * 0.55);
     this.glow.setCenter(root.x, root.z);
     this.marks.setProgress(ff, this.playback.frame);
@@ -750,5 +838,53 @@ export class Viewer {
     this.camera.aspect = w / h;
     this.camera.updateProjectionMatrix();
     this.dirty = true;
+  }
+}
+
+/**
+ * The character's lights: a sky/ground fill, a key light high in front that casts the character's shadow on the
+ * ground (a shadow-only plane under it, so the unlit ground layers stay as they are), and a soft light from the
+ * camera so the side in view is never dark. They follow the shown root.
+ */
+class CharacterLights {
+  readonly group = new THREE.Group();
+  private readonly key: THREE.DirectionalLight;
+  private readonly catcher: THREE.Mesh;
+
+  constructor(camera: THREE.Camera) {
+    const sky = new THREE.HemisphereLight(0xdfe6ff, 0x3a3f52, 1.15);
+    this.key = new THREE.DirectionalLight(0xfff3e6, 1.5);
+    this.key.position.set(1.6, 5, 2.4);
+    this.key.castShadow = true;
+    this.key.shadow.mapSize.set(1024, 1024);
+    const cam = this.key.shadow.camera;
+    cam.left = -2.2; cam.right = 2.2; cam.top = 2.2; cam.bottom = -2.2; cam.near = 0.5; cam.far = 12;
+    this.key.shadow.bias = -0.0005;
+    this.key.shadow.normalBias = 0.02;
+    this.key.shadow.radius = 3;
+    // The camera's light: added to the camera, which is put in the group so that its children are drawn.
+    const fill = new THREE.DirectionalLight(0xcfd8ff, 0.55);
+    fill.position.set(0, 0, 1);
+    fill.target.position.set(0, 0, 0);
+    camera.add(fill, fill.target);
+    this.catcher = new THREE.Mesh(new THREE.PlaneGeometry(4.4, 4.4).rotateX(-Math.PI / 2), new THREE.ShadowMaterial({ color: 0x000000, opacity: 0.32, depthWrite: false }));
+    this.catcher.position.y = 0.002; // just above the floor and its marks
+    this.catcher.receiveShadow = true;
+    this.catcher.renderOrder = 1;
+    this.group.add(sky, this.key, this.key.target, this.catcher, camera);
+  }
+
+  /** Puts the key light and the shadow catcher over ground point (x, z), sized for a figure `height` tall. */
+  follow(x: number, z: number, height: number): void {
+    const s = Math.max(height / 1.7, 0.3);
+    this.key.position.set(x + 1.6 * s, 5 * s, z + 2.4 * s);
+    this.key.target.position.set(x, 0, z);
+    this.key.shadow.camera.far = 12 * s;
+    this.catcher.position.set(x, 0.002, z);
+  }
+
+  setShadows(on: boolean): void {
+    this.key.castShadow = on;
+    this.catcher.visible = on;
   }
 }
