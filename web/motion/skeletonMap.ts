@@ -211,6 +211,10 @@ export function fromCanonical(
   const out = new Float32Array(motion.positions.length);
   const inv = 1 / mapping.scale;
   const hips = 0;
+  // The joint at the canonical hips, when it is not the root (a Biped's pelvis, Bandai's Hips under a floor root,
+  // iClone's CC_Base_Hip): it is placed at the cleaned hips itself, not carried on its parent (its offset from a
+  // root that stays at the origin changes every frame: it has position channels of its own).
+  const hipsJoint = motion.parents[mapping.source[hips]] >= 0 ? mapping.source[hips] : -1;
   const p = motion.positions;
   const lengths = medianBoneLengths(motion, jitter);
   // A bone that is not a whole canonical segment rides rigidly on its owner: its offset in the owner's frame is the
@@ -220,7 +224,7 @@ export function fromCanonical(
     const values = [new Float64Array(motion.frames), new Float64Array(motion.frames), new Float64Array(motion.frames)];
     for (let j = 0; j < J; j++) {
       const parent = motion.parents[j];
-      if (parent < 0 || whole[j]) continue;
+      if (parent < 0 || whole[j] || j === hipsJoint) continue;
       for (let f = 0; f < motion.frames; f++) {
         const o = (f * J + j) * 3, q = (f * J + parent) * 3, r = (f * K + owner[j]) * 4;
         const g = before.rotations;
@@ -254,7 +258,7 @@ export function fromCanonical(
       if (parent < 0) {
         // The root moves with the canonical hips (it is the hips in every scheme but a Biped's root node).
         for (let a = 0; a < 3; a++) target[a + j * 3] = p[(f * J + j) * 3 + a] + (pt(after.points, hips, a) - pt(before.points, hips, a)) * inv;
-      } else if (whole[j]) {
+      } else if (whole[j] || j === hipsJoint) {
         for (let a = 0; a < 3; a++) target[j * 3 + a] = pt(after.points, owner[j], a) * inv;
       } else {
         attach(j, target, target);
@@ -268,7 +272,7 @@ export function fromCanonical(
         const n = Math.hypot(d[0], d[1], d[2]);
         if (n < 1e-9) continue;
         const c = (n - lengths[j]) / n;
-        const parentMoves = motion.parents[parent] >= 0 ? 0.5 : 0; // the root stays where the hips put it
+        const parentMoves = motion.parents[parent] >= 0 && parent !== hipsJoint ? 0.5 : 0; // the root and hips stay where the hips put them
         for (let a = 0; a < 3; a++) {
           target[j * 3 + a] -= (1 - parentMoves) * c * d[a];
           target[parent * 3 + a] += parentMoves * c * d[a];
@@ -277,7 +281,7 @@ export function fromCanonical(
     }
     for (let j = 0; j < J; j++) {
       const parent = motion.parents[j];
-      if (parent < 0) {
+      if (parent < 0 || j === hipsJoint) {
         for (let a = 0; a < 3; a++) placed[j * 3 + a] = target[j * 3 + a];
       } else if (whole[j]) {
         const d = [0, 1, 2].map((a) => target[j * 3 + a] - placed[parent * 3 + a]);
