@@ -108,8 +108,8 @@ export async function modelBenchmark(ctx, { client, threads, batch, steps, gener
  * Display frame rate while a live mode streams (default threads), plus how far its stream got per second.
  * `model`: Steer mode's model choice (#steer-model) to set first.
  */
-export async function liveModeBenchmark(ctx, button, statusId, model) {
-  const { context, page, problems } = await openPlayground(ctx.browser, ctx.url, VIEWPORT);
+export async function liveModeBenchmark(ctx, button, statusId, model, query = '') {
+  const { context, page, problems } = await openPlayground(ctx.browser, ctx.url + query, VIEWPORT);
   const streamFrame = () => page.evaluate((id) => Number($ui(id).dataset.frame), statusId);
   try {
     await page.click(button);
@@ -130,6 +130,8 @@ export async function liveModeBenchmark(ctx, button, statusId, model) {
       target_fps: 60,
       stream_frames_per_s: +((f1 - f0) / SECONDS).toFixed(1),
       target_stream_frames_per_s: modelFps, // the stream keeps up with real time
+      look: stats.look,
+      character_vertices: stats.characterVertices,
       ...displayFields(stats, problems),
     };
   } finally {

@@ -33,6 +33,15 @@ const AIM: number[] = CANONICAL_JOINTS.map((_, k) => {
   return child;
 });
 
+/** Per side (left, right): the leg's hip, knee, ankle and the arm's shoulder, elbow, wrist. */
+const LEGS = [[J.LeftUpLeg, J.LeftLeg, J.LeftFoot], [J.RightUpLeg, J.RightLeg, J.RightFoot]] as const;
+const ARMS = [[J.LeftArm, J.LeftForeArm, J.LeftHand], [J.RightArm, J.RightForeArm, J.RightHand]] as const;
+/** Per side, the bones turned with the leg's side vector, then those turned with the arm's. */
+const LEG_BONES = [[J.LeftUpLeg, J.LeftLeg, J.LeftFoot, J.LeftToeBase], [J.RightUpLeg, J.RightLeg, J.RightFoot, J.RightToeBase]] as const;
+const ARM_BONES = [[J.LeftArm, J.LeftForeArm, J.LeftHand], [J.RightArm, J.RightForeArm, J.RightHand]] as const;
+/** The tips: no body part of their own. */
+const TIPS = [J.LeftToeBase_end, J.RightToeBase_end, J.Head_end, J.LeftHand_end, J.RightHand_end] as const;
+
 /** Canonical leg length (hip → knee → ankle) of training/mocap/canonical_skeleton.json; the shape's sizes are for it. */
 const CANONICAL_LEG = 0.829;
 
@@ -112,9 +121,9 @@ export class BoneSolver {
     const chest = J.Spine1 * 16;
     const M = this.matrices;
     for (let s = 0; s < 2; s++) {
-      const [hip, knee, ankle] = s === 0 ? [J.LeftUpLeg, J.LeftLeg, J.LeftFoot] : [J.RightUpLeg, J.RightLeg, J.RightFoot];
-      this.limbSide(P, hip, knee, ankle, hipsSide, this.legSide[s], 0.1, 0.3);
-      const [shoulder, elbow, wrist] = s === 0 ? [J.LeftArm, J.LeftForeArm, J.LeftHand] : [J.RightArm, J.RightForeArm, J.RightHand];
+      const leg = LEGS[s], arm = ARMS[s];
+      this.limbSide(P, leg[0], leg[1], leg[2], hipsSide, this.legSide[s], 0.1, 0.3);
+      const shoulder = arm[0], elbow = arm[1], wrist = arm[2];
       // Arms' fallback: upper arm × (chest front + a little chest up), the elbow's axis when it bends forward.
       const { a, armFallback: c } = this;
       diff(P, elbow, shoulder, a); normalise(a);
@@ -124,14 +133,12 @@ export class BoneSolver {
       this.limbSide(P, shoulder, elbow, wrist, c, this.armSide[s], 0.12, 0.35);
     }
     for (let s = 0; s < 2; s++) {
-      const leg = this.legSide[s], arm = this.armSide[s];
-      const chain = s === 0
-        ? [[J.LeftUpLeg, leg], [J.LeftLeg, leg], [J.LeftFoot, leg], [J.LeftToeBase, leg], [J.LeftArm, arm], [J.LeftForeArm, arm], [J.LeftHand, arm]] as const
-        : [[J.RightUpLeg, leg], [J.RightLeg, leg], [J.RightFoot, leg], [J.RightToeBase, leg], [J.RightArm, arm], [J.RightForeArm, arm], [J.RightHand, arm]] as const;
-      for (const [k, side] of chain) this.frame(P, k, side);
+      for (let i = 0; i < LEG_BONES[s].length; i++) this.frame(P, LEG_BONES[s][i], this.legSide[s]);
+      for (let i = 0; i < ARM_BONES[s].length; i++) this.frame(P, ARM_BONES[s][i], this.armSide[s]);
     }
     // Tips: the parent's rotation, on their own point.
-    for (const k of [J.LeftToeBase_end, J.RightToeBase_end, J.Head_end, J.LeftHand_end, J.RightHand_end]) {
+    for (let t = 0; t < TIPS.length; t++) {
+      const k = TIPS[t];
       const p = CANONICAL_PARENTS[k];
       for (let i = 0; i < 12; i++) M[k * 16 + i] = M[p * 16 + i];
       M[k * 16 + 12] = P[k * 3]; M[k * 16 + 13] = P[k * 3 + 1]; M[k * 16 + 14] = P[k * 3 + 2]; M[k * 16 + 15] = 1;

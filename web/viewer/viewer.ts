@@ -7,6 +7,7 @@ import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 import type { Motion } from '../motion/types';
 import { Figure } from './figure';
 import { CharacterDriver } from './character';
+import type { CharacterView } from './userCharacter';
 import { DEFAULT_LOOK, type Look } from './look';
 import { COMPANION_MANNEQUIN_COLORS, restMannequin } from './mannequin';
 import { BACKGROUND, BlobShadow, Floor, FloorGlow, GroundMarks } from './ground';
@@ -82,7 +83,9 @@ export class Viewer {
   private readonly marks = new GroundMarks();
   private figure: Figure | null = null;
   /** The shown motion as the mannequin; null when its skeleton does not map to the canonical one. */
-  private character: CharacterDriver | null = null;
+  private character: CharacterView | null = null;
+  /** A user's own character (userCharacter.ts) drawn instead of the mannequin: set by setCharacterSource. */
+  private characterSource: ((motion: Motion, companion: boolean) => CharacterView | null) | null = null;
   private look: Look = DEFAULT_LOOK;
   private readonly lights: CharacterLights;
   /**
@@ -92,7 +95,7 @@ export class Viewer {
    */
   private readonly lit: boolean;
   private motion: Motion | null = null;
-  private companion: { motion: Motion; figure: Figure; character: CharacterDriver | null; pose: Float32Array; dx: number; dz: number; labels: HTMLElement[] } | null = null;
+  private companion: { motion: Motion; figure: Figure; character: CharacterView | null; pose: Float32Array; dx: number; dz: number; labels: HTMLElement[] } | null = null;
   private readonly companionShadow = new BlobShadow();
   private pose = new Float32Array(0);
   private root = 0;
@@ -281,6 +284,7 @@ export class Viewer {
     this.visibility?.disconnect();
     this.controls.dispose();
     this.setCompanion(null);
+    this.removeFigures(); // (the character's skeleton holds a bone texture that the traversal below would not find)
     const textures = new Set<THREE.Texture>();
     this.scene.traverse((object) => {
       const mesh = object as THREE.Mesh;
@@ -347,7 +351,7 @@ export class Viewer {
     this.removeFigures();
     this.figure = figure;
     this.scene.add(figure.mesh);
-    this.character = CharacterDriver.for(motion, { lit: this.lit });
+    this.character = this.characterFor(motion, false);
     if (this.character) this.scene.add(this.character.mannequin.mesh);
     this.showLook();
     this.motion = motion;
@@ -433,7 +437,7 @@ export class Viewer {
     if (!this.companion) {
       const figure = new Figure(companion.motion, COMPANION_PALETTE);
       this.scene.add(figure.mesh);
-      const character = CharacterDriver.for(companion.motion, { colors: COMPANION_MANNEQUIN_COLORS, lit: this.lit });
+      const character = this.characterFor(companion.motion, true);
       if (character) this.scene.add(character.mannequin.mesh);
       // Offset towards the screen's left: minus the camera's horizontal right vector (−dz, dx of the view direction).
       const vx = this.controls.target.x - this.camera.position.x, vz = this.controls.target.z - this.camera.position.z;
@@ -523,9 +527,42 @@ export class Viewer {
     this.showLook();
   }
 
+  /** The character drawn for a motion: the user's own when one is set (and it retargets), else the mannequin. */
+  private characterFor(motion: Motion, companion: boolean): CharacterView | null {
+    const own = this.characterSource?.(motion, companion) ?? null;
+    if (own) return own;
+    return companion ? CharacterDriver.for(motion, { colors: COMPANION_MANNEQUIN_COLORS, lit: this.lit }) : CharacterDriver.for(motion, { lit: this.lit });
+  }
+
+  /**
+   * Draws a user's own character instead of the mannequin (null: the mannequin again): `source` makes one for a
+   * motion (the companion's when `companion`), or returns null to leave the mannequin. The shown figures are rebuilt.
+   */
+  setCharacterSource(source: ((motion: Motion, companion: boolean) => CharacterView | null) | null): void {
+    this.characterSource = source;
+    const swap = (old: CharacterView | null, motion: Motion | null, companion: boolean): CharacterView | null => {
+      if (old) {
+        this.scene.remove(old.mannequin.mesh);
+        old.dispose();
+      }
+      const made = motion && motion.frames > 0 ? this.characterFor(motion, companion) : null;
+      if (made) this.scene.add(made.mannequin.mesh);
+      return made;
+    };
+    this.character = swap(this.character, this.motion, false);
+    if (this.companion) this.companion.character = swap(this.companion.character, this.companion.motion, true);
+    this.showLook();
+    this.applyPose();
+  }
+
+  /** The character drawn for the shown motion and for the companion (null: none, or the look hides it). */
+  get characters(): { main: CharacterView | null; companion: CharacterView | null } {
+    return { main: this.character, companion: this.companion?.character ?? null };
+  }
+
   /** The figures' visibility for the look: the stick figure wherever there is no character. */
   private showLook(): void {
-    const pairs: Array<[Figure | null, CharacterDriver | null]> = [[this.figure, this.character]];
+    const pairs: Array<[Figure | null, CharacterView | null]> = [[this.figure, this.character]];
     if (this.companion) pairs.push([this.companion.figure, this.companion.character]);
     for (const [figure, character] of pairs) {
       if (figure) figure.mesh.visible = this.look !== 'character' || !character;
