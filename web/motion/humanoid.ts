@@ -10,8 +10,9 @@
 //   3. the hips: the common ancestor of the legs and the chest; the head: where the upper body's remaining leaves meet;
 //   4. along each limb, from its ancestor to its farthest leaf (the toe or finger tip, not a heel or a twist bone), the
 //      joints whose bone lengths fit human proportions best: thigh ≈ shin, upper arm ≈ 1.25 × forearm, the foot or
-//      hand beyond (Winter's segment table), with a joint named as a naming scheme names that point preferred and a
-//      helper joint (twist, roll, share bones) avoided. Joints of (almost) no length count as one point;
+//      hand beyond (Winter's segment table), with a joint named as a naming scheme names that point preferred (taken
+//      outright for the toe base and hand end) and a helper joint (twist, roll, share bones) avoided. Joints of
+//      (almost) no length count as one point;
 //   5. the neck base: the joint from the chest up that lies nearest the shoulders; the spine points between;
 //   6. left and right: from names that differ only by a side word (Left/Right, L/R, _l/_r, lThigh/rThigh …), else
 //      from the pose: the toes point forward and the left side is at up × forward.
@@ -337,6 +338,7 @@ function limbPoints(t: Tree, top: number, tip: number, names: readonly string[])
 }
 
 type Hint = (j: number, point: CanonicalJoint) => number;
+type Hints = { hint: Hint; named: (j: number, point: CanonicalJoint) => boolean };
 
 /**
  * The naming scheme that places the most points (when it places at least 6), whether it names joint j as a point,
@@ -358,7 +360,7 @@ const sq = (x: number) => x * x;
 const slack = (x: number) => sq(Math.max(0, x - EXTREMITY_SLACK));
 
 /** A leg's points (socket, knee, ankle, toe base?, toe end?) below `pelvis` down to its farthest leaf. */
-function fitLeg(t: Tree, pelvis: number, legRoot: number, hint: Hint, side: 'Left' | 'Right', names: readonly string[]) {
+function fitLeg(t: Tree, pelvis: number, legRoot: number, { hint, named }: Hints, side: 'Left' | 'Right', names: readonly string[]) {
   const tip = farthestLeaf(t, legRoot, pelvis);
   const pts = limbPoints(t, pelvis, tip, names);
   if (pts.length < 3) return undefined;
@@ -382,13 +384,14 @@ function fitLeg(t: Tree, pelvis: number, legRoot: number, hint: Hint, side: 'Lef
   else if (toes.length > 1) {
     toeEnd = toes[toes.length - 1];
     const want = (2 / 3) * arc(ankle, toeEnd);
-    toeBase = nearest(toes.slice(0, -1), (j) => Math.abs(arc(ankle, j) - want) + hint(j, `${side}ToeBase`) * arc(ankle, toeEnd));
+    const candidates = toes.slice(0, -1);
+    toeBase = candidates.find((j) => named(j, `${side}ToeBase`)) ?? nearest(candidates, (j) => Math.abs(arc(ankle, j) - want));
   }
   return { UpLeg: socket, Leg: pts[best.knee], Foot: ankle, ToeBase: toeBase, ToeBase_end: toeEnd };
 }
 
 /** An arm's points (shoulder, elbow, wrist, hand end?) below `chest` down to its farthest leaf. */
-function fitArm(t: Tree, chest: number, armRoot: number, hint: Hint, side: 'Left' | 'Right', names: readonly string[]) {
+function fitArm(t: Tree, chest: number, armRoot: number, { hint, named }: Hints, side: 'Left' | 'Right', names: readonly string[]) {
   const tip = farthestLeaf(t, armRoot, chest);
   const pts = limbPoints(t, chest, tip, names);
   if (pts.length < 3) return undefined;
@@ -411,7 +414,7 @@ function fitArm(t: Tree, chest: number, armRoot: number, hint: Hint, side: 'Left
   const wrist = pts[best.w];
   const fore = arc(pts[best.e], wrist);
   const beyond = pts.slice(best.w + 1);
-  const handEnd = beyond.length ? nearest(beyond, (j) => Math.abs(arc(wrist, j) - HAND_TO_FOREARM * fore) + hint(j, `${side}Hand_end`) * fore) : -1;
+  const handEnd = beyond.length ? (beyond.find((j) => named(j, `${side}Hand_end`)) ?? nearest(beyond, (j) => Math.abs(arc(wrist, j) - HAND_TO_FOREARM * fore))) : -1;
   return { Arm: pts[best.s], ForeArm: pts[best.e], Hand: wrist, Hand_end: handEnd };
 }
 
@@ -503,7 +506,8 @@ export function mapHumanoid(sk: PosedSkeleton): HumanoidMap {
   const t = treeOf(sk);
   if (!(t.height > 0)) refuse('its joints all lie at one height, so no legs can be told');
   const names = sk.joints;
-  const { hint, named, scheme } = hintsFor(names);
+  const hints = hintsFor(names);
+  const { hint, named, scheme } = hints;
   const leaves = t.children.flatMap((c, j) => (c.length === 0 ? [j] : []));
   const lowest = (set: number[]) => set.reduce((a, b) => (t.lift[b] < t.lift[a] - 1e-12 ? b : a));
 
@@ -549,11 +553,11 @@ export function mapHumanoid(sk: PosedSkeleton): HumanoidMap {
   })();
 
   // 4. Limbs, sides still unknown (A, B).
-  const legs = legRoots.map((r) => fitLeg(t, pelvis, r, hint, 'Left', names));
-  const legsOther = legRoots.map((r) => fitLeg(t, pelvis, r, hint, 'Right', names));
+  const legs = legRoots.map((r) => fitLeg(t, pelvis, r, hints, 'Left', names));
+  const legsOther = legRoots.map((r) => fitLeg(t, pelvis, r, hints, 'Right', names));
   if (!legs[0] || !legs[1]) refuse(`no ${!legs[0] && !legs[1] ? 'knees or ankles' : 'knee or ankle on one leg'} (a leg needs a hip, knee and ankle joint)`);
-  const arms = armRoots.map((r) => fitArm(t, chest, r, hint, 'Left', names));
-  const armsOther = armRoots.map((r) => fitArm(t, chest, r, hint, 'Right', names));
+  const arms = armRoots.map((r) => fitArm(t, chest, r, hints, 'Left', names));
+  const armsOther = armRoots.map((r) => fitArm(t, chest, r, hints, 'Right', names));
   if (!arms[0] || !arms[1]) refuse('no elbow or wrist on an arm (an arm needs a shoulder, elbow and wrist joint)');
 
   // 6. Sides: names first, else the pose. Each limb is fitted again with the other side's hints when it is the right.
