@@ -13,7 +13,8 @@
 //      hand beyond (Winter's segment table), with a joint named as a naming scheme names that point preferred (taken
 //      outright for the toe base and hand end) and a helper joint (twist, roll, share bones) avoided. Joints of
 //      (almost) no length count as one point;
-//   5. the neck base: the joint from the chest up that lies nearest the shoulders; the spine points between;
+//   5. the neck base: the joint from the chest up that the naming scheme names so, else the one nearest the
+//      shoulders; the spine points between;
 //   6. left and right: from names that differ only by a side word (Left/Right, L/R, _l/_r, lThigh/rThigh …), else
 //      from the pose: the toes point forward and the left side is at up × forward.
 // Points a skeleton lacks but that lie between or beyond points it has (extra spine and neck points, toe and hand
@@ -577,7 +578,7 @@ export function mapHumanoid(sk: PosedSkeleton): HumanoidMap {
   const neckPath = [chest, ...pathDown(t, chest, skull).filter((j) => j !== skull)];
   const nearShoulders = (j: number) =>
     median(t.frames.map((f) => (dist(t.at(f, j), t.at(f, shoulders[0])) + dist(t.at(f, j), t.at(f, shoulders[1]))) / 2));
-  const neck = nearest(neckPath, (j) => nearShoulders(j) * (1 + hint(j, 'Neck') / 2) + 0.1 * (t.arc[j] - t.arc[chest]));
+  const neck = neckPath.find((j) => named(j, 'Neck')) ?? nearest(neckPath, (j) => nearShoulders(j) * (1 + hint(j, 'Neck') / 2) + 0.1 * (t.arc[j] - t.arc[chest]));
 
   const source = CANONICAL_JOINTS.map(() => -1);
   const put = (point: CanonicalJoint, j: number) => (source[CANONICAL_JOINTS.indexOf(point)] = j);
