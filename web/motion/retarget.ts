@@ -1,0 +1,520 @@
+// Retargeting a humanoid motion onto a character's own skeleton (issue 40, "Bring your own character"), by rotations.
+//
+//   1. The source (any humanoid Motion: a model's canonical output or an import) becomes the canonical points in
+//      metres (humanoid.ts maps it, skeletonMap.toCanonical places the points it lacks).
+//   2. The rig's rest pose is mapped the same way (mapRig): its rest canonical points and each bone's rest world
+//      rotation.
+//   3. Per frame, each mapped bone's world rotation = R × its rest world rotation, where R takes the bone's rest
+//      segment (its canonical point to the next one along the chain) and a twist reference to the source's current
+//      ones: the hip line for the hips, the shoulder line for the chest and neck, the limb's bend for thighs, shins,
+//      upper arms and forearms (the knee's or elbow's offset from the line through the limb's ends, with the feet's
+//      or the torso's forward where the limb is straight), the shin for the foot. Hands, toes and the head turn with
+//      their parent plus the least swing. Rest-pose differences (T or A pose, a rig facing −z, bone axes that do
+//      not follow the bones) cancel: R is measured from the rig's own rest directions.
+//      Unmapped bones (fingers, twist bones, clavicles, a root at the floor) keep their rest rotation relative to
+//      their parent. Local rotation = inverse(parent world) × world.
+//   4. The hips go where the source's hips go, scaled by leg length (character leg / source leg), with the height
+//      shifted by the difference in ankle heights so that planted feet land on the floor.
+//   5. Where the source's feet are planted (its contacts, else labelled from height and speed, contactLabels.ts),
+//      the character's foot is held still on the floor: its lowest point (relative to where the point stands in the
+//      rest pose, so a mesh sole stands on the floor) is pinned horizontally where it was when the contact began and
+//      put at floor height; thigh and shin turn by two-bone IK (footLock.ts) to reach, the foot keeps its world
+//      rotation. The correction is blended in and out over RELEASE_SECONDS.
+import { labelContacts } from './contactLabels';
+import { twoBoneIK, smoothstep } from './footLock';
+import { CANONICAL_JOINTS, mapHumanoid, SkeletonMapError, type CanonicalJoint, type HumanoidMap } from './humanoid';
+import { cross, length, normalize, quatConjugate, quatIdentity, quatMultiply, quatNormalize, quatRotate, rotationFromTwoVectors, sub, swingRotation, type Quat, type Vec3 } from './math';
+import { mapSkeleton, toCanonical } from './skeletonMap';
+import type { Motion } from './types';
+
+/** A character's skeleton as the file gives it: bones in parent-before-child order. Units: the file's (any). */
+export interface CharacterRig {
+  bones: string[];
+  parents: number[];
+  /** Rest (bind) pose: each bone's local rotation (x, y, z, w) and translation relative to its parent; the root's
+   *  relative to the scene (the armature's own transform folded in). */
+  restRotations: Quat[];
+  restTranslations: Vec3[];
+  /** Optional: a humanoid map given by the file itself (VRM), canonical point -> bone index; else found by mapHumanoid. */
+  humanoid?: HumanoidMap;
+}
+
+export interface RetargetOptions {
+  /** keep planted feet planted with two-bone IK on the character's legs (default true) */
+  footIK?: boolean;
+}
+
+export interface RetargetResult {
+  /** The motion on the character's skeleton: its bone names and parents, world positions per frame (metres). */
+  motion: Motion;
+  /** frames × bones × 4: each bone's LOCAL rotation per frame (x, y, z, w), to drive a THREE.SkinnedMesh's bones. */
+  rotations: Float32Array;
+  /** frames × 3: the root bone's local translation per frame (in the rig's units). */
+  rootTranslations: Float32Array;
+  /** The rig's humanoid map used (canonical point -> bone), and what canonical points the rig lacks (derived). */
+  mapping: HumanoidMap;
+  /** Character leg length / source leg length: how proportions were scaled. */
+  scale: number;
+  /** Units of the rig per metre (e.g. 100 for a centimetre rig, 1 for metres), as detected from its height. */
+  unitsPerMetre: number;
+  /** Added: the rig's rest pose as canonical points (25 × 3, metres, CANONICAL_JOINTS order; derived points placed). */
+  restCanonical: Float32Array;
+  /** Added: the source's foot contacts used for the foot IK (frames × 2, left, right; 1 = planted). */
+  contacts: Uint8Array;
+}
+
+/** A human's height (m), to tell a rig's units: units per metre is the power of ten nearest height / this. */
+const TYPICAL_HEIGHT = 1.7;
+/** Foot corrections fade in before a contact and out after it over this long (s). */
+const RELEASE_SECONDS = 0.15;
+/** A rig whose lowest rest foot point is within this height above y = 0 (m) stands on y = 0; else on that point. */
+const REST_FLOOR_SLACK = 0.15;
+/** Below this sine of the angle between a segment and its twist reference, the reference is not trusted. */
+const PARALLEL_SINE = 0.08;
+/** How strongly a knee's or elbow's bend sets the limb's twist against the fallback forward (per leg length). */
+const BEND_WEIGHT = 6;
+
+const K = CANONICAL_JOINTS.length;
+const at = (name: CanonicalJoint): number => CANONICAL_JOINTS.indexOf(name);
+
+type Points = (k: number) => Vec3;
+type Twist = (p: Points) => Vec3;
+
+/** How each canonical point's bone turns: towards the first point of `to` (far enough away), twisted by `twist`
+ *  (undefined: with its canonical parent, plus the least swing). */
+interface SegmentRule {
+  to: number[];
+  twist?: Twist;
+  parent: number;
+}
+
+const hipLine: Twist = (p) => sub(p(at('LeftUpLeg')), p(at('RightUpLeg')));
+const shoulderLine: Twist = (p) => sub(p(at('LeftArm')), p(at('RightArm')));
+const torsoForward = (p: Points): Vec3 => normalize(cross(sub(p(at('Neck')), p(at('Hips'))), hipLine(p)));
+const chestForward = (p: Points): Vec3 => normalize(cross(sub(p(at('Neck')), p(at('Spine1'))), shoulderLine(p)));
+
+/** The knee's forward: where the foot points, plus the knee's offset ahead of the hip–ankle line when bent. */
+function kneeTwist(side: 'Left' | 'Right'): Twist {
+  const [hip, knee, ankle, toe] = ['UpLeg', 'Leg', 'Foot', 'ToeBase'].map((n) => at(`${side}${n}` as CanonicalJoint));
+  return (p) => {
+    const h = p(hip), k = p(knee), a = p(ankle);
+    const leg = length(sub(k, h)) + length(sub(a, k)) || 1;
+    const mid: Vec3 = [(h[0] + a[0]) / 2, (h[1] + a[1]) / 2, (h[2] + a[2]) / 2];
+    const foot = normalize(sub(p(toe), a));
+    const bend = sub(k, mid);
+    return [foot[0] + (BEND_WEIGHT * bend[0]) / leg, foot[1] + (BEND_WEIGHT * bend[1]) / leg, foot[2] + (BEND_WEIGHT * bend[2]) / leg];
+  };
+}
+
+/** The elbow's front: the chest's forward, plus (against) the elbow's offset behind the shoulder–wrist line when bent. */
+function elbowTwist(side: 'Left' | 'Right'): Twist {
+  const [shoulder, elbow, wrist] = ['Arm', 'ForeArm', 'Hand'].map((n) => at(`${side}${n}` as CanonicalJoint));
+  return (p) => {
+    const s = p(shoulder), e = p(elbow), w = p(wrist);
+    const arm = length(sub(e, s)) + length(sub(w, e)) || 1;
+    const mid: Vec3 = [(s[0] + w[0]) / 2, (s[1] + w[1]) / 2, (s[2] + w[2]) / 2];
+    const fwd = chestForward(p);
+    const bend = sub(e, mid);
+    return [fwd[0] - (BEND_WEIGHT * bend[0]) / arm, fwd[1] - (BEND_WEIGHT * bend[1]) / arm, fwd[2] - (BEND_WEIGHT * bend[2]) / arm];
+  };
+}
+
+function segmentRules(): SegmentRule[] {
+  const rules: SegmentRule[] = CANONICAL_JOINTS.map(() => ({ to: [], parent: -1 }));
+  const rule = (name: CanonicalJoint, to: CanonicalJoint[], parent: CanonicalJoint | '', twist?: Twist) =>
+    (rules[at(name)] = { to: to.map(at), twist, parent: parent ? at(parent) : -1 });
+  rule('Hips', ['Neck'], '', hipLine);
+  rule('Spine', ['Spine1', 'Neck'], 'Hips', (p) => {
+    const a = normalize(hipLine(p)), b = normalize(shoulderLine(p));
+    return [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
+  });
+  rule('Spine1', ['Neck'], 'Spine', shoulderLine);
+  rule('Neck', ['Neck1', 'Head'], 'Spine1', shoulderLine);
+  rule('Neck1', ['Head'], 'Neck', shoulderLine);
+  rule('Head', ['Head_end'], 'Neck1');
+  rule('Head_end', [], 'Head');
+  for (const side of ['Left', 'Right'] as const) {
+    const n = (s: string) => `${side}${s}` as CanonicalJoint;
+    rule(n('UpLeg'), [n('Leg')], 'Hips', kneeTwist(side));
+    rule(n('Leg'), [n('Foot')], n('UpLeg'), kneeTwist(side));
+    rule(n('Foot'), [n('ToeBase'), n('ToeBase_end')], n('Leg'), (p) => sub(p(at(n('Leg'))), p(at(n('Foot')))));
+    rule(n('ToeBase'), [n('ToeBase_end')], n('Foot'));
+    rule(n('ToeBase_end'), [], n('ToeBase'));
+    rule(n('Arm'), [n('ForeArm')], 'Spine1', elbowTwist(side));
+    rule(n('ForeArm'), [n('Hand')], n('Arm'), elbowTwist(side));
+    rule(n('Hand'), [n('Hand_end')], n('ForeArm'));
+    rule(n('Hand_end'), [], n('Hand'));
+  }
+  return rules;
+}
+const RULES = segmentRules();
+
+function describeRigError(message: string): never {
+  throw new SkeletonMapError(`character rig: ${message}`);
+}
+
+function checkRig(rig: CharacterRig): void {
+  const n = rig.bones?.length ?? 0;
+  if (n < 3) describeRigError(`it has ${n} bone${n === 1 ? '' : 's'}, not a humanoid skeleton`);
+  for (const [what, list] of [['parents', rig.parents], ['restRotations', rig.restRotations], ['restTranslations', rig.restTranslations]] as const) {
+    if (!list || list.length !== n) describeRigError(`${list?.length ?? 0} ${what} for ${n} bones`);
+  }
+  for (let b = 0; b < n; b++) {
+    const p = rig.parents[b];
+    if (!(Number.isInteger(p) && p >= -1 && p < b)) describeRigError(`bone ${b} (${rig.bones[b]}) has parent ${p}; parents must come before children`);
+    if (!rig.restRotations[b].every(Number.isFinite) || !rig.restTranslations[b].every(Number.isFinite)) {
+      describeRigError(`bone ${b} (${rig.bones[b]}) has a rest rotation or translation that is not a finite number`);
+    }
+  }
+}
+
+/** Rest world rotations and positions (rig units) of every bone: FK of the rest pose (three.js semantics). */
+function restWorld(rig: CharacterRig): { rotations: Quat[]; positions: Vec3[] } {
+  const rotations: Quat[] = [];
+  const positions: Vec3[] = [];
+  rig.parents.forEach((p, b) => {
+    const q = quatNormalize(rig.restRotations[b]);
+    const t = rig.restTranslations[b];
+    if (p < 0) {
+      rotations[b] = q;
+      positions[b] = [t[0], t[1], t[2]];
+    } else {
+      rotations[b] = quatNormalize(quatMultiply(rotations[p], q));
+      const o = quatRotate(rotations[p], t);
+      positions[b] = [positions[p][0] + o[0], positions[p][1] + o[1], positions[p][2] + o[2]];
+    }
+  });
+  return { rotations, positions };
+}
+
+/** World rest positions (bones × 3) of a rig: FK of its rest pose. */
+export function restPositions(rig: CharacterRig): Float32Array {
+  checkRig(rig);
+  return Float32Array.from(restWorld(rig).positions.flat());
+}
+
+/** The rig's humanoid map (its own VRM map when given, else mapHumanoid on the rest pose); throws SkeletonMapError naming what is missing. */
+export function mapRig(rig: CharacterRig): HumanoidMap {
+  const positions = restPositions(rig);
+  if (rig.humanoid) {
+    const { source } = rig.humanoid;
+    if (source.length !== K || source.some((j) => !Number.isInteger(j) || j < -1 || j >= rig.bones.length)) {
+      describeRigError(`its humanoid map has ${source.length} points (expected ${K}) or names a bone that is not there`);
+    }
+    for (const need of ['Hips', 'LeftUpLeg', 'LeftLeg', 'LeftFoot', 'RightUpLeg', 'RightLeg', 'RightFoot', 'Neck', 'Head', 'LeftArm', 'LeftForeArm', 'LeftHand', 'RightArm', 'RightForeArm', 'RightHand'] as const) {
+      if (source[at(need)] < 0) describeRigError(`its humanoid map has no bone for ${need}`);
+    }
+    return rig.humanoid;
+  }
+  return mapHumanoid({ joints: rig.bones, parents: rig.parents, frames: 1, positions });
+}
+
+/** The source motion's canonical points (frames × 25 × 3, metres). */
+function sourceCanonical(source: Motion): Float32Array {
+  const canonical = source.joints.length === K && source.joints.every((name, j) => name === CANONICAL_JOINTS[j]);
+  if (canonical) return source.positions;
+  return toCanonical(source, { ...mapSkeleton(source, 1), scale: 1 });
+}
+
+function legLength(points: ArrayLike<number>, frames: number): number {
+  let total = 0;
+  const p = (f: number, k: number): Vec3 => [points[(f * K + k) * 3], points[(f * K + k) * 3 + 1], points[(f * K + k) * 3 + 2]];
+  for (let f = 0; f < frames; f++) {
+    for (const side of ['Left', 'Right']) {
+      const [h, k, a] = ['UpLeg', 'Leg', 'Foot'].map((n) => p(f, at(`${side}${n}` as CanonicalJoint)));
+      total += length(sub(k, h)) + length(sub(a, k));
+    }
+  }
+  return total / (2 * frames);
+}
+
+const midpoint = (a: Vec3, b: Vec3): Vec3 => [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2];
+
+function median(values: number[]): number {
+  if (!values.length) return NaN;
+  const s = [...values].sort((a, b) => a - b);
+  return s[Math.floor(s.length / 2)];
+}
+
+/** R taking (from, its twist reference) to (to, its reference); undefined where a reference lies along its segment. */
+function alignFrames(fromDir: Vec3, fromRef: Vec3, toDir: Vec3, toRef: Vec3): Quat | undefined {
+  const sine = (a: Vec3, b: Vec3) => length(cross(a, b)) / ((length(a) * length(b)) || 1);
+  if (sine(fromDir, fromRef) < PARALLEL_SINE || sine(toDir, toRef) < PARALLEL_SINE) return undefined;
+  return rotationFromTwoVectors(fromDir, fromRef, toDir, toRef);
+}
+
+interface LegBones {
+  thigh: number;
+  knee: number;
+  ankle: number;
+  /** Foot points (ankle, toe, toe end) as offsets in the ankle bone's frame (rig units), and each one's rest height above the floor (m). */
+  offsets: Vec3[];
+  clearance: number[];
+}
+
+/** Retargets `source` (any humanoid Motion: every model's canonical output or an import) onto `rig`. */
+export function retarget(source: Motion, rig: CharacterRig, options: RetargetOptions = {}): RetargetResult {
+  checkRig(rig);
+  const F = source.frames;
+  if (!(F >= 1) || !(source.fps > 0)) throw new Error(`retarget: the motion needs frames and a positive fps (got ${F} frames at ${source.fps} fps)`);
+  const B = rig.bones.length;
+  const footIK = options.footIK ?? true;
+
+  // The source's canonical points and contacts.
+  const src = sourceCanonical(source);
+  const srcAt = (f: number, k: number): Vec3 => [src[(f * K + k) * 3], src[(f * K + k) * 3 + 1], src[(f * K + k) * 3 + 2]];
+  const contacts = source.contacts && source.contacts.length === F * 2
+    ? Uint8Array.from(source.contacts)
+    : labelContacts(src, new Uint8Array(F * 2), CANONICAL_JOINTS, source.fps);
+
+  // The rig: rest world pose, map, units, rest canonical points (metres).
+  const rest = restWorld(rig);
+  const mapping = mapRig(rig);
+  const unitsPerMetre = 10 ** Math.round(Math.log10(mapping.height / TYPICAL_HEIGHT));
+  const restFlat = Float32Array.from(rest.positions.flat());
+  const restCanonical = toCanonical(
+    { fps: 30, frames: 1, joints: rig.bones, parents: rig.parents, positions: restFlat },
+    { scheme: mapping.scheme, source: mapping.source, scale: 1 / unitsPerMetre },
+  );
+  const restAt = (k: number): Vec3 => [restCanonical[k * 3], restCanonical[k * 3 + 1], restCanonical[k * 3 + 2]];
+
+  const sourceLeg = legLength(src, F);
+  const characterLeg = legLength(restCanonical, 1);
+  if (!(sourceLeg > 1e-4) || !(characterLeg > 1e-4)) throw new SkeletonMapError(`retarget: ${sourceLeg > 1e-4 ? 'the character' : 'the motion'}'s legs have no length`);
+  const scale = characterLeg / sourceLeg;
+
+  // Where each segment points: the first target point far enough from the bone's point in the rest and the source.
+  const minSegment = 0.01 * characterLeg;
+  const segmentEnd = RULES.map((rule, k) => rule.to.find((e) =>
+    length(sub(restAt(e), restAt(k))) > minSegment && length(sub(srcAt(0, e), srcAt(0, k))) > minSegment * (sourceLeg / characterLeg)) ?? -1);
+  const restDir = segmentEnd.map((e, k) => (e >= 0 ? sub(restAt(e), restAt(k)) : ([0, 0, 0] as Vec3)));
+  const restRef = RULES.map((rule) => (rule.twist ? rule.twist(restAt) : ([0, 0, 0] as Vec3)));
+  const boneOf = mapping.source;
+  const pointOfBone = new Array<number>(B).fill(-1);
+  boneOf.forEach((b, k) => b >= 0 && pointOfBone[b] < 0 && (pointOfBone[b] = k));
+  const restLocal = rig.restRotations.map(quatNormalize);
+
+  // Heights: the rig's rest floor, its ankles' height above it; the source's planted ankle height.
+  const footPointsOf = (side: 'Left' | 'Right') => ['Foot', 'ToeBase', 'ToeBase_end'].map((n) => at(`${side}${n}` as CanonicalJoint));
+  const restFootPoints = (['Left', 'Right'] as const).flatMap(footPointsOf);
+  const restLowest = Math.min(...restFootPoints.map((k) => restAt(k)[1]));
+  const restFloor = restLowest >= 0 && restLowest <= REST_FLOOR_SLACK ? 0 : restLowest;
+  const characterAnkle = (restAt(at('LeftFoot'))[1] + restAt(at('RightFoot'))[1]) / 2 - restFloor;
+  const plantedAnkles: number[] = [];
+  for (let f = 0; f < F; f++) {
+    (['Left', 'Right'] as const).forEach((side, s) => contacts[f * 2 + s] && plantedAnkles.push(srcAt(f, at(`${side}Foot`))[1]));
+  }
+  let sourceAnkle = median(plantedAnkles);
+  if (!Number.isFinite(sourceAnkle)) {
+    const lows: number[] = [];
+    for (let f = 0; f < F; f++) lows.push(Math.min(srcAt(f, at('LeftFoot'))[1], srcAt(f, at('RightFoot'))[1]));
+    sourceAnkle = median(lows);
+  }
+
+  // The rest offset (m) from the hips point to the legs' hip joints' midpoint.
+  const restHipJoints = sub(midpoint(restAt(at('LeftUpLeg')), restAt(at('RightUpLeg'))), restAt(at('Hips')));
+  const hipsBone = boneOf[at('Hips')];
+  let rootOfHips = hipsBone;
+  while (rig.parents[rootOfHips] >= 0) rootOfHips = rig.parents[rootOfHips];
+  if (rootOfHips !== 0) describeRigError(`the hips (${rig.bones[hipsBone]}) do not hang from the first bone (${rig.bones[0]})`);
+  // The root's rest offset from the hips: the bones between keep their rest rotations, so it is constant.
+  const hipsFromRoot = sub(rest.positions[hipsBone], rest.positions[0]);
+
+  const legs: LegBones[] = (['Left', 'Right'] as const).map((side) => {
+    const ankle = boneOf[at(`${side}Foot`)];
+    const inverseAnkle = quatConjugate(rest.rotations[ankle]);
+    const points = footPointsOf(side);
+    return {
+      thigh: boneOf[at(`${side}UpLeg`)],
+      knee: boneOf[at(`${side}Leg`)],
+      ankle,
+      offsets: points.map((k) => quatRotate(inverseAnkle, sub(restAt(k), restAt(at(`${side}Foot`))).map((v) => v * unitsPerMetre) as Vec3)),
+      clearance: points.map((k) => restAt(k)[1] - restFloor),
+    };
+  });
+
+  const rotations = new Float32Array(F * B * 4);
+  const rootTranslations = new Float32Array(F * 3);
+  const positions = new Float32Array(F * B * 3);
+  const worlds: Quat[][] = [];
+
+  // Pass 1: the pose from the source's rotations; per bone its world rotation (mapped bones: R × rest world).
+  for (let f = 0; f < F; f++) {
+    const p: Points = (k) => srcAt(f, k);
+    const delta: Quat[] = new Array(K);
+    for (let k = 0; k < K; k++) {
+      const rule = RULES[k];
+      const parentDelta = rule.parent >= 0 ? delta[rule.parent] : quatIdentity();
+      const e = segmentEnd[k];
+      if (e < 0) {
+        delta[k] = parentDelta;
+        continue;
+      }
+      const dir = sub(p(e), p(k));
+      const aligned = rule.twist ? alignFrames(restDir[k], restRef[k], dir, rule.twist(p)) : undefined;
+      delta[k] = aligned ?? quatNormalize(quatMultiply(swingRotation(quatRotate(parentDelta, restDir[k]), dir), parentDelta));
+    }
+    const world: Quat[] = new Array(B);
+    for (let b = 0; b < B; b++) {
+      const k = pointOfBone[b];
+      const parent = rig.parents[b];
+      world[b] = k >= 0 ? quatNormalize(quatMultiply(delta[k], rest.rotations[b])) : parent >= 0 ? quatMultiply(world[parent], restLocal[b]) : restLocal[b];
+    }
+    worlds.push(world);
+    // The legs' hip joints (their midpoint) go where the source's go, scaled; the character stands on y = 0
+    // (whatever floor its rest pose stood on), its ankles as high above it as the source's are, scaled.
+    const mid = midpoint(p(at('LeftUpLeg')), p(at('RightUpLeg')));
+    const hipJoints: Vec3 = [mid[0] * scale, (mid[1] - sourceAnkle) * scale + characterAnkle, mid[2] * scale];
+    const hips = sub(hipJoints, quatRotate(delta[at('Hips')], restHipJoints));
+    const root = sub(hips.map((v) => v * unitsPerMetre) as Vec3, hipsFromRoot);
+    rootTranslations.set(root, f * 3);
+    poseFrame(rig, world, root, restLocal, rotations, positions, f);
+  }
+
+  const mapped = pointOfBone.map((k) => k >= 0);
+  if (footIK) plantFeet(rig, legs, worlds, mapped, contacts, source.fps, unitsPerMetre, rootTranslations, restLocal, rotations, positions);
+
+  for (let i = 0; i < positions.length; i++) positions[i] /= unitsPerMetre;
+  const motion: Motion = { fps: source.fps, frames: F, joints: [...rig.bones], parents: [...rig.parents], positions, contacts };
+  return { motion, rotations, rootTranslations, mapping, scale, unitsPerMetre, restCanonical, contacts };
+}
+
+/**
+ * One frame from world rotations: re-derives unmapped bones' world rotations (rest local under the parent's current
+ * world), writes the local rotations and the positions (rig units; FK with three.js semantics: a bone's position is
+ * its parent's plus the parent's world rotation applied to the bone's rest translation).
+ */
+function poseFrame(rig: CharacterRig, world: Quat[], root: Vec3, restLocal: Quat[], rotations: Float32Array, positions: Float32Array, f: number): void {
+  const B = rig.bones.length;
+  for (let b = 0; b < B; b++) {
+    const parent = rig.parents[b];
+    let local: Quat;
+    if (parent < 0) {
+      local = world[b];
+      const t = b === 0 ? root : rig.restTranslations[b];
+      positions.set(t, (f * B + b) * 3);
+    } else {
+      local = quatNormalize(quatMultiply(quatConjugate(world[parent]), world[b]));
+      const o = quatRotate(world[parent], rig.restTranslations[b]);
+      const pp = (f * B + parent) * 3;
+      positions.set([positions[pp] + o[0], positions[pp + 1] + o[1], positions[pp + 2] + o[2]], (f * B + b) * 3);
+    }
+    // Keep w ≥ 0 so that consecutive frames interpolate the short way.
+    if (local[3] < 0) local = [-local[0], -local[1], -local[2], -local[3]];
+    rotations.set(local, (f * B + b) * 4);
+  }
+}
+
+/** The world rotations of a frame with unmapped bones re-derived from their (possibly turned) parents. */
+function refreshUnmapped(rig: CharacterRig, world: Quat[], mapped: boolean[], restLocal: Quat[]): void {
+  for (let b = 0; b < rig.bones.length; b++) {
+    const parent = rig.parents[b];
+    if (!mapped[b] && parent >= 0) world[b] = quatMultiply(world[parent], restLocal[b]);
+  }
+}
+
+/**
+ * Holds the character's planted feet still on the floor (see the header, step 5), in place: turns the thighs and
+ * shins of `worlds` and rewrites `rotations` and `positions`.
+ */
+function plantFeet(
+  rig: CharacterRig, legs: LegBones[], worlds: Quat[][], mapped: boolean[], contacts: Uint8Array, fps: number, unitsPerMetre: number,
+  rootTranslations: Float32Array, restLocal: Quat[], rotations: Float32Array, positions: Float32Array,
+): void {
+  const B = rig.bones.length;
+  const F = worlds.length;
+  const pos = (f: number, b: number): Vec3 => [positions[(f * B + b) * 3], positions[(f * B + b) * 3 + 1], positions[(f * B + b) * 3 + 2]];
+  const footPoints = (f: number, leg: LegBones): Vec3[] => {
+    const a = pos(f, leg.ankle);
+    return leg.offsets.map((o) => {
+      const d = quatRotate(worlds[f][leg.ankle], o);
+      return [a[0] + d[0], a[1] + d[1], a[2] + d[2]] as Vec3;
+    });
+  };
+  // Height of a foot above the floor: its lowest point relative to that point's rest height (rig units).
+  const lowest = (points: Vec3[], leg: LegBones): { i: number; height: number } => {
+    let i = 0, height = Infinity;
+    points.forEach((p, n) => {
+      const h = p[1] - leg.clearance[n] * unitsPerMetre;
+      if (h < height) [i, height] = [n, h];
+    });
+    return { i, height };
+  };
+  const blend = Math.max(1, Math.round(RELEASE_SECONDS * fps));
+  const shifts: Vec3[][] = legs.map(() => new Array<Vec3>(F));
+  legs.forEach((leg, s) => {
+    // Planted frames: pin the lowest point where it was (corrected) the frame before, at floor height.
+    let previous: Vec3[] | null = null;
+    const planted: boolean[] = [];
+    for (let f = 0; f < F; f++) {
+      planted[f] = contacts[f * 2 + s] > 0;
+      if (!planted[f]) {
+        previous = null;
+        continue;
+      }
+      const points = footPoints(f, leg);
+      const low = lowest(points, leg);
+      const anchor = previous ? previous[low.i] : points[low.i];
+      const shift: Vec3 = [anchor[0] - points[low.i][0], -low.height, anchor[2] - points[low.i][2]];
+      shifts[s][f] = shift;
+      previous = points.map((p) => [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]] as Vec3);
+    }
+    // Free frames: the neighbouring contacts' corrections fading out (after) and in (before); never below the floor.
+    for (let f = 0; f < F; f++) {
+      if (planted[f]) continue;
+      const shift: Vec3 = [0, 0, 0];
+      for (let d = 1; d <= blend; d++) {
+        const w = 1 - smoothstep(d / (blend + 1));
+        const fade = (g: number) => {
+          if (g < 0 || g >= F || !planted[g]) return false;
+          for (let a = 0; a < 3; a++) shift[a] += w * shifts[s][g][a];
+          return true;
+        };
+        if (fade(f - d)) break;
+      }
+      for (let d = 1; d <= blend; d++) {
+        const w = 1 - smoothstep(d / (blend + 1));
+        const g = f + d;
+        if (g < F && planted[g]) {
+          for (let a = 0; a < 3; a++) shift[a] += w * shifts[s][g][a];
+          break;
+        }
+      }
+      const height = lowest(footPoints(f, leg).map((p) => [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]] as Vec3), leg).height;
+      if (height < 0) shift[1] -= height;
+      shifts[s][f] = shift;
+    }
+  });
+
+  for (let f = 0; f < F; f++) {
+    const world = worlds[f];
+    let changed = false;
+    legs.forEach((leg, s) => {
+      const shift = shifts[s][f];
+      if (Math.hypot(...shift) < 1e-9) return;
+      const hip = pos(f, leg.thigh), knee = pos(f, leg.knee), ankle = pos(f, leg.ankle);
+      const target: Vec3 = [ankle[0] + shift[0], ankle[1] + shift[1], ankle[2] + shift[2]];
+      const l1 = length(sub(knee, hip)), l2 = length(sub(ankle, knee));
+      const [newKnee, newAnkle] = twoBoneIK(hip, knee, target, l1, l2, 0.9999, null, 0);
+      const thighTurn = rotationFromTwoVectors(sub(knee, hip), sub(ankle, hip), sub(newKnee, hip), sub(newAnkle, hip)) ?? swingRotation(sub(knee, hip), sub(newKnee, hip));
+      const shinTurn = quatMultiply(swingRotation(quatRotate(thighTurn, sub(ankle, knee)), sub(newAnkle, newKnee)), thighTurn);
+      // Every bone from the thigh down to (not including) the foot turns: the thigh by thighTurn, the shin and the
+      // bones between it and the foot by shinTurn; the foot keeps its world rotation.
+      for (let b = leg.thigh; b < B; b++) {
+        if (b === leg.ankle || !isBelow(rig.parents, b, leg.thigh) || isBelow(rig.parents, b, leg.ankle)) continue;
+        if (!mapped[b]) continue;
+        world[b] = quatNormalize(quatMultiply(isBelow(rig.parents, b, leg.knee) ? shinTurn : thighTurn, world[b]));
+      }
+      changed = true;
+    });
+    if (!changed) continue;
+    refreshUnmapped(rig, world, mapped, restLocal);
+    poseFrame(rig, world, [rootTranslations[f * 3], rootTranslations[f * 3 + 1], rootTranslations[f * 3 + 2]], restLocal, rotations, positions, f);
+  }
+}
+
+/** Whether bone `b` is `ancestor` or lies below it. */
+function isBelow(parents: readonly number[], b: number, ancestor: number): boolean {
+  for (let j = b; j >= 0; j = parents[j]) if (j === ancestor) return true;
+  return false;
+}
