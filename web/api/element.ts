@@ -18,7 +18,7 @@ import { capMessage, quoteInput } from '../motion/text';
 import { prefetchRuntime } from '../runtime/worker/workerClient';
 import { DEFAULT_LOOK, type Look } from '../viewer/look';
 
-const OTHER_ATTRIBUTES = ['src', 'autoplay', 'camera-controls', 'controls', 'poster', 'loading', 'link'] as const;
+const OTHER_ATTRIBUTES = ['src', 'character', 'autoplay', 'camera-controls', 'controls', 'poster', 'loading', 'link'] as const;
 const CONTROLS = ['full', 'minimal', 'none'] as const;
 type Controls = (typeof CONTROLS)[number];
 const LOADING = ['eager', 'lazy'] as const;
@@ -137,6 +137,11 @@ export class MotionPlaygroundElement extends HTMLElement {
       void this.loadSource();
       return;
     }
+    if (name === 'character') {
+      if (after === null) this.app.characters.clear();
+      else void this.loadCharacterAttribute();
+      return;
+    }
     if ((VIEW_KEYS as readonly string[]).includes(name) || name === 'dance-style') void this.api.ready.then(() => this.applyView(this.attributeView(), false));
   }
 
@@ -171,6 +176,7 @@ export class MotionPlaygroundElement extends HTMLElement {
     this.app = app;
     this.watchContext(app, signal);
     this.api = createPlayground(app);
+    app.characters.allowedOrigins = () => allowedOrigins(this.getAttribute('allowed-origins'));
     const version = this.shadow.getElementById('version');
     if (version) version.textContent = `v${this.api.version}`;
     app.viewer.controls.enabled = this.hasAttribute('camera-controls');
@@ -200,7 +206,7 @@ export class MotionPlaygroundElement extends HTMLElement {
         app.show(kept.motion, kept.name);
         if (!this.hasAttribute('autoplay')) app.viewer.pause();
       }
-      if (this.hasAttribute('src')) await this.loadSource();
+      await Promise.all([this.hasAttribute('src') ? this.loadSource() : undefined, this.loadCharacterAttribute()]);
       if (!signal.aborted) this.fire('load');
     });
   }
@@ -417,6 +423,26 @@ export class MotionPlaygroundElement extends HTMLElement {
     }
   }
 
+  // ---------- character ----------
+
+  /**
+   * Loads the character the `character` attribute names, else (on the page, with `link`) the URL's `character=`
+   * parameter: a .glb, .gltf or .vrm under the same rules as `src`. A failure fires `error` and keeps what is shown.
+   */
+  private async loadCharacterAttribute(): Promise<void> {
+    const app = this.app;
+    if (!app) return;
+    const fromLink = this.hasAttribute('link') ? new URLSearchParams(location.search || location.hash.replace(/^#/, '')).get('character') : null;
+    const url = this.getAttribute('character') ?? fromLink;
+    if (!url) return;
+    const what = this.hasAttribute('character') ? 'character' : 'Link: character';
+    try {
+      await app.loadCharacter(url);
+    } catch (e) {
+      if (this.app === app && !(e instanceof Error && e.name === 'SupersededError')) app.reportError(`${what}: ${errorMessage(e)}`);
+    }
+  }
+
   // ---------- presentation ----------
 
   private showControls(): void {
@@ -590,7 +616,7 @@ function allowedOrigins(text: string | null): string[] {
 }
 
 /** Reflected properties: each attribute as a property of the same (camel-cased) name. */
-const STRING_PROPERTIES: Record<string, string> = { mode: 'mode', model: 'model', danceStyle: 'dance-style', src: 'src', controls: 'controls', poster: 'poster', loading: 'loading', path: 'path' };
+const STRING_PROPERTIES: Record<string, string> = { mode: 'mode', model: 'model', danceStyle: 'dance-style', src: 'src', character: 'character', controls: 'controls', poster: 'poster', loading: 'loading', path: 'path' };
 const NUMBER_PROPERTIES = ['seed', 'temperature'];
 const BOOLEAN_PROPERTIES: Record<string, string> = { autoplay: 'autoplay', cameraControls: 'camera-controls', link: 'link' };
 

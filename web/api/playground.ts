@@ -25,6 +25,7 @@ import type { Capability, GenerateCall, PathStats } from '../runtime/descriptor'
 import { Registry, type RegisteredModel } from '../runtime/registry';
 import { mapSkeleton } from '../motion/skeletonMap';
 import { addNoise as addNoiseTo, checkNoiseOptions, type NoiseOptions } from '../motion/noise';
+import type { CharacterInfo, CharacterSource } from '../ui/characterInput';
 
 declare const __APP_VERSION__: string;
 
@@ -147,6 +148,24 @@ export type DenoisedMotion = Motion & { contacts: Uint8Array; stats: CleanupStat
 export { GENERATE_DEFAULT_TEMPERATURE } from '../runtime/generator/descriptor';
 export const GENERATE_MAX_FRAMES = 100_000;
 
+/** Your own character (docs/api.md "Your own character"). */
+export type { CharacterInfo, CharacterSource };
+
+export interface LoadCharacterOptions {
+  /** Load it for Compare's second figure only (the side-by-side companion); default false: for both figures. */
+  companion?: boolean;
+}
+
+export interface RetargetCallOptions {
+  /** Keep planted feet planted with two-bone IK on the character's legs (default true). */
+  footIK?: boolean;
+}
+
+/** exportGLB's options with `character: true`: the loaded character animated (resolves with the bytes). */
+export type CharacterGLBExportOptions = { character: true; name?: string };
+/** exportBVH's options with `character: true`: the motion on the character's skeleton. */
+export type CharacterBVHExportOptions = { character: true };
+
 export interface Playground {
   /** Package version of the page, e.g. "0.1.0". */
   readonly version: string;
@@ -160,12 +179,26 @@ export interface Playground {
    * BVH text of a motion (centimetres, y up, ZYX Euler channels, Frame Time = 1/fps). `options.restPose`:
    * 'clip' (default, the clip's tallest frame) or 'tpose' (a T-pose facing +z, for retargeting tools).
    */
-  exportBVH(motion: Motion, options?: BVHExportOptions): string;
+  exportBVH(motion: Motion, options?: BVHExportOptions | CharacterBVHExportOptions): string;
   /**
    * Binary glTF (GLB) of a motion: a skinned figure bound to a skeleton and one animation (root translation,
    * joint rotations). `options.restPose`: 'tpose' (default) or 'clip'; `options.name` names it.
    */
-  exportGLB(motion: Motion, options?: GLBExportOptions): Uint8Array<ArrayBuffer>;
+  exportGLB(motion: Motion, options?: GLBExportOptions & { character?: false }): Uint8Array<ArrayBuffer>;
+  /** With `character: true`: the loaded character's mesh, skin and materials with the motion retargeted onto it (a Promise). */
+  exportGLB(motion: Motion, options: CharacterGLBExportOptions): Promise<Uint8Array<ArrayBuffer>>;
+  /**
+   * Loads a rigged humanoid (.glb, self-contained .gltf or .vrm; a URL under the `src` rules, a Blob or bytes) and
+   * draws it instead of the mannequin in every mode, retargeted from the shown motion. Rejects with a short reason
+   * (no skin, broken, over 32 MiB, not a humanoid), keeping the character and motion shown.
+   */
+  loadCharacter(source: CharacterSource, options?: LoadCharacterOptions): Promise<CharacterInfo>;
+  /** The loaded character (as loadCharacter resolved), or null: the mannequin. */
+  character(): CharacterInfo | null;
+  /** Back to the project's mannequin. */
+  clearCharacter(): void;
+  /** The motion retargeted onto the loaded character: its bones' names and parents, world positions per frame (metres). */
+  retarget(motion: Motion, options?: RetargetCallOptions): Motion;
   /** Shows a motion in the viewer from its first frame, playing. `name` labels it on the page. */
   show(motion: Motion, name?: string): void;
   play(): void;
@@ -267,8 +300,18 @@ function checkKeys(options: unknown, known: string[], shape: string): Record<str
 /** Export options (undefined: the defaults); the values themselves are checked by the exporters. */
 function checkExportOptions(options: unknown, withName: boolean): { restPose?: RestPose; name?: string } {
   if (options === undefined) return {};
-  const keys = withName ? ['restPose', 'name'] : ['restPose'];
-  return checkKeys(options, keys, `{ restPose?: 'tpose' | 'clip'${withName ? ', name?' : ''} }`) as { restPose?: RestPose; name?: string };
+  const keys = withName ? ['restPose', 'name', 'character'] : ['restPose', 'character']; // character: false (onCharacter)
+  const { restPose, name } = checkKeys(options, keys, `{ restPose?: 'tpose' | 'clip'${withName ? ', name?' : ''} }`) as { restPose?: RestPose; name?: string };
+  return { ...(restPose !== undefined ? { restPose } : {}), ...(name !== undefined ? { name } : {}) };
+}
+
+/** Whether export options ask for the loaded character (`character: true`); any other `character` value is refused. */
+function onCharacter(options: unknown): boolean {
+  if (typeof options !== 'object' || options === null || !('character' in options)) return false;
+  const v = (options as { character: unknown }).character;
+  if (v === true) return true;
+  if (v === false || v === undefined) return false; // the plain export
+  throw new TypeError(`character must be true or false, got ${describeValue(v)}`);
 }
 
 /** Throws unless `options` are view options: layer switches true or false, framing "character" or "all". */
@@ -436,10 +479,40 @@ export function createPlayground(app: App): Playground {
     },
 
     exportBVH(motion, options) {
-      return guarded('exportBVH', () => exportBVHText(validateMotion(motion), checkExportOptions(options, false)));
+      return guarded('exportBVH', () => {
+        if (onCharacter(options)) {
+          checkKeys(options, ['character'], '{ character: true }');
+          return app.characters.exportBVH(validateMotion(motion));
+        }
+        return exportBVHText(validateMotion(motion), checkExportOptions(options, false));
+      });
     },
-    exportGLB(motion, options) {
+    exportGLB: ((motion: Motion, options?: GLBExportOptions | CharacterGLBExportOptions) => {
+      if (onCharacter(options)) {
+        return guardedAsync('exportGLB', async () => {
+          const { name } = checkKeys(options, ['character', 'name'], '{ character: true, name? }') as { name?: unknown };
+          if (name !== undefined && typeof name !== 'string') throw new TypeError(`name must be a string, got ${describeValue(name)}`);
+          return app.characters.exportGLB(validateMotion(motion), name ?? 'motion');
+        });
+      }
       return guarded('exportGLB', () => exportGLBBytes(validateMotion(motion), checkExportOptions(options, true)));
+    }) as Playground['exportGLB'],
+
+    loadCharacter(source, options) {
+      return guardedAsync('loadCharacter', async () => {
+        const o = options === undefined ? {} : checkKeys(options, ['companion'], '{ companion? }');
+        if (o.companion !== undefined && typeof o.companion !== 'boolean') throw new TypeError(`companion must be true or false, got ${describeValue(o.companion)}`);
+        return app.loadCharacter(source, o.companion === true);
+      });
+    },
+    character: () => app.characters.info,
+    clearCharacter: () => app.characters.clear(),
+    retarget(motion, options) {
+      return guarded('retarget', () => {
+        const o = options === undefined ? {} : checkKeys(options, ['footIK'], '{ footIK? }');
+        if (o.footIK !== undefined && typeof o.footIK !== 'boolean') throw new TypeError(`footIK must be true or false, got ${describeValue(o.footIK)}`);
+        return app.characters.retarget(validateMotion(motion), o as RetargetCallOptions).motion;
+      });
     },
 
     show(motion, name = 'motion') {

@@ -22,6 +22,7 @@ import { Capture } from './capture';
 import { ExportMenu } from './exportMenu';
 import { BusyIndicator, ModelHost, pageThreads, withClient } from './modelHost';
 import { CleanupPanel } from './cleanupPanel';
+import { CHARACTER_FILE, CharacterInput } from './characterInput';
 import { DanceMode } from './modes/danceMode';
 import type { ModeHost } from './modes/host';
 import type { LiveChunk, LiveMode } from './modes/liveMode';
@@ -47,6 +48,8 @@ export class App implements ModeHost {
   readonly viewer: Viewer;
   readonly panel: Panel;
   readonly toasts: Toasts;
+  /** The user's own character, drawn instead of the mannequin once loaded (characterInput.ts). */
+  readonly characters: CharacterInput;
   private readonly busy = new BusyIndicator($('model-status'));
   /** The models the page runs (empty until the manifest is loaded: `useModels`). */
   private models = new Registry();
@@ -62,6 +65,8 @@ export class App implements ModeHost {
   private readonly exportBtn = $<HTMLButtonElement>('export-btn');
   private readonly exportGlbBtn = $<HTMLButtonElement>('export-glb-btn');
   private readonly restPoseSelect = $<HTMLSelectElement>('rest-pose');
+  /** The Export menu's "on my character" switch, shown once a character is loaded. */
+  private readonly onCharacter = { row: $('export-on-character-row'), box: $<HTMLInputElement>('export-on-character'), name: $('export-on-character-name') };
   /** Snapshot and Record. */
   readonly capture: Capture;
   /** The header's Export menu (exports, snapshot, record). */
@@ -94,6 +99,7 @@ export class App implements ModeHost {
     this.viewer = new Viewer($('stage'));
     this.panel = new Panel(this.viewer);
     this.toasts = new Toasts($('toasts'));
+    this.characters = new CharacterInput(this.viewer);
     this.viewer.onFrame = (s) => {
       this.panel.update(s);
       if (this.mode === 'clip') this.cleanup?.frame(s);
@@ -355,6 +361,7 @@ export class App implements ModeHost {
   exportCurrent(format: 'bvh' | 'glb'): void {
     const m = this.current;
     if (!m) return;
+    if (this.characters.current && this.onCharacter.box.checked) return void this.exportOnCharacter(m, format);
     const write = (restPose: RestPose) =>
       format === 'bvh'
         ? new Blob([exportBVH(m, { restPose })], { type: 'text/plain' })
@@ -375,11 +382,46 @@ export class App implements ModeHost {
     }
   }
 
+  /** Downloads `m` on the user's character: its skeleton (BVH) or its mesh, skin and materials animated (GLB). */
+  private async exportOnCharacter(m: Motion, format: 'bvh' | 'glb'): Promise<void> {
+    const name = `${this.exportName()}-${this.characters.current!.name}`;
+    try {
+      const blob = format === 'bvh'
+        ? new Blob([this.characters.exportBVH(m)], { type: 'text/plain' })
+        : new Blob([await this.characters.exportGLB(m, name)], { type: 'model/gltf-binary' });
+      downloadBlob(`${name}.${format}`, blob);
+    } catch (e) {
+      this.reportError(`Export failed: ${errorMessage(e)}`);
+    }
+  }
+
+  /**
+   * Loads a character (a dropped or picked .glb, .gltf or .vrm, an attribute's URL, the API's source); a failure is
+   * shown and keeps the character and motion shown. Resolves with what loadCharacter resolves to; rejects as shown.
+   */
+  async loadCharacter(...args: Parameters<CharacterInput['load']>): ReturnType<CharacterInput['load']> {
+    const info = await this.characters.load(...args);
+    this.onCharacter.row.hidden = false;
+    this.onCharacter.name.textContent = info.name;
+    return info;
+  }
+
   /**
    * Imports dropped or picked files in the import worker: one .bvh, or an .amc with its .asf (dropped
    * together or the .asf first). Large ones show their progress; a failure leaves the scene as it was.
    */
   async handleFiles(files: File[]): Promise<void> {
+    const character = files.find((f) => CHARACTER_FILE.test(f.name));
+    if (character) {
+      try {
+        const info = await this.loadCharacter(character);
+        this.note(`Character ${info.name} loaded: ${info.bones.length} bones, ${info.height.toFixed(2)} m tall.`);
+      } catch (e) {
+        this.reportError(`Character: ${errorMessage(e)}`);
+      }
+      files = files.filter((f) => f !== character);
+      if (!files.length) return;
+    }
     const bytes = files.reduce((sum, f) => sum + f.size, 0);
     let outcome: FileImportOutcome;
     try {

@@ -1,4 +1,4 @@
-// Fetching the <motion-playground> element's `src`: only from the page's own origin or an allowed
+// Fetching the <motion-playground> element's `src` (and its `character` file, fetchSourceBytes): only from the page's own origin or an allowed
 // list, over http(s), at most MAX_SOURCE_BYTES, gunzipped when gzipped. Errors say why, briefly, quoting the URL
 // short (MAX_URL_QUOTE characters): a `src` may be any length.
 
@@ -55,6 +55,25 @@ export const SOURCE_TIMEOUT_MS = 30_000;
  * whole fetch fails after `timeoutMs` (SOURCE_TIMEOUT_MS) without an answer.
  */
 export async function fetchMotionSource(src: string, pageHref: string, allowed: readonly string[], fetchFn: typeof fetch = fetch, timeoutMs = SOURCE_TIMEOUT_MS): Promise<string> {
+  return fetchWithin(src, pageHref, allowed, timeoutMs, async (url, signal) => {
+    const bytes = await fetchChecked(url, pageHref, allowed, fetchFn, signal);
+    const gzipped = bytes.length > 2 && bytes[0] === 0x1f && bytes[1] === 0x8b;
+    if (!gzipped) return new TextDecoder().decode(bytes);
+    const unzipped = new Response(new Blob([bytes as BlobPart]).stream().pipeThrough(new DecompressionStream('gzip')));
+    return new TextDecoder().decode(await readLimited(unzipped, quoteUrl(url.href)));
+  });
+}
+
+/**
+ * The bytes at `src` as they are (no gunzip), under the same rules as fetchMotionSource: allowed origins, the final
+ * URL after redirects checked, MAX_SOURCE_BYTES, the `timeoutMs` deadline. (The `character` attribute's file.)
+ */
+export function fetchSourceBytes(src: string, pageHref: string, allowed: readonly string[], fetchFn: typeof fetch = fetch, timeoutMs = SOURCE_TIMEOUT_MS): Promise<Uint8Array> {
+  return fetchWithin(src, pageHref, allowed, timeoutMs, (url, signal) => fetchChecked(url, pageHref, allowed, fetchFn, signal));
+}
+
+/** Runs `read` on the checked URL of `src`, failing after `timeoutMs` (its signal aborts then). */
+async function fetchWithin<T>(src: string, pageHref: string, allowed: readonly string[], timeoutMs: number, read: (url: URL, signal: AbortSignal) => Promise<T>): Promise<T> {
   const url = checkSourceUrl(src, pageHref, allowed);
   const controller = new AbortController();
   let timer: ReturnType<typeof setTimeout> | undefined;
@@ -67,13 +86,14 @@ export async function fetchMotionSource(src: string, pageHref: string, allowed: 
   });
   try {
     // Raced as well as aborted: a fetch that ignores its signal cannot hold the element either.
-    return await Promise.race([fetchChecked(url, pageHref, allowed, fetchFn, controller.signal), deadline]);
+    return await Promise.race([read(url, controller.signal), deadline]);
   } finally {
     clearTimeout(timer);
   }
 }
 
-async function fetchChecked(url: URL, pageHref: string, allowed: readonly string[], fetchFn: typeof fetch, signal: AbortSignal): Promise<string> {
+/** The response's bytes, checked (final origin, HTTP status, size). */
+async function fetchChecked(url: URL, pageHref: string, allowed: readonly string[], fetchFn: typeof fetch, signal: AbortSignal): Promise<Uint8Array> {
   let response: Response;
   try {
     response = await fetchFn(url.href, { credentials: 'same-origin', signal });
@@ -91,11 +111,7 @@ async function fetchChecked(url: URL, pageHref: string, allowed: readonly string
   if (!response.ok) throw new Error(`${quoteUrl(url.href)}: HTTP ${response.status}`);
   const declared = Number(response.headers.get('content-length'));
   if (declared > MAX_SOURCE_BYTES) throw new Error(`${quoteUrl(url.href)} is ${(declared / MIB).toFixed(1)} MiB; the limit is ${MAX_SOURCE_BYTES / MIB} MiB`);
-  const bytes = await readLimited(response, quoteUrl(url.href));
-  const gzipped = bytes.length > 2 && bytes[0] === 0x1f && bytes[1] === 0x8b;
-  if (!gzipped) return new TextDecoder().decode(bytes);
-  const unzipped = new Response(new Blob([bytes as BlobPart]).stream().pipeThrough(new DecompressionStream('gzip')));
-  return new TextDecoder().decode(await readLimited(unzipped, quoteUrl(url.href)));
+  return readLimited(response, quoteUrl(url.href));
 }
 
 async function readLimited(response: Response, what: string): Promise<Uint8Array> {
