@@ -1,5 +1,5 @@
 import { describe, expect, it } from 'vitest';
-import { CONTACT_THRESHOLDS, detectContacts, findFootJoints, percentile } from '../../web/motion/contacts';
+import { CONTACT_THRESHOLDS, detectContacts, findFootJoints, footJointsOf, percentile } from '../../web/motion/contacts';
 import { parseAMC } from '../../web/motion/asfamc';
 import { parseBVH } from '../../web/motion/bvh';
 import type { Motion } from '../../web/motion/types';
@@ -124,5 +124,31 @@ describe('percentile', () => {
     expect(percentile([4, 1, 3, 2], 5)).toBeCloseTo(1.15, 12);
     expect(percentile([5], 5)).toBe(5);
     expect(percentile([0, 10], 50)).toBe(5);
+  });
+});
+
+describe('footJointsOf', () => {
+  it('finds the feet of a skeleton whose names no rule knows by the humanoid mapper, with the same contacts', () => {
+    const named = parseBVH(readCorpus('cmu/bvh/07_04.bvh.gz'));
+    const nameless = { ...named, joints: named.joints.map((_, j) => `bone${j}`) };
+    expect(findFootJoints(nameless.joints, 'left')).toBeUndefined();
+    expect(footJointsOf(nameless)).toEqual(footJointsOf(named));
+    expect(detectContacts(nameless)).toEqual(detectContacts(named));
+  });
+
+  it('gives a Bandai Namco walk (Foot_L, Toes_L) contacts on both feet', () => {
+    const m = parseBVH(readCorpus('bandai/bvh/dataset-2_walk_normal_001.bvh.gz'), { unitScale: 0.01 });
+    const [left, right] = footJointsOf(m)!;
+    expect([m.joints[left.ankle], m.joints[left.toe], m.joints[right.ankle], m.joints[right.toe]]).toEqual(['Foot_L', 'Toes_L', 'Foot_R', 'Toes_R']);
+    const contacts = detectContacts(m)!;
+    for (const { fraction, touchDowns } of summary(m, contacts)) {
+      expect(fraction).toBeGreaterThan(0.2);
+      expect(touchDowns).toBeGreaterThanOrEqual(3);
+    }
+  });
+
+  it('is undefined for a skeleton that is not a humanoid', () => {
+    const m = parseBVH(readCorpus('cmu/bvh/07_04.bvh.gz'));
+    expect(footJointsOf({ ...m, joints: m.joints.map((_, j) => `bone${j}`), parents: m.parents.map((_, j) => j - 1) })).toBeUndefined();
   });
 });

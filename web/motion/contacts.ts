@@ -4,6 +4,7 @@
 // of that joint's y over the clip) and speed v = |central-difference velocity| in m/s. A foot turns
 // ON when (h_ankle < 0.05 and v_ankle < 0.5) or (h_toe < 0.04 and v_toe < 0.5), and turns OFF only
 // when neither (h_ankle < 0.07 and v_ankle < 0.75) nor (h_toe < 0.06 and v_toe < 0.75) holds.
+import { CANONICAL_JOINTS, mapHumanoid } from './humanoid';
 import type { Motion } from './types';
 
 export const CONTACT_THRESHOLDS = {
@@ -85,9 +86,29 @@ function heightAndSpeed(motion: Motion, joint: number): { height: Float64Array; 
   return { height, speed };
 }
 
+/**
+ * Both feet's ankle and toe joints (left, right): by name (findFootJoints, the rule the Python side shares), else by
+ * the humanoid mapper (humanoid.ts), which finds the feet of any humanoid skeleton whatever its names (a foot without
+ * toe joints uses its ankle for both); undefined for a skeleton that is not a humanoid.
+ */
+export function footJointsOf(motion: Pick<Motion, 'joints' | 'parents' | 'frames' | 'positions'>): [FootJoints, FootJoints] | undefined {
+  const named = [findFootJoints(motion.joints, 'left'), findFootJoints(motion.joints, 'right')];
+  if (named[0] && named[1]) return named as [FootJoints, FootJoints];
+  try {
+    const { source } = mapHumanoid(motion);
+    const foot = (side: 'Left' | 'Right'): FootJoints => {
+      const ankle = source[CANONICAL_JOINTS.indexOf(`${side}Foot`)], toe = source[CANONICAL_JOINTS.indexOf(`${side}ToeBase`)];
+      return { ankle, toe: toe >= 0 ? toe : ankle };
+    };
+    return [foot('Left'), foot('Right')];
+  } catch {
+    return undefined;
+  }
+}
+
 /** Foot contacts, frames × 2 (left, right; 1 = planted), or undefined if the feet cannot be found. */
 export function detectContacts(motion: Motion): Uint8Array | undefined {
-  const sides = [findFootJoints(motion.joints, 'left'), findFootJoints(motion.joints, 'right')];
+  const sides = footJointsOf(motion) ?? [undefined, undefined];
   if (!sides[0] || !sides[1]) return undefined;
   const T = CONTACT_THRESHOLDS;
   const contacts = new Uint8Array(motion.frames * 2);

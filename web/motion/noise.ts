@@ -1,7 +1,7 @@
 // Synthetic capture noise, for trying clean-up (lowpass.ts, footLock.ts) on a clean clip: Gaussian jitter,
 // outlier poses (marker swaps, glitches) and feet that slide while planted (inertial-suit drift). Seeded,
 // so the same options always give the same noise.
-import { findFootJoints } from './contacts';
+import { footJointsOf } from './contacts';
 import { Rng } from './random';
 import { quoteInput } from './text';
 import type { Motion } from './types';
@@ -68,9 +68,9 @@ const stream = (seed: number, kind: number) => new Rng((seed ^ Math.imul(kind, 0
 
 /** The ankle and every joint below it, per side; parents come before children, so one pass finds them. */
 function footChains(motion: Motion): number[][] {
-  return (['left', 'right'] as const).map((side) => {
-    const feet = findFootJoints(motion.joints, side);
-    if (!feet) throw new Error(`noise: drift needs the feet, but no ${side} ankle and toe joints were found by name`);
+  const both = footJointsOf(motion);
+  if (!both) throw new Error('noise: drift needs the feet, but this skeleton is not a humanoid whose feet can be found');
+  return both.map((feet) => {
     const inChain = motion.parents.map(() => false);
     const chain: number[] = [];
     motion.parents.forEach((p, j) => {

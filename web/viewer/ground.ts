@@ -4,7 +4,7 @@
 import * as THREE from 'three';
 import { PALETTE } from './palette';
 import type { Motion } from '../motion/types';
-import { findFootJoints } from '../motion/contacts';
+import { footJointsOf } from '../motion/contacts';
 
 export const BACKGROUND = PALETTE.background;
 export const FLOOR_COLOR = PALETTE.floor;
@@ -165,7 +165,7 @@ function findFootprints(motion: Motion, contacts: Uint8Array | undefined): Footp
   const prints: Footprint[] = [];
   if (!contacts || contacts.length < motion.frames * 2) return prints;
   const J = motion.joints.length, P = motion.positions;
-  const feet = [findFootJoints(motion.joints, 'left'), findFootJoints(motion.joints, 'right')];
+  const feet = footJointsOf(motion) ?? [undefined, undefined];
   for (const side of [0, 1] as const) {
     const ft = feet[side];
     if (!ft) continue;
