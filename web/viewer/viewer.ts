@@ -37,6 +37,8 @@ export interface RenderStats {
   look: Look;
   /** Vertices of the character drawn now (0: none drawn, the look is 'skeleton' or the skeleton does not map to a humanoid). */
   characterVertices: number;
+  /** Vertices of the companion's character drawn now (Compare's second figure; 0: none). */
+  companionVertices: number;
 }
 
 /** How far (m) a companion figure is drawn beside the main one, towards the left of the screen. */
@@ -513,6 +515,7 @@ export class Viewer {
       software: this.gl.software,
       look: this.look,
       characterVertices: this.character && this.look !== 'skeleton' ? this.character.mannequin.vertexCount : 0,
+      companionVertices: this.companion?.character && this.look !== 'skeleton' ? this.companion.character.mannequin.vertexCount : 0,
     };
   }
 
