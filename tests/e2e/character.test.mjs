@@ -1,0 +1,298 @@
+// Issue 40, "Bring your own character" and "Export the animated character": a rigged humanoid loaded by
+// playground.loadCharacter (a URL, a Blob, bytes), dropped on the page, named by the element's `character` attribute
+// or the page's `character=` URL parameter; rigs of other namings made in the page with three.js's GLTFExporter
+// (tests/support/characterRigs.mjs: Mixamo-prefixed and 0.01-scaled in an A-pose, VRM 0.x and 1.0 humanoid maps, a
+// skeleton facing −z); Compare with two characters side by side; bad files refused with a short message that keeps
+// the character and motion shown; the export of the animated character read back by three.js's GLTFLoader.
+// The CC0 character ../shared/characters/quaternius-human-male.glb is served to the page by a route, never copied.
+import assert from 'node:assert/strict';
+import { readFileSync } from 'node:fs';
+import path from 'node:path';
+import { describe, before, test } from 'node:test';
+import { corpusText, installUiLookups, ROOT, sitePage, usePlayground, waitUntil } from './harness.mjs';
+
+const CHARACTER = path.resolve(ROOT, '../shared/characters/quaternius-human-male.glb');
+const RIGS = `/@fs${ROOT}tests/support/characterRigs.mjs`;
+const WALK = 'cmu/bvh/07_04.bvh.gz';
+const CORP = { 'Cross-Origin-Resource-Policy': 'same-origin' };
+
+describe('your own character', { timeout: 600_000 }, () => {
+  const suite = usePlayground();
+  const pages = new Map();
+
+  before(async () => {
+    const glb = readFileSync(CHARACTER);
+    // Every page of the context: the character under characters/, site pages under site/.
+    await suite.context.route(`${suite.url}characters/**`, (route) => {
+      const file = new URL(route.request().url()).pathname.replace(/^\/characters\//, '');
+      if (file === 'quaternius-human-male.glb') return route.fulfill({ status: 200, contentType: 'model/gltf-binary', headers: CORP, body: glb });
+      if (file === 'truncated.glb') return route.fulfill({ status: 200, contentType: 'model/gltf-binary', headers: CORP, body: glb.subarray(0, 100_000) });
+      return route.fulfill({ status: 404, body: 'not here' });
+    });
+    await suite.context.route(`${suite.url}site/**`, (route) => {
+      const file = new URL(route.request().url()).pathname.replace(/^\/site\//, '');
+      if (pages.has(file)) return route.fulfill({ status: 200, contentType: 'text/html', body: pages.get(file) });
+      if (file === 'characters/quaternius-human-male.glb') return route.fulfill({ status: 200, contentType: 'model/gltf-binary', body: glb });
+      if (file === 'characters/truncated.glb') return route.fulfill({ status: 200, contentType: 'model/gltf-binary', body: glb.subarray(0, 100_000) });
+      return route.fulfill({ status: 404, body: 'not here' });
+    });
+    await suite.page.evaluate(async (text) => {
+      window.walk = await window.playground.importMotion(text, 'bvh');
+    }, corpusText(WALK));
+  });
+
+  /** Shows the CMU walk and loads the quaternius character by URL; resolves to what loadCharacter resolved. */
+  const loadQuaternius = () =>
+    suite.page.evaluate(async () => {
+      window.playground.show(window.walk, 'walk');
+      return window.playground.loadCharacter('characters/quaternius-human-male.glb');
+    });
+
+  test('loadCharacter reads the quaternius rig: Unreal-style names mapped, its height and rest pose; drawn for the shown clip', async () => {
+    const { page } = suite;
+    const info = await loadQuaternius();
+    assert.equal(info.name, 'quaternius-human-male');
+    assert.equal(info.bones.length, 66);
+    assert.equal(info.parents.length, 66);
+    assert.equal(info.mapSource, 'mapped');
+    assert.deepEqual(
+      [info.mapping.Hips, info.mapping.LeftUpLeg, info.mapping.LeftLeg, info.mapping.LeftFoot, info.mapping.RightArm, info.mapping.RightHand, info.mapping.Head],
+      ['pelvis', 'thigh_l', 'calf_l', 'foot_l', 'upperarm_r', 'hand_r', 'head'],
+    );
+    for (const point of info.missing) assert.ok(!(point in info.mapping), `${point} is both mapped and missing`);
+    assert.ok(info.height > 1.5 && info.height < 1.9, `height ${info.height} m`);
+    assert.equal(info.restPose.rotations.length, 66);
+    assert.equal(info.restPose.translations.length, 66);
+    // Rest positions in metres: the feet near the floor, the head ~height up.
+    const ys = info.restPose.positions.map((p) => p[1]);
+    assert.ok(Math.min(...ys) > -0.05 && Math.min(...ys) < 0.1, `lowest rest point ${Math.min(...ys)} m`);
+    assert.ok(Math.abs(Math.max(...ys) - info.height) < 0.05, `highest rest point ${Math.max(...ys)} m vs height ${info.height}`);
+    const drawn = await waitUntil(page, () => window.playground.stats().characterVertices === 7399 && window.playground.stats(), null, { message: 'the character is drawn' });
+    assert.equal(drawn.look, 'character');
+    assert.deepEqual(await page.evaluate(() => window.playground.character()?.name), 'quaternius-human-male');
+    // Retargeted onto its own skeleton: its bone names, the shown clip's frames, feet on the floor.
+    const r = await page.evaluate(() => {
+      const m = window.playground.retarget(window.walk);
+      const J = m.joints.length;
+      let low = Infinity;
+      const foot = m.joints.indexOf('ball_l');
+      for (let f = 0; f < m.frames; f++) low = Math.min(low, m.positions[(f * J + foot) * 3 + 1]);
+      return { joints: m.joints.length, first: m.joints[0], frames: m.frames, shown: window.playground.current().frames, low };
+    });
+    assert.deepEqual([r.joints, r.first, r.frames], [66, 'root', r.shown]);
+    assert.ok(r.low > -0.05 && r.low < 0.08, `the left ball's lowest height ${r.low} m`);
+    // Back to the mannequin.
+    await page.evaluate(() => window.playground.clearCharacter());
+    await waitUntil(page, () => window.playground.stats().characterVertices !== 7399, null, { message: 'the mannequin is back' });
+    assert.equal(await page.evaluate(() => window.playground.character()), null);
+  });
+
+  test('rigs of other namings load and retarget facing the source: Mixamo 0.01 in an A-pose, VRM 0.x and 1.0 maps, facing −z', async () => {
+    const results = await suite.page.evaluate(async (rigsUrl) => {
+      const rigs = await import(rigsUrl);
+      const pg = window.playground;
+      const cases = {
+        mixamo: { naming: 'mixamo', scale: 0.01, pose: 'A' },
+        vrm0: { naming: 'vrm', vrm: 0 },
+        vrm1: { naming: 'vrm', vrm: 1, pose: 'A' },
+        backwards: { naming: 'vrm', facing: -1 },
+      };
+      const src = window.walk;
+      const SJ = src.joints.length;
+      const s = (name, f) => Array.from(src.positions.subarray((f * SJ + src.joints.indexOf(name)) * 3, (f * SJ + src.joints.indexOf(name)) * 3 + 3));
+      const out = {};
+      for (const [key, options] of Object.entries(cases)) {
+        const info = await pg.loadCharacter(await rigs.makeRig(options));
+        const m = pg.retarget(src);
+        const J = m.joints.length;
+        const p = (name, f) => Array.from(m.positions.subarray((f * J + m.joints.indexOf(name)) * 3, (f * J + m.joints.indexOf(name)) * 3 + 3));
+        // Over the clip: the cosine between the character's hip line (right → left) and the source's, and its hips' height.
+        let cos = 0, hipY = 0;
+        const [lh, rh, hips] = [info.mapping.LeftUpLeg, info.mapping.RightUpLeg, info.mapping.Hips];
+        for (let f = 0; f < m.frames; f++) {
+          const a = p(lh, f).map((v, i) => v - p(rh, f)[i]), b = s('LeftUpLeg', f).map((v, i) => v - s('RightUpLeg', f)[i]);
+          cos += (a[0] * b[0] + a[2] * b[2]) / (Math.hypot(a[0], a[2]) * Math.hypot(b[0], b[2]) || 1);
+          hipY += p(hips, f)[1];
+        }
+        out[key] = { mapSource: info.mapSource, height: info.height, leftUpLeg: info.mapping.LeftUpLeg, leftHand: info.mapping.LeftHand, missing: info.missing, cos: cos / m.frames, hipY: hipY / m.frames };
+      }
+      return out;
+    }, RIGS);
+    assert.equal(results.mixamo.leftUpLeg, 'mixamorig:LeftUpLeg');
+    assert.equal(results.mixamo.leftHand, 'mixamorig:LeftHand');
+    assert.equal(results.mixamo.mapSource, 'mapped');
+    assert.equal(results.vrm0.mapSource, 'vrm0');
+    assert.equal(results.vrm1.mapSource, 'vrm1');
+    assert.equal(results.vrm0.leftUpLeg, 'leftUpperLeg');
+    for (const [key, r] of Object.entries(results)) {
+      assert.ok(Math.abs(r.height - 1.72) < 0.03, `${key}: height ${r.height} m (the body is 1.72 m, whatever its units)`);
+      assert.ok(r.cos > 0.95, `${key}: the character's hip line follows the source's (mean cosine ${r.cos.toFixed(3)})`);
+      assert.ok(r.hipY > 0.75 && r.hipY < 1.05, `${key}: hips at ${r.hipY.toFixed(2)} m`);
+    }
+  });
+
+  test('a .glb dropped on the page becomes the character', async () => {
+    const { page } = suite;
+    await page.evaluate(() => window.playground.clearCharacter());
+    await page.evaluate(async () => {
+      window.playground.show(window.walk, 'walk');
+      const bytes = await (await fetch('characters/quaternius-human-male.glb')).arrayBuffer();
+      const data = new DataTransfer();
+      data.items.add(new File([bytes], 'dropped-hero.glb', { type: 'model/gltf-binary' }));
+      $uiFrame().dispatchEvent(new DragEvent('drop', { dataTransfer: data, bubbles: true, cancelable: true }));
+    });
+    const name = await waitUntil(page, () => window.playground.character()?.name, null, { message: 'the dropped character is loaded' });
+    assert.equal(name, 'dropped-hero');
+    await waitUntil(page, () => window.playground.stats().characterVertices === 7399, null, { message: 'the dropped character is drawn' });
+    assert.equal(await page.evaluate(() => window.playground.current().frames), 450, 'the motion stays');
+    // The Export menu offers the export on it.
+    assert.equal(await page.evaluate(() => $ui('export-on-character-row').hidden), false);
+  });
+
+  test('the character attribute loads one; a bad one fires error with a short reason', async () => {
+    pages.set('attr.html', sitePage(`
+      <motion-playground id="good" character="characters/quaternius-human-male.glb" controls="minimal"></motion-playground>
+      <motion-playground id="far" character="https://example.com/hero.glb" controls="none"></motion-playground>`));
+    const page = await suite.context.newPage();
+    try {
+      await page.goto(`${suite.url}site/attr.html`, { waitUntil: 'load' });
+      await waitUntil(page, () => ['good', 'far'].every((id) => window.events.some((e) => e.id === id && e.type === 'load')), null, { timeout: 90_000, message: 'both elements load' });
+      const r = await page.evaluate(() => {
+        const [good, far] = document.querySelectorAll('motion-playground');
+        return {
+          good: good.playground.character()?.name ?? null,
+          prop: good.character,
+          farError: window.events.find((e) => e.id === 'far' && e.type === 'error')?.detail.reason ?? null,
+          far: far.playground.character(),
+        };
+      });
+      assert.equal(r.good, 'quaternius-human-male');
+      assert.equal(r.prop, 'characters/quaternius-human-male.glb');
+      assert.match(r.farError, /^character: .*example\.com.*(origin|allowed)/);
+      assert.ok(r.farError.length <= 300);
+      assert.equal(r.far, null);
+      // Changing the attribute to a broken file fires error and keeps the character.
+      await page.evaluate(() => (document.getElementById('good').character = 'characters/truncated.glb'));
+      const reason = await waitUntil(page, () => window.events.find((e) => e.id === 'good' && e.type === 'error')?.detail.reason, null, { message: 'the broken file fires error' });
+      assert.match(reason, /^character: .*(cut short|could not be read)/);
+      assert.equal(await page.evaluate(() => document.getElementById('good').playground.character()?.name), 'quaternius-human-male');
+    } finally {
+      await page.close();
+    }
+  });
+
+  test('the page loads the character of its URL parameter character=', async () => {
+    const page = await suite.context.newPage();
+    try {
+      await page.addInitScript(installUiLookups);
+      await page.goto(`${suite.url}?mode=clip&character=characters/quaternius-human-male.glb`, { waitUntil: 'load' });
+      await page.waitForFunction(() => window.playground !== undefined);
+      const name = await waitUntil(page, () => window.playground.character()?.name, null, { timeout: 60_000, message: 'the URL parameter loads the character' });
+      assert.equal(name, 'quaternius-human-male');
+      assert.match(page.url(), /character=characters/, 'the parameter stays in the link');
+    } finally {
+      await page.close();
+    }
+  });
+
+  test('bad files are refused with a short message, and the character and motion shown stay', async () => {
+    const { page } = suite;
+    await loadQuaternius();
+    const r = await page.evaluate(async (rigsUrl) => {
+      const rigs = await import(rigsUrl);
+      const pg = window.playground;
+      const full = new Uint8Array(await (await fetch('characters/quaternius-human-male.glb')).arrayBuffer());
+      const bad = {
+        noSkin: await rigs.makeRig({ skin: false }),
+        truncated: full.slice(0, 200_000),
+        noLegs: await rigs.makeRig({ legs: false }),
+        notGltf: new TextEncoder().encode('HIERARCHY\nROOT Hips'),
+        huge: new Blob([new Uint8Array(33 * 1024 * 1024)]),
+        missingUrl: 'characters/nothing.glb',
+      };
+      const out = {};
+      for (const [key, source] of Object.entries(bad)) {
+        try {
+          await pg.loadCharacter(source);
+          out[key] = { message: null };
+        } catch (e) {
+          out[key] = { message: e.message, lastError: pg.lastError(), character: pg.character()?.name, frames: pg.current()?.frames };
+        }
+      }
+      return out;
+    }, RIGS);
+    const expected = {
+      noSkin: /no skinned mesh/,
+      truncated: /cut short|could not be read/,
+      noLegs: /not a humanoid.*(leg|foot|feet)/i,
+      notGltf: /not a glTF file/,
+      huge: /33\.0 MiB; the limit is 32 MiB/,
+      missingUrl: /HTTP 404/,
+    };
+    for (const [key, pattern] of Object.entries(expected)) {
+      const o = r[key];
+      assert.ok(o.message, `${key} is refused`);
+      assert.match(o.message, /^loadCharacter: /, key);
+      assert.match(o.message, pattern, key);
+      assert.ok(o.message.length <= 300, `${key}: ${o.message.length} characters`);
+      assert.equal(o.lastError, o.message, `${key}: shown on the page`);
+      assert.equal(o.character, 'quaternius-human-male', `${key}: the character stays`);
+      assert.equal(o.frames, 450, `${key}: the motion stays`);
+    }
+    assert.equal(await page.evaluate(() => window.playground.stats().characterVertices), 7399, 'still drawn');
+    // The missing URL's 404 is the browser's own console line: expected here, and the only one.
+    const problems = suite.problems.splice(0);
+    assert.deepEqual(problems.filter((p) => !/status of 404/.test(p)), []);
+  });
+
+  test('exportGLB(motion, { character: true }) reads back in GLTFLoader: one skin, and every bone within 1 mm of retarget() on every frame', async () => {
+    const { page } = suite;
+    await loadQuaternius();
+    const r = await page.evaluate(async (rigsUrl) => {
+      const rigs = await import(rigsUrl);
+      const pg = window.playground;
+      const clip = { ...window.walk, frames: 90, positions: window.walk.positions.slice(0, 90 * window.walk.joints.length * 3), contacts: undefined };
+      const bytes = await pg.exportGLB(clip, { character: true, name: 'hero-walk' });
+      const expected = pg.retarget(clip);
+      const back = await rigs.playBack(bytes, clip.fps, clip.frames, expected.joints);
+      let worst = 0;
+      expected.joints.forEach((_, k) => {
+        for (let f = 0; f < clip.frames; f++) {
+          for (let i = 0; i < 3; i++) worst = Math.max(worst, Math.abs(back.positions[k][f * 3 + i] - expected.positions[(f * expected.joints.length + k) * 3 + i]));
+        }
+      });
+      const bvh = pg.exportBVH(clip, { character: true });
+      const fromBvh = await pg.importMotion(bvh, 'bvh');
+      return { bytes: bytes.length, isUint8: bytes instanceof Uint8Array, ...back, positions: undefined, worst, bvhJoints: fromBvh.joints, bvhFrames: fromBvh.frames, plain: pg.exportGLB(clip) instanceof Uint8Array };
+    }, RIGS);
+    assert.ok(r.isUint8 && r.bytes > 100_000, `${r.bytes} bytes`);
+    assert.equal(r.plain, true, 'the plain export is still bytes, not a promise');
+    assert.equal(r.skinnedMeshes, 1);
+    assert.equal(r.bones, 66);
+    assert.equal(r.clips, 1);
+    assert.equal(r.tracks, 67, 'a rotation per bone and the root translation');
+    assert.ok(r.found.every(Boolean), 'every bone is a node of the file');
+    assert.ok(r.worst < 0.001, `worst bone position error ${(r.worst * 1000).toFixed(3)} mm`);
+    assert.equal(r.bvhFrames, 90);
+    assert.ok(r.bvhJoints.includes('thigh_l') && r.bvhJoints.includes('pelvis'), 'the BVH is on the character\'s skeleton');
+  });
+
+  test('Compare: Random walk side by side draws two characters, the companion its own', async () => {
+    const { page } = suite;
+    const companion = await page.evaluate(async (rigsUrl) => {
+      const rigs = await import(rigsUrl);
+      await window.playground.loadCharacter('characters/quaternius-human-male.glb');
+      return window.playground.loadCharacter(await rigs.makeRig({ naming: 'mixamo', scale: 0.01, pose: 'A' }), { companion: true });
+    }, RIGS);
+    await page.evaluate(() => {
+      $ui('mode-walk').click();
+      if (!$ui('walk-refine').checked) $ui('walk-refine').click();
+      if (!$ui('walk-side-by-side').checked) $ui('walk-side-by-side').click();
+    });
+    const stats = await waitUntil(page, () => window.playground.stats().companionVertices > 0 && window.playground.stats(), null, { timeout: 180_000, message: 'the companion is drawn as a character' });
+    assert.equal(stats.characterVertices, 7399, 'the main figure is the quaternius character');
+    assert.equal(stats.companionVertices, companion.vertices, 'the companion is the second character');
+    assert.notEqual(companion.vertices, 7399);
+    await page.evaluate(() => $ui('mode-clip').click());
+  });
+});
