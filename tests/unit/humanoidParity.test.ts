@@ -3,10 +3,11 @@
 // of many naming schemes (CMU BVH and ASF, Mixamo in centimetres, Unreal, VRM, Bandai Namco, Daz without toes,
 // iClone, a 3ds Max Biped in an A-pose, anonymous names with the sides told by the pose) posed over a few frames,
 // and a few that are not humanoids, with Python's answer: the joint at each canonical point, the naming scheme, how
-// the sides were told and the facing, or the error message. The positions are stored rounded, so both sides read the
-// same numbers: the joints chosen must be the same, the facing within 1e-4.
+// the sides were told and the facing, or the error message; and the naming schemes' tables, normalised names and
+// side votes of name pairs. The positions are stored rounded, so both sides read the same numbers: the joints chosen
+// must be the same, the facing within 1e-4.
 import { describe, expect, it } from 'vitest';
-import { CANONICAL_JOINTS, mapHumanoid, SkeletonMapError } from '../../web/motion/humanoid';
+import { CANONICAL_JOINTS, mapHumanoid, NAME_SCHEMES, normaliseName, sideByNames, SkeletonMapError } from '../../web/motion/humanoid';
 import { readRepoFile } from './corpus';
 
 interface Case {
@@ -23,7 +24,15 @@ interface Case {
   error?: string;
 }
 
-const fixture = JSON.parse(readRepoFile('tests/fixtures/humanoid_map.json')) as { canonical_joints: string[]; cases: Case[] };
+interface Fixture {
+  canonical_joints: string[];
+  schemes: Array<{ name: string; points: Record<string, string[]> }>;
+  normalised: Array<[string, string]>;
+  sides: Array<[string, string, number]>;
+  cases: Case[];
+}
+
+const fixture = JSON.parse(readRepoFile('tests/fixtures/humanoid_map.json')) as Fixture;
 
 /** What the page answers for a case, in the fixture's terms (joint names, '' where a point is derived). */
 function pageAnswer(c: Case): Partial<Case> {
@@ -43,6 +52,12 @@ describe('humanoid mapper: web/motion/humanoid.ts = training/mocap/humanoid.py',
     expect(new Set(mapped.map((c) => c.scheme)).size).toBeGreaterThanOrEqual(9);
     expect(mapped.some((c) => c.sides_by === 'pose' && c.frames > 48)).toBe(true);
     expect(new Set(fixture.cases.filter((c) => c.error).map((c) => c.error)).size).toBeGreaterThanOrEqual(4);
+  });
+
+  it('has the same naming schemes, normalised names and side words as Python', () => {
+    expect(NAME_SCHEMES.map((s) => ({ name: s.name, points: s.points }))).toEqual(fixture.schemes);
+    expect(fixture.normalised.filter(([name, n]) => normaliseName(name) !== n)).toEqual([]);
+    expect(fixture.sides.filter(([a, b, vote]) => sideByNames(a, b) !== vote)).toEqual([]);
   });
 
   it('puts every canonical point on the same joint as Python, or refuses with the same message', () => {
