@@ -30,8 +30,11 @@ function toSegment(p: THREE.Vector3, a: THREE.Vector3, b: THREE.Vector3): number
   return p.distanceTo(a.clone().addScaledVector(ab, t));
 }
 
-describe('mannequin geometry and skin', () => {
-  const mannequin = restMannequin();
+describe.each([
+  { lit: true, name: 'lit (GPU)' },
+  { lit: false, name: 'matcap, fewer triangles (software GL)' },
+])('mannequin geometry and skin: $name', ({ lit }) => {
+  const mannequin = restMannequin({ lit });
   const geometry = mannequin.mesh.geometry;
   const index = geometry.getAttribute('skinIndex');
   const weight = geometry.getAttribute('skinWeight');
@@ -43,7 +46,7 @@ describe('mannequin geometry and skin', () => {
     expect(mannequin.skeleton.bones.map((b) => b.name)).toEqual([...CANONICAL_JOINTS]);
     expect(mannequin.mesh).toBeInstanceOf(THREE.SkinnedMesh);
     expect(mannequin.vertexCount).toBe(count);
-    expect(count).toBeGreaterThan(3000); // smooth, not boxes
+    expect(count).toBeGreaterThan(lit ? 5000 : 1500); // smooth, not boxes
   });
 
   it('binds every vertex: weights sum to 1 on valid bones', () => {

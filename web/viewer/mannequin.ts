@@ -310,7 +310,10 @@ const on = (b: number): Array<[number, number]> => [[b, 1]];
 const blend = (a: number, b: number, t: number): Array<[number, number]> => [[a, 1 - t], [b, t]];
 
 /** The mannequin's tubes in the bind pose (metres, for bone lengths `L`, hips at the origin). */
-export function buildTubes(L: Float64Array, colors: MannequinColors): Tube[] {
+export function buildTubes(L: Float64Array, colors: MannequinColors, detail = 1): Tube[] {
+  // Rings per span and per cap at this level of detail.
+  const d = (n: number) => Math.max(1, Math.round(n * detail));
+  const ds = (n: number | number[]) => (Array.isArray(n) ? n.map(d) : d(n));
   const P = bindPoints(L);
   const s = (L[J.LeftLeg] + L[J.LeftFoot]) / CANONICAL_LEG || 1; // size relative to the canonical body
   const up: V3 = v(0, 1, 0), down: V3 = v(0, -1, 0), fwd: V3 = v(0, 0, 1), back: V3 = v(0, 0, -1);
@@ -333,9 +336,9 @@ export function buildTubes(L: Float64Array, colors: MannequinColors): Tube[] {
       ring(add(lerp3(sp1, neck, 0.95), v(0, 0, 0.004 * s)), 0.172, 0.1, on(J.Spine1)),
       ring(yoke, 0.17, 0.085, on(J.Spine1)),
     ];
-    const rings = sample(keys, 4);
-    const top = cap(rings[rings.length - 1], up, 0.05 * s, 5);
-    const bottom = cap(rings[0], down, 0.045 * s, 4).reverse();
+    const rings = sample(keys, ds(4));
+    const top = cap(rings[rings.length - 1], up, 0.05 * s, d(5));
+    const bottom = cap(rings[0], down, 0.045 * s, d(4)).reverse();
     tubes.push({ rings: [...bottom, ...rings, ...top], side: v(1, 0, 0), color: colors.body });
   }
 
@@ -347,8 +350,8 @@ export function buildTubes(L: Float64Array, colors: MannequinColors): Tube[] {
       ring(lerp3(neck, n1, 0.8), 0.05, 0.05, blend(J.Neck, J.Neck1, 0.4)),
       ring(lerp3(n1, head, 0.45), 0.046, 0.048, on(J.Neck1)),
     ];
-    const rings = sample(keys, 4);
-    tubes.push({ rings: [...cap(rings[0], down, 0.02 * s, 2).reverse(), ...rings, ...cap(rings[rings.length - 1], up, 0.02 * s, 2)], side: v(1, 0, 0), color: colors.body });
+    const rings = sample(keys, ds(4));
+    tubes.push({ rings: [...cap(rings[0], down, 0.02 * s, d(2)).reverse(), ...rings, ...cap(rings[rings.length - 1], up, 0.02 * s, d(2))], side: v(1, 0, 0), color: colors.body });
   }
 
   // Head: an egg, a little forward of the neck, the jaw narrower.
@@ -357,7 +360,7 @@ export function buildTubes(L: Float64Array, colors: MannequinColors): Tube[] {
     const centre = add(lerp3(head, top, 0.15), v(0, 0, 0.018 * s));
     const ry = 0.112 * s;
     const keys: Ring[] = [];
-    const n = 14;
+    const n = Math.max(8, Math.round(14 * detail));
     for (let i = 1; i < n; i++) {
       const a = (i / n) * Math.PI; // 0 = chin, π = crown
       const y = -Math.cos(a) * ry;
@@ -388,8 +391,8 @@ export function buildTubes(L: Float64Array, colors: MannequinColors): Tube[] {
         ring(lerp3(knee, ankle, 0.75), 0.036, 0.038, on(S)),
         ring(lerp3(knee, ankle, 0.98), 0.031, 0.033, on(S)),
       ];
-      const rings = sample(keys, [4, 4, 3, 3, 3, 3, 4, 3]);
-      tubes.push({ rings: [...cap(rings[0], up, 0.06 * s, 4).reverse(), ...rings, ...cap(rings[rings.length - 1], down, 0.03 * s, 3)], side: v(1, 0, 0), color });
+      const rings = sample(keys, ds([4, 4, 3, 3, 3, 3, 4, 3]));
+      tubes.push({ rings: [...cap(rings[0], up, 0.06 * s, d(4)).reverse(), ...rings, ...cap(rings[rings.length - 1], down, 0.03 * s, d(3))], side: v(1, 0, 0), color });
     }
 
     // Foot: heel → instep → ball → toe tip, the sole flat on the ground when planted.
@@ -404,8 +407,8 @@ export function buildTubes(L: Float64Array, colors: MannequinColors): Tube[] {
         ring(v(ball[0], soleY + 0.022 * s, ball[2]), 0.046, 0.022, blend(F, T, 0.5)),
         ring(v(tip[0], soleY + 0.015 * s, lerp3(ball, tip, 0.75)[2]), 0.038, 0.015, on(T)),
       ];
-      const rings = sample(keys, 4);
-      tubes.push({ rings: [...cap(rings[0], back, 0.03 * s, 4).reverse(), ...rings, ...cap(rings[rings.length - 1], fwd, 0.025 * s, 3)], side: v(1, 0, 0), color });
+      const rings = sample(keys, ds(4));
+      tubes.push({ rings: [...cap(rings[0], back, 0.03 * s, d(4)).reverse(), ...rings, ...cap(rings[rings.length - 1], fwd, 0.025 * s, d(3))], side: v(1, 0, 0), color });
     }
 
     // Arm: shoulder ball → upper arm → elbow → forearm → wrist.
@@ -422,8 +425,8 @@ export function buildTubes(L: Float64Array, colors: MannequinColors): Tube[] {
         ring(lerp3(el, wr, 0.4), 0.038, 0.04, on(F)),
         ring(lerp3(el, wr, 0.95), 0.026, 0.03, blend(F, H, 0.2)),
       ];
-      const rings = sample(keys, [4, 4, 3, 3, 3, 4]);
-      tubes.push({ rings: [...cap(rings[0], scale(dir, -1), 0.055 * s, 4).reverse(), ...rings, ...cap(rings[rings.length - 1], dir, 0.02 * s, 2)], side: v(0, 0, 1), color });
+      const rings = sample(keys, ds([4, 4, 3, 3, 3, 4]));
+      tubes.push({ rings: [...cap(rings[0], scale(dir, -1), 0.055 * s, d(4)).reverse(), ...rings, ...cap(rings[rings.length - 1], dir, 0.02 * s, d(2))], side: v(0, 0, 1), color });
     }
 
     // Hand: a mitten, flat, its width along the body's front in the bind pose (palm to the thigh when hanging).
@@ -437,18 +440,15 @@ export function buildTubes(L: Float64Array, colors: MannequinColors): Tube[] {
         ring(lerp3(wr, end, 0.8), 0.038, 0.017, on(H)),
         ring(lerp3(wr, end, 1.05), 0.03, 0.013, on(H)),
       ];
-      const rings = sample(keys, 3);
-      tubes.push({ rings: [...cap(rings[0], scale(dir, -1), 0.012 * s, 2).reverse(), ...rings, ...cap(rings[rings.length - 1], dir, 0.022 * s, 3)], side: v(0, 0, 1), color });
+      const rings = sample(keys, ds(3));
+      tubes.push({ rings: [...cap(rings[0], scale(dir, -1), 0.012 * s, d(2)).reverse(), ...rings, ...cap(rings[rings.length - 1], dir, 0.022 * s, d(3))], side: v(0, 0, 1), color });
     }
   }
   return tubes;
 }
 
-/** Vertices around each ring. */
-const SEGMENTS = 24;
-
-/** One BufferGeometry (positions, normals, colours, skin indices and weights) from the tubes. */
-export function tubeGeometry(tubes: Tube[]): THREE.BufferGeometry {
+/** One BufferGeometry (positions, normals, colours, skin indices and weights) from the tubes, `SEGMENTS` vertices around each ring. */
+export function tubeGeometry(tubes: Tube[], SEGMENTS = 24): THREE.BufferGeometry {
   let vertexCount = 0;
   for (const t of tubes) vertexCount += t.rings.length * SEGMENTS + 2;
   const pos = new Float32Array(vertexCount * 3);
@@ -574,7 +574,8 @@ export class Mannequin {
   constructor(points: Float32Array, frames: number, { colors = MANNEQUIN_COLORS, lit = true }: MannequinOptions = {}) {
     const lengths = measureBones(points, frames);
     const bind = bindPoints(lengths);
-    const geometry = tubeGeometry(buildTubes(lengths, colors));
+    // Software GL pays for every triangle (figure.ts): there, half the rings and 14 vertices around each.
+    const geometry = lit ? tubeGeometry(buildTubes(lengths, colors)) : tubeGeometry(buildTubes(lengths, colors, 0.5), 14);
     this.vertexCount = geometry.getAttribute('position').count;
 
     // Bind rotations: the same solver on the bind pose.
