@@ -7,7 +7,7 @@
 // Set BLENDER_KEEP_DIR to keep the exported files and the expected positions there.
 import assert from 'node:assert/strict';
 import { spawn } from 'node:child_process';
-import { existsSync, mkdirSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
+import { existsSync, mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { after, before, describe, test } from 'node:test';
@@ -104,6 +104,30 @@ function expectedPositions(clip, names) {
 
 const BLENDER = findBlender();
 
+/**
+ * In-page (issue 40): the CMU clip's first 120 frames on the quaternius character (../shared/characters, served by a
+ * route) and on a Mixamo-named, 0.01-scaled rig made in the page, each exported with exportGLB(clip, { character:
+ * true }); the expected positions are playground.retarget(clip)'s, keyed by the names the file gives the bones.
+ */
+function exportCharactersInPage(page, cmuText) {
+  return page.evaluate(async ({ cmuText, rigsUrl }) => {
+    const pg = window.playground;
+    const rigs = await import(rigsUrl);
+    const cmu = await pg.importMotion(cmuText, 'bvh');
+    const J = cmu.joints.length;
+    const clip = { ...cmu, frames: 120, positions: cmu.positions.slice(0, 120 * J * 3), contacts: undefined };
+    const sources = { quaternius: 'characters/quaternius-human-male.glb', mixamo: await rigs.makeRig({ naming: 'mixamo', scale: 0.01, pose: 'A' }) };
+    const out = {};
+    for (const [key, source] of Object.entries(sources)) {
+      await pg.loadCharacter(source);
+      const bytes = await pg.exportGLB(clip, { character: true, name: key });
+      const m = pg.retarget(clip);
+      out[key] = { fps: m.fps, frames: m.frames, joints: m.joints, positions: Array.from(m.positions), names: { glb: m.joints.map(rigs.threeNodeName) }, files: [{ kind: 'glb', restPose: 'character', bytes: Array.from(bytes) }] };
+    }
+    return out;
+  }, { cmuText, rigsUrl: `/@fs${ROOT}tests/support/characterRigs.mjs` });
+}
+
 describe('exports open correctly in Blender', { timeout: 600_000 }, () => {
   let server, url, browser, dir;
   before(async () => {
@@ -160,6 +184,38 @@ describe('exports open correctly in Blender', { timeout: 600_000 }, () => {
     for (const r of results) {
       assert.deepEqual(r.missing_bones, [], `${path.basename(r.file)}: a bone for every joint`);
       if (r.file.endsWith('.glb')) assert.equal(r.skinned_meshes, 1, `${path.basename(r.file)}: one mesh skinned to the armature`);
+      assert.ok(r.max_error_m <= TOLERANCE_M, `${path.basename(r.file)}: max error ${(r.max_error_m * 1000).toFixed(3)} mm at ${r.worst_joint}, frame ${r.worst_frame} (at most 1 mm)`);
+    }
+    assert.equal(run.code, 0, `Blender's exit status:\n${tail}`);
+  });
+  test('the animated character, exportGLB(motion, { character: true }): one armature deforming the mesh, every bone within 1 mm of the page\'s retargeted positions', async (t) => {
+    if (!BLENDER) {
+      t.skip('Blender not installed: apt-get install blender');
+      return;
+    }
+    const { page, problems, context } = await openPlayground(browser, url);
+    const glb = readFileSync(path.resolve(ROOT, '../shared/characters/quaternius-human-male.glb'));
+    await context.route(`${url}characters/**`, (route) => route.fulfill({ status: 200, contentType: 'model/gltf-binary', headers: { 'Cross-Origin-Resource-Policy': 'same-origin' }, body: glb }));
+    const clips = await exportCharactersInPage(page, corpusText(CMU_CLIP));
+    assert.deepEqual(problems, [], 'no console or page errors while exporting');
+    await context.close();
+    const args = [];
+    for (const [key, clip] of Object.entries(clips)) {
+      const base = path.join(dir, `character-${key}`);
+      writeFileSync(`${base}.glb`, Uint8Array.from(clip.files[0].bytes));
+      writeFileSync(`${base}.glb.expected.json`, JSON.stringify(expectedPositions(clip, clip.names.glb)));
+      args.push(`${base}.glb`, `${base}.glb.expected.json`);
+    }
+    const run = await runBlender(BLENDER, args, 480_000);
+    const results = run.stdout.split('\n').filter((l) => l.startsWith('RESULT ')).map((l) => JSON.parse(l.slice(7)));
+    for (const r of results) {
+      t.diagnostic(`${path.basename(r.file)}: max error ${(r.max_error_m * 1000).toFixed(4)} mm (${r.worst_joint ?? '-'} at frame ${r.worst_frame ?? '-'}; ${r.joints_checked} bones × ${r.frames_checked} frames; ${r.skinned_meshes} skinned mesh(es))`);
+    }
+    const tail = `${run.stdout.slice(-2000)}\n${run.stderr.slice(-2000)}`;
+    assert.equal(results.length, args.length / 2, `one RESULT line per file from Blender (exit ${run.code} ${run.signal ?? ''}):\n${tail}`);
+    for (const r of results) {
+      assert.deepEqual(r.missing_bones, [], `${path.basename(r.file)}: a bone for every bone of the character`);
+      assert.equal(r.skinned_meshes, 1, `${path.basename(r.file)}: the mesh deformed by the one armature`);
       assert.ok(r.max_error_m <= TOLERANCE_M, `${path.basename(r.file)}: max error ${(r.max_error_m * 1000).toFixed(3)} mm at ${r.worst_joint}, frame ${r.worst_frame} (at most 1 mm)`);
     }
     assert.equal(run.code, 0, `Blender's exit status:\n${tail}`);

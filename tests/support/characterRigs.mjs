@@ -206,3 +206,8 @@ export async function playBack(bytes, fps, frames, names) {
     positions: out,
   };
 }
+
+/** The name a node of `name` has after three.js's GLTFLoader (and so in a GLB three.js writes back). */
+export function threeNodeName(name) {
+  return THREE.PropertyBinding.sanitizeNodeName(name);
+}
