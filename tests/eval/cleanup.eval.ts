@@ -4,6 +4,7 @@
 import { writeFileSync } from 'node:fs';
 import { it } from 'vitest';
 import { parseAMC } from '../../web/motion/asfamc';
+import { parseBVH } from '../../web/motion/bvh';
 import { detectContacts } from '../../web/motion/contacts';
 import { addNoise } from '../../web/motion/noise';
 import { boneLengthChange, canonicalView, floorHeight, footSliding, jerk, meanJointError } from '../../web/motion/motionStats';
@@ -24,6 +25,16 @@ const LEVELS = [0.01, 0.03, 0.05];
 const OUTLIERS = 0.01;
 const MAX_FRAMES = 1200;
 const METHODS: CleanupMethod[] = ['map', 'manifold', 'lowpass'];
+
+/**
+ * Other skeletons (issue 40), measured the same way against the filter: the 3ds Max-friendly CMU conversion of an
+ * Indian dance (LeftHip, LeftKnee …; zero-offset collar and hip joints) and a Bandai Namco walk (UpperLeg_L …, a root
+ * bone on the floor; read in centimetres, its unit, which the importer's detection takes for inches until issue 39).
+ */
+const SKELETON_CLIPS = [
+  { label: '3ds Max-friendly CMU (Indian dance 94_01)', file: 'aclstm-extra/indian/94_01.bvh.gz', unitScale: undefined },
+  { label: 'Bandai Namco (walk, normal style)', file: 'bandai/bvh/dataset-2_walk_normal_001.bvh.gz', unitScale: 0.01 },
+];
 
 const info = parseGeneratorInfo(JSON.parse(readRepoFile('public/models/generator.json')), 'generator.json');
 const manifold = parseManifoldInfo(JSON.parse(readRepoFile('public/models/manifold.json')), 'manifold.json');
@@ -130,8 +141,26 @@ it('evaluates the clean-up methods', async () => {
     error_cm: +(100 * mean(method, level, 'error', 'check')).toFixed(2),
     sliding: +mean(method, level, 'sliding', 'check').toFixed(3),
   }))) };
+  const skeletonRows: { skeleton: string; method: string; level: number; error_cm: number; sliding: number; seconds: number }[] = [];
+  for (const { label, file, unitScale } of SKELETON_CLIPS) {
+    const m = parseBVH(readCorpus(file), unitScale ? { unitScale } : {});
+    const frames = Math.min(m.frames, Math.round(10 * m.fps));
+    const positions = m.positions.slice(0, frames * m.joints.length * 3);
+    const floor = floorHeight(canonicalView({ ...m, frames, positions }));
+    for (let i = 1; i < positions.length; i += 3) positions[i] -= floor;
+    const clean = { ...m, frames, positions };
+    const add = (method: string, level: number, motion: Motion) =>
+      skeletonRows.push({ skeleton: label, method, level, error_cm: +(100 * meanJointError(motion, clean)).toFixed(2), sliding: +footSliding(motion, 0).toFixed(3), seconds: +(frames / m.fps).toFixed(1) });
+    add('clean capture', 0, clean);
+    for (const level of LEVELS) {
+      const { motion: noisy } = addNoise(clean, { jitter: level, outliers: OUTLIERS, seed: 1 });
+      add('noisy input', level, noisy);
+      for (const method of ['map', 'lowpass'] as const) add(method, level, (await run(method, noisy)).motion);
+      console.log(label, level, 'done');
+    }
+  }
   const real = { jerk: +(realRows.reduce((a, r) => a + r.jerk, 0) / realRows.length).toFixed(0), sliding: +(realRows.filter((r) => Number.isFinite(r.sliding)).reduce((a, r, _, all) => a + r.sliding / all.length, 0)).toFixed(3) };
-  const out = { clips: realRows, levels: LEVELS, outliers: OUTLIERS, real, summary, check, rows };
+  const out = { clips: realRows, levels: LEVELS, outliers: OUTLIERS, real, summary, check, skeletons: skeletonRows, rows };
   writeFileSync(`${REPO_ROOT}docs/models/cleanup.json`, JSON.stringify(out, null, 1) + '\n');
   console.log(JSON.stringify(summary));
   console.log(JSON.stringify(check.summary));

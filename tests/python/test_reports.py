@@ -150,6 +150,16 @@ def test_the_cleanup_tables_show_the_numbers_in_cleanup_json():
     for s in stored["check"]["summary"]:
         error, sliding = check[f"{round(100 * s['level'])} cm"][methods.index(s["method"])].split(" / ")
         assert (float(error), float(sliding)) == (s["error_cm"], s["sliding"])
+    skeletons = {}
+    for line in text.split("\n"):
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if line.startswith("| ") and len(cells) == 5 and cells[1].endswith(" cm") and " / " in cells[2]:
+            skeletons[(cells[0], cells[1])] = cells[2:]
+    shown_rows = [s for s in stored["skeletons"] if s["method"] != "clean capture"]
+    assert len(skeletons) * 3 == len(shown_rows)
+    for s in shown_rows:
+        error, sliding = skeletons[(s["skeleton"], f"{round(100 * s['level'])} cm")][["noisy input", "map", "lowpass"].index(s["method"])].split(" / ")
+        assert (float(error), float(sliding)) == (s["error_cm"], s["sliding"])
     summary = "\n".join(report_lines("cleanup")[2:7])
     by = {(s["method"], s["level"]): s for s in stored["summary"]}
     for method in ("map", "lowpass"):
