@@ -204,3 +204,7 @@ def test_refuses_what_is_not_a_humanoid_with_a_message():
         map_humanoid(["a", "b"], [-1, 0], chain[:, :2])
     with pytest.raises(ValueError, match=r"positions must be \(frames, 3, 3\)"):
         map_humanoid(["a", "b", "c"], [-1, 0, 1], chain)
+    with pytest.raises(ValueError, match=r"joint 1 \(b\) has parent 2: each parent must be listed before its children"):
+        map_humanoid(["a", "b", "c"], [-1, 2, 0], chain[:, :3])
+    with pytest.raises(ValueError, match="finite"):
+        map_humanoid(["a", "b", "c"], [-1, 0, 1], chain[:, :3] * np.nan)

@@ -264,6 +264,7 @@ class _Tree:
         return self.pose[f][j]
 
     def lca(self, a: int, b: int) -> int:
+        """The lowest common ancestor; -1 for joints of separate trees (a skeleton with several roots)."""
         while self.depth[a] > self.depth[b]:
             a = self.parents[a]
         while self.depth[b] > self.depth[a]:
@@ -273,7 +274,10 @@ class _Tree:
         return a
 
     def tree_distance(self, a: int, b: int) -> float:
-        return self.arc[a] + self.arc[b] - 2 * self.arc[self.lca(a, b)]
+        """Along the bones; NaN between separate trees (as the page's arithmetic on a missing ancestor gives), so
+        that no comparison picks such a pair."""
+        c = self.lca(a, b)
+        return self.arc[a] + self.arc[b] - 2 * self.arc[c] if c >= 0 else math.nan
 
     def is_below(self, j: int, ancestor: int) -> bool:
         k = j
@@ -511,14 +515,22 @@ def _refuse(missing: str) -> SkeletonMapError:
 
 
 def map_humanoid(joints: Sequence[str], parents: Sequence[int], positions: np.ndarray) -> HumanoidMap:
-    """The canonical points of a humanoid skeleton: `joints` (names), `parents` (-1 for the root, each parent listed
-    before its children) and world `positions` (frames, joints, 3), any unit, y up. Raises a SkeletonMapError naming
-    what is missing for a skeleton without two legs, two arms or a head."""
+    """The canonical points of a humanoid skeleton: `joints` (names), `parents` (-1 for a root, each parent listed
+    before its children; joints of a second tree are never taken for a limb's) and world `positions` (frames, joints,
+    3), any unit, y up. Raises a SkeletonMapError naming what is missing for a skeleton without two legs, two arms or
+    a head, a ValueError for inconsistent input."""
     positions = np.asarray(positions, dtype=np.float64)
     J = len(joints)
     if len(parents) != J or positions.ndim != 3 or positions.shape[1:] != (J, 3):
         raise ValueError(f"positions must be (frames, {J}, 3) for {J} joints and {len(parents)} parents, "
                          f"found {positions.shape}")
+    # The page walks the joints in order and needs each parent before its children, as every reader lists them.
+    misplaced = next((j for j, p in enumerate(parents) if not -1 <= p < j), None)
+    if misplaced is not None:
+        raise ValueError(f"joint {misplaced} ({joints[misplaced]}) has parent {parents[misplaced]}: each parent must "
+                         "be listed before its children (or be -1 for a root)")
+    if not np.isfinite(positions).all():
+        raise ValueError("positions must be finite numbers")
     if J < 3 or positions.shape[0] < 1:
         raise _refuse(f"it has {J} joint{'' if J == 1 else 's'}, not legs, arms and a head")
     t = _Tree(parents, positions)
