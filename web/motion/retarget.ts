@@ -23,7 +23,7 @@
 import { labelContacts } from './contactLabels';
 import { twoBoneIK, smoothstep } from './footLock';
 import { CANONICAL_JOINTS, mapHumanoid, SkeletonMapError, type CanonicalJoint, type HumanoidMap } from './humanoid';
-import { cross, length, normalize, quatConjugate, quatIdentity, quatMultiply, quatNormalize, quatRotate, rotationFromTwoVectors, sub, swingRotation, type Quat, type Vec3 } from './math';
+import { cross, length, normalize, quatConjugate, quatFromAxisAngle, quatIdentity, quatMultiply, quatNormalize, quatRotate, rotationFromTwoVectors, sub, swingRotation, type Quat, type Vec3 } from './math';
 import { mapSkeleton, toCanonical } from './skeletonMap';
 import type { Motion } from './types';
 
@@ -69,6 +69,10 @@ const TYPICAL_HEIGHT = 1.7;
 const RELEASE_SECONDS = 0.15;
 /** A rig whose lowest rest foot point is within this height above y = 0 (m) stands on y = 0; else on that point. */
 const REST_FLOOR_SLACK = 0.15;
+/** The share of a foot's planted frames, lowest ankle first, taken as the foot standing flat. */
+const FLAT_SHARE = 0.25;
+/** The most a planted foot is kept above the floor (m) where the source's is higher (a contact's first and last frames). */
+const PLANTED_LIFT = 0.02;
 /** Below this sine of the angle between a segment and its twist reference, the reference is not trusted. */
 const PARALLEL_SINE = 0.08;
 /** How strongly a knee's or elbow's bend sets the limb's twist against the fallback forward (per leg length). */
@@ -228,6 +232,19 @@ function legLength(points: ArrayLike<number>, frames: number): number {
   return total / (2 * frames);
 }
 
+/** Per canonical point: 0 or 1 for the left or right foot and toe (their segments' slope is aligned), else -1. */
+const FOOT_POINTS_SIDE = CANONICAL_JOINTS.map((n) => (['LeftFoot', 'LeftToeBase'].includes(n) ? 0 : ['RightFoot', 'RightToeBase'].includes(n) ? 1 : -1));
+
+/** A direction's slope: its angle above the ground (radians, negative below). */
+const pitchOf = (d: Vec3): number => Math.atan2(d[1], Math.hypot(d[0], d[2]));
+
+/** `d` turned down by `angle` (radians) in its vertical plane; unchanged where it is (nearly) vertical. */
+function pitchDown(d: Vec3, angle: number): Vec3 {
+  const axis = cross([0, 1, 0], d);
+  if (length(axis) < 1e-6 * length(d) || angle === 0) return d;
+  return quatRotate(quatFromAxisAngle(axis, angle), d);
+}
+
 const midpoint = (a: Vec3, b: Vec3): Vec3 => [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2];
 
 function median(values: number[]): number {
@@ -288,6 +305,21 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
   const segmentEnd = RULES.map((rule, k) => rule.to.find((e) =>
     length(sub(restAt(e), restAt(k))) > minSegment && length(sub(srcAt(0, e), srcAt(0, k))) > minSegment * (sourceLeg / characterLeg)) ?? -1);
   const restDir = segmentEnd.map((e, k) => (e >= 0 ? sub(restAt(e), restAt(k)) : ([0, 0, 0] as Vec3)));
+  // Feet: the rig's flat foot (its rest) may slope more or less than the source's flat foot (its median slope over
+  // the planted frames where its ankle is lowest: flat on the floor, not landing on the heel or the ball); the foot
+  // and toes are turned down by the difference, so that a flat foot of the source is flat on the character too (toes
+  // neither floating nor sunk when the heel is down).
+  const footPitch = (['Left', 'Right'] as const).map((side, s) => {
+    const [ankle, toe] = [at(`${side}Foot`), at(`${side}ToeBase`)];
+    const planted: Array<{ height: number; pitch: number }> = [];
+    for (let f = 0; f < F; f++) {
+      if (contacts[f * 2 + s]) planted.push({ height: srcAt(f, ankle)[1], pitch: pitchOf(sub(srcAt(f, toe), srcAt(f, ankle))) });
+    }
+    planted.sort((a, b) => a.height - b.height);
+    const flattest = planted.slice(0, Math.max(1, Math.ceil(planted.length * FLAT_SHARE)));
+    const sourceFlat = planted.length ? median(flattest.map((p) => p.pitch)) : NaN;
+    return Number.isFinite(sourceFlat) ? sourceFlat - pitchOf(sub(restAt(toe), restAt(ankle))) : 0;
+  });
   const restRef = RULES.map((rule) => (rule.twist ? rule.twist(restAt) : ([0, 0, 0] as Vec3)));
   const boneOf = mapping.source;
   const pointOfBone = new Array<number>(B).fill(-1);
@@ -297,6 +329,9 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
   // Heights: the rig's rest floor, its ankles' height above it; the source's planted ankle height.
   const footPointsOf = (side: 'Left' | 'Right') => ['Foot', 'ToeBase', 'ToeBase_end'].map((n) => at(`${side}${n}` as CanonicalJoint));
   const restFootPoints = (['Left', 'Right'] as const).flatMap(footPointsOf);
+  // The points a planted foot stands on: the ankle (heel) and the toe base. Not the toe tip, which is often derived
+  // along the foot (skeletonMap.ts) and dips below the floor when the heel lifts, in the source too.
+  const solePointsOf = (side: 'Left' | 'Right') => ['Foot', 'ToeBase'].map((n) => at(`${side}${n}` as CanonicalJoint));
   const restLowest = Math.min(...restFootPoints.map((k) => restAt(k)[1]));
   const restFloor = restLowest >= 0 && restLowest <= REST_FLOOR_SLACK ? 0 : restLowest;
   const characterAnkle = (restAt(at('LeftFoot'))[1] + restAt(at('RightFoot'))[1]) / 2 - restFloor;
@@ -310,6 +345,15 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
     for (let f = 0; f < F; f++) lows.push(Math.min(srcAt(f, at('LeftFoot'))[1], srcAt(f, at('RightFoot'))[1]));
     sourceAnkle = median(lows);
   }
+  // Each source foot's height above the floor per frame (its lowest point less where that lies when planted), scaled
+  // up for a taller character but not down for a shorter one (toe clearance in the swing is a few centimetres
+  // whatever one's size): a swinging foot of the character clears the floor at least as far, so it does not scuff it.
+  const sourceFootPoints = (['Left', 'Right'] as const).map(solePointsOf);
+  const lowestOf = (f: number, s: number) => Math.min(...sourceFootPoints[s].map((k) => srcAt(f, k)[1]));
+  const plantedLows: number[] = [];
+  for (let f = 0; f < F; f++) for (let s = 0; s < 2; s++) if (contacts[f * 2 + s]) plantedLows.push(lowestOf(f, s));
+  const sourceSole = Number.isFinite(median(plantedLows)) ? median(plantedLows) : 0;
+  const swingClearance = [0, 1].map((s) => Float64Array.from({ length: F }, (_, f) => Math.max(0, lowestOf(f, s) - sourceSole) * Math.max(1, scale)));
 
   // The rest offset (m) from the hips point to the legs' hip joints' midpoint.
   const restHipJoints = sub(midpoint(restAt(at('LeftUpLeg')), restAt(at('RightUpLeg'))), restAt(at('Hips')));
@@ -323,7 +367,7 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
   const legs: LegBones[] = (['Left', 'Right'] as const).map((side) => {
     const ankle = boneOf[at(`${side}Foot`)];
     const inverseAnkle = quatConjugate(rest.rotations[ankle]);
-    const points = footPointsOf(side);
+    const points = solePointsOf(side);
     return {
       thigh: boneOf[at(`${side}UpLeg`)],
       knee: boneOf[at(`${side}Leg`)],
@@ -350,7 +394,9 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
         delta[k] = parentDelta;
         continue;
       }
-      const dir = sub(p(e), p(k));
+      let dir = sub(p(e), p(k));
+      const footSide = FOOT_POINTS_SIDE[k];
+      if (footSide >= 0) dir = pitchDown(dir, footPitch[footSide]);
       const aligned = rule.twist ? alignFrames(restDir[k], restRef[k], dir, rule.twist(p)) : undefined;
       delta[k] = aligned ?? quatNormalize(quatMultiply(swingRotation(quatRotate(parentDelta, restDir[k]), dir), parentDelta));
     }
@@ -372,7 +418,7 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
   }
 
   const mapped = pointOfBone.map((k) => k >= 0);
-  if (footIK) plantFeet(rig, legs, worlds, mapped, contacts, source.fps, unitsPerMetre, rootTranslations, restLocal, rotations, positions);
+  if (footIK) plantFeet(rig, legs, worlds, mapped, contacts, swingClearance, source.fps, unitsPerMetre, rootTranslations, restLocal, rotations, positions);
 
   for (let i = 0; i < positions.length; i++) positions[i] /= unitsPerMetre;
   const motion: Motion = { fps: source.fps, frames: F, joints: [...rig.bones], parents: [...rig.parents], positions, contacts };
@@ -418,7 +464,7 @@ function refreshUnmapped(rig: CharacterRig, world: Quat[], mapped: boolean[], re
  * shins of `worlds` and rewrites `rotations` and `positions`.
  */
 function plantFeet(
-  rig: CharacterRig, legs: LegBones[], worlds: Quat[][], mapped: boolean[], contacts: Uint8Array, fps: number, unitsPerMetre: number,
+  rig: CharacterRig, legs: LegBones[], worlds: Quat[][], mapped: boolean[], contacts: Uint8Array, swingClearance: Float64Array[], fps: number, unitsPerMetre: number,
   rootTranslations: Float32Array, restLocal: Quat[], rotations: Float32Array, positions: Float32Array,
 ): void {
   const B = rig.bones.length;
@@ -455,11 +501,16 @@ function plantFeet(
       const points = footPoints(f, leg);
       const low = lowest(points, leg);
       const anchor = previous ? previous[low.i] : points[low.i];
-      const shift: Vec3 = [anchor[0] - points[low.i][0], -low.height, anchor[2] - points[low.i][2]];
+      // As high as the source's foot above its floor (scaled), up to PLANTED_LIFT: a labelled contact begins and ends
+      // with the source's foot still a few centimetres up (contactLabels.ts), and pulling it down there drags the
+      // character's foot along the floor.
+      const lift = Math.min(swingClearance[s][f], PLANTED_LIFT) * unitsPerMetre;
+      const shift: Vec3 = [anchor[0] - points[low.i][0], lift - low.height, anchor[2] - points[low.i][2]];
       shifts[s][f] = shift;
       previous = points.map((p) => [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]] as Vec3);
     }
-    // Free frames: the neighbouring contacts' corrections fading out (after) and in (before); never below the floor.
+    // Free frames: the neighbouring contacts' corrections fading out (after) and in (before); the foot at least as
+    // high above the floor as the source's (scaled).
     for (let f = 0; f < F; f++) {
       if (planted[f]) continue;
       const shift: Vec3 = [0, 0, 0];
@@ -481,7 +532,8 @@ function plantFeet(
         }
       }
       const height = lowest(footPoints(f, leg).map((p) => [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]] as Vec3), leg).height;
-      if (height < 0) shift[1] -= height;
+      const clearance = swingClearance[s][f] * unitsPerMetre;
+      if (height < clearance) shift[1] += clearance - height;
       shifts[s][f] = shift;
     }
   });
