@@ -234,7 +234,8 @@ class _Tree:
         J = len(parents)
         self.parents = list(parents)
         self.frames = _sampled(positions.shape[0])
-        # Only the frames looked at, as Python floats: the same arithmetic as the page, number by number.
+        # Only the frames looked at, as Python floats: the page's operations in its order (hypot and log may differ
+        # from the page's in the last bit, far below the 1e-12 that decides a tie).
         self.pose: dict[int, list[Point]] = {f: [tuple(p) for p in positions[f].tolist()] for f in self.frames}
         self.children: list[list[int]] = [[] for _ in range(J)]
         for j, p in enumerate(self.parents):
