@@ -28,14 +28,25 @@ MAX_TURN_RATE = 2.5
 # Pure pursuit looks LOOKAHEAD_SECONDS of travel ahead along the path, and at least MIN_LOOKAHEAD metres.
 LOOKAHEAD_SECONDS = 0.6
 MIN_LOOKAHEAD = 0.5
-# The follower searches for itself along the path from PROGRESS_BACK behind to PROGRESS_AHEAD ahead of
-# its last arc length, so a path that crosses itself is not short-cut (as web/optimizer trackArc).
-PROGRESS_BACK = 0.3
+# The follower searches for itself along the path from its last arc length to PROGRESS_AHEAD further, so a
+# path that crosses itself is not short-cut (as web/optimizer trackArc), and never behind it: where a path
+# doubles back, the leg it walked lies under the leg it walks. Where stretches of the path lie within TIE
+# (squared metres) of each other, the nearest is the earliest.
 PROGRESS_AHEAD = 1.2
+TIE = 1e-9
 # It slows down over the last STOP_SECONDS of travel so it stops at the end instead of overshooting, and
 # stands still once it is within ARRIVED metres of the end (else the slow-down never quite finishes).
 STOP_SECONDS = 0.5
 ARRIVED = 0.05
+# A bend sharper than SHARP_BEND rad (from the path's direction where the walker is) stops the look-ahead:
+# pure pursuit would cut across it (a reversal whole), so the walker is steered to the bend itself, slowing as
+# it nears (as at the end), looks past it once within BEND_REACH metres of it, and speeds up again as it slowed.
+# Its forward speed falls with the heading error, full within FULL_SPEED_ERROR rad and none from STILL_ERROR on,
+# so a reversal turns on the spot rather than walking a loop off the path.
+SHARP_BEND = math.pi / 4
+BEND_REACH = 0.1
+FULL_SPEED_ERROR = math.pi / 9
+STILL_ERROR = math.pi / 4
 
 
 def wrap(a):
@@ -94,15 +105,54 @@ class PolylinePath:
         self.arc = np.concatenate([[0.0], np.cumsum(seg)])
         self.length = float(self.arc[-1])
 
+    def segment_at(self, s: float) -> int:
+        """Index of the segment at arc length s (at a point, the segment leaving it; kept on the path)."""
+        return int(np.clip(np.searchsorted(self.arc, s, side="right") - 1, 0, len(self.points) - 2))
+
     def point_at(self, s: float) -> np.ndarray:
         s = min(max(s, 0.0), self.length)
-        i = int(np.clip(np.searchsorted(self.arc, s, side="right") - 1, 0, len(self.points) - 2))
+        i = self.segment_at(s)
         span = self.arc[i + 1] - self.arc[i]
         t = (s - self.arc[i]) / span if span > 0 else 0.0
         return self.points[i] + (self.points[i + 1] - self.points[i]) * t
 
+    def bend_after(self, s_from: float, s_to: float, angle: float) -> float:
+        """Arc length of the first point after s_from and up to s_to where the path's direction has turned more
+        than `angle` rad from its direction at s_from (zero-length segments skipped), or inf if there is none."""
+        i = self.segment_at(s_from)
+        while i < len(self.points) - 2 and self.arc[i + 1] == self.arc[i]:
+            i += 1
+        a, b = self.points[i], self.points[i + 1]
+        along = math.atan2(b[0] - a[0], b[1] - a[1])
+        k = i + 1
+        while k + 1 < len(self.points) and self.arc[k] <= s_to:
+            if self.arc[k + 1] != self.arc[k] and self.arc[k] > s_from:
+                p, q = self.points[k], self.points[k + 1]
+                if abs(float(wrap(math.atan2(q[0] - p[0], q[1] - p[1]) - along))) > angle:
+                    return float(self.arc[k])
+            k += 1
+        return math.inf
+
+    def bend_before(self, s_from: float, s_to: float, angle: float) -> float:
+        """Arc length of the last point before s_from and down to s_to (s_to <= s_from) where the path's direction
+        differs by more than `angle` rad from its direction at s_from (zero-length segments skipped), or -inf."""
+        i = self.segment_at(s_from)
+        while i < len(self.points) - 2 and self.arc[i + 1] == self.arc[i]:
+            i += 1
+        a, b = self.points[i], self.points[i + 1]
+        along = math.atan2(b[0] - a[0], b[1] - a[1])
+        k = i
+        while k > 0 and self.arc[k] >= s_to:
+            if self.arc[k] != self.arc[k - 1]:
+                p, q = self.points[k - 1], self.points[k]
+                if abs(float(wrap(math.atan2(q[0] - p[0], q[1] - p[1]) - along))) > angle:
+                    return float(self.arc[k])
+            k -= 1
+        return -math.inf
+
     def project(self, x: float, z: float, s_from: float, s_to: float) -> float:
-        """Arc length of the nearest point to (x, z) on the segments overlapping [s_from, s_to]."""
+        """Arc length of the nearest point to (x, z) on the path between arc lengths s_from and s_to (0 if the
+        path has none there); of points as near (within TIE), the earliest."""
         best, best_s = math.inf, 0.0
         for i in range(len(self.points) - 1):
             if self.arc[i + 1] < s_from or self.arc[i] > s_to:
@@ -110,25 +160,40 @@ class PolylinePath:
             a, b = self.points[i], self.points[i + 1]
             d = b - a
             len2 = float(d @ d)
-            t = min(max(((x - a[0]) * d[0] + (z - a[1]) * d[1]) / len2, 0.0), 1.0) if len2 > 0 else 0.0
+            span = float(self.arc[i + 1] - self.arc[i])
+            # The part of the segment inside [s_from, s_to], as fractions of it.
+            lo = max((s_from - self.arc[i]) / span, 0.0) if span > 0 else 0.0
+            hi = min((s_to - self.arc[i]) / span, 1.0) if span > 0 else 0.0
+            t = min(max(((x - a[0]) * d[0] + (z - a[1]) * d[1]) / len2, lo), hi) if len2 > 0 else 0.0
             e = a + d * t - (x, z)
-            if float(e @ e) < best:
-                best, best_s = float(e @ e), float(self.arc[i] + t * (self.arc[i + 1] - self.arc[i]))
+            if float(e @ e) < best - TIE:
+                best, best_s = float(e @ e), float(self.arc[i] + t * span)
         return best_s
 
 
 def control_along_path(path: PolylinePath, x: float, z: float, heading: float, progress: float, speed: float):
-    """The signal that steers a walker at (x, z) facing `heading` along `path` at `speed` (pure pursuit),
-    and its new progress (arc length) along the path, searched near the last one."""
-    s = path.project(x, z, progress - PROGRESS_BACK, progress + PROGRESS_AHEAD)
+    """The signal that steers a walker at (x, z) facing `heading` along `path` at `speed` (pure pursuit, towards
+    a sharp bend before the look-ahead point: SHARP_BEND), and its new progress (arc length) along the path,
+    searched from the last one on."""
+    s = path.project(x, z, progress, progress + PROGRESS_AHEAD)
     remaining = path.length - s
-    target = path.point_at(s + max(MIN_LOOKAHEAD, speed * LOOKAHEAD_SECONDS))
     if remaining <= ARRIVED:
         return np.array([0.0, 0.0, 0.0]), s
+    reach = max(MIN_LOOKAHEAD, speed * LOOKAHEAD_SECONDS)
+    ahead = s + reach
+    bend = path.bend_after(s, ahead, SHARP_BEND)
+    passed = path.bend_before(s, s - reach, SHARP_BEND)
+    if bend - s <= BEND_REACH:  # at the bend: look past it, and leave it as from a stop
+        passed = bend
+        bend = path.bend_after(bend, ahead, SHARP_BEND)
+    target = path.point_at(min(ahead, bend))
     want = math.atan2(target[0] - x, target[1] - z)
-    fwd = min(speed, remaining / STOP_SECONDS)
-    out = control_toward_heading(heading, want, fwd)
-    return out, s
+    # Slowing over STOP_SECONDS into the end or a bend, and speeding up as gently out of a bend.
+    slowing = min(remaining, max(bend - s, BEND_REACH), max(s - passed, BEND_REACH))
+    error = abs(float(wrap(want - heading)))
+    facing = min(max((STILL_ERROR - error) / (STILL_ERROR - FULL_SPEED_ERROR), 0.0), 1.0)
+    fwd = min(speed, slowing / STOP_SECONDS) * facing
+    return control_toward_heading(heading, want, fwd), s
 
 
 class Rng:

@@ -14,6 +14,7 @@ import { apiFailure, drawStroke, ROOT, usePlayground, waitUntil } from './harnes
 const REFERENCE = JSON.parse(readFileSync(path.join(ROOT, 'tests/fixtures/vae_lstm_reference.json'), 'utf8'));
 const VAE = JSON.parse(readFileSync(path.join(ROOT, 'public/models/vae-lstm.json'), 'utf8'));
 const REPORT = JSON.parse(readFileSync(path.join(ROOT, 'docs/models/vae-lstm.json'), 'utf8'));
+const BENCHMARK = JSON.parse(readFileSync(path.join(ROOT, 'tests/fixtures/benchmark_paths.json'), 'utf8'));
 /** The reports' freeze line: a second below this share of the real clips' median pose change has stopped moving. */
 const FREEZE_FRACTION = 0.2;
 const J = VAE.skeleton.joints.length;
@@ -192,6 +193,25 @@ describe('the VAE-LSTM through window.playground', { timeout: 300_000 }, () => {
     assert.match(bad.message, /generate: control has 1 frames/);
     const temp = await apiFailure(page, 'generate', { model: 'vae-lstm', frames: 10, seed: 0, temperature: 1 });
     assert.match(temp.message, /unknown option "temperature" for model "vae-lstm"/);
+  });
+
+  test('followPath walks a path that doubles back (issue 43): >= 95% of its length within 0.15 m, walking and running', async () => {
+    // The benchmark's back-and-forth scribble (four reversals), measured on the returned motion's root (the hips) with
+    // the shared measure (web/motion/pathCoverage.ts). Before: 30% walking, 52% running (pure pursuit cut each reversal).
+    const points = BENCHMARK.paths['back-and-forth'].points;
+    const r = await suite.page.evaluate(async (points) => {
+      const { pathCoverage, rootGroundTrack } = await import('/motion/pathCoverage.ts');
+      const out = [];
+      for (const gait of ['walk', 'run']) {
+        const m = await window.playground.followPath({ model: 'vae-lstm', points, gait, seed: 0 });
+        out.push({ gait, coverage: pathCoverage(points, rootGroundTrack(m.positions, m.joints.length)), stats: m.stats, frames: m.frames });
+      }
+      return out;
+    }, points);
+    for (const { gait, coverage, stats, frames } of r) {
+      console.log(`# VAE-LSTM back-and-forth, ${gait}: ${(coverage * 100).toFixed(1)}% within 0.15 m, mean error ${stats.meanError.toFixed(3)} m, ${frames} frames`);
+      assert.ok(coverage >= 0.95, `${gait}: ${(coverage * 100).toFixed(1)}% of the path followed within 0.15 m`);
+    }
   });
 
   test('parity in the browser: the four graphs and a whole generation over two chunks of the cell', async () => {

@@ -20,6 +20,7 @@ import {
   wrap,
   type Root,
 } from '../../web/motion/control';
+import { pathCoverage } from '../../web/motion/pathCoverage';
 import { readRepoFile } from './corpus';
 
 interface PathCase {
@@ -49,6 +50,7 @@ interface Fixture {
 }
 
 const fixture = JSON.parse(readRepoFile('tests/fixtures/control_signal.json')) as Fixture;
+const BENCHMARK = JSON.parse(readRepoFile('tests/fixtures/benchmark_paths.json')) as { paths: Record<string, { points: number[][] }> };
 const FPS = fixture.fps;
 
 /** The largest |a − b| (angles: wrapped, so −π + ε and π − ε are 2ε apart); throws on different lengths. */
@@ -200,6 +202,27 @@ describe('control signal behaviour', () => {
       // Midway (5 s in) it walks at the asked speed, back on the line.
       expect(run.signals[3 * 150]).toBe(1.5);
       expect(Math.abs(run.states[3 * 150])).toBeLessThan(0.05);
+    }
+  });
+
+  it('a walker driven by controlAlongPath follows a path that doubles back (issue 43) ≥ 95% of its length within 0.15 m, walking or running', () => {
+    // The benchmark's back-and-forth scribble: pure pursuit cut each reversal whole (its look-ahead point jumped to
+    // the next leg) and the projection jumped to the leg lying under the one walked, 30% followed. Now the walker
+    // goes to each tip, slowing, turns on the spot and speeds up again along the next leg.
+    const points = BENCHMARK.paths['back-and-forth'].points as [number, number][];
+    const path = new PolylinePath(points);
+    for (const speed of [0.6, 1.2, 2.0, 2.8]) {
+      const run = follow(path, { x: 0, z: 0, heading: 0 }, speed, Math.ceil(((path.length / speed) * 2.5 + 10) * FPS));
+      const track: [number, number][] = [];
+      for (let t = 0; t < run.states.length; t += 3) track.push([run.states[t], run.states[t + 1]]);
+      expect(pathCoverage(points, track), `${speed} m/s`).toBeGreaterThanOrEqual(0.95);
+      expect(Math.hypot(run.end.x - points[points.length - 1][0], run.end.z - points[points.length - 1][1]), `${speed} m/s`).toBeLessThan(0.1);
+      // It turns on the spot rather than walking a loop: never more than 0.15 m off the path.
+      const off = Math.max(...track.map(([x, z]) => {
+        const [px, pz] = path.pointAt(path.project(x, z, 0, path.length));
+        return Math.hypot(px - x, pz - z);
+      }));
+      expect(off, `${speed} m/s`).toBeLessThan(0.15);
     }
   });
 

@@ -24,12 +24,29 @@ export const MAX_TURN_RATE = 2.5;
 /** Pure pursuit looks LOOKAHEAD_SECONDS of travel ahead along the path, and at least MIN_LOOKAHEAD m. */
 export const LOOKAHEAD_SECONDS = 0.6;
 export const MIN_LOOKAHEAD = 0.5;
-/** The follower searches for itself from PROGRESS_BACK behind to PROGRESS_AHEAD ahead of its last arc length (m). */
-export const PROGRESS_BACK = 0.3;
+/**
+ * The follower searches for itself on the path from its last arc length to PROGRESS_AHEAD m further, never behind
+ * it: where a path doubles back, the leg it walked lies under the leg it walks.
+ */
 export const PROGRESS_AHEAD = 1.2;
+/** Where stretches of a path lie within this squared distance (m²) of each other, the nearest is the earliest. */
+const TIE = 1e-9;
 /** It slows down over the last STOP_SECONDS of travel so it stops at the end, and stands still within ARRIVED metres of it. */
 export const STOP_SECONDS = 0.5;
 export const ARRIVED = 0.05;
+/**
+ * A bend of the path sharper than SHARP_BEND rad (from the path's direction where the walker is) stops the look-ahead:
+ * pure pursuit would cut across it (a reversal whole), so the walker is steered to the bend itself, slowing as it
+ * nears (as at the end), looks past it once within BEND_REACH m of it, and speeds up again as it slowed.
+ */
+export const SHARP_BEND = Math.PI / 4;
+export const BEND_REACH = 0.1;
+/**
+ * Forward speed falls with the heading error: full within FULL_SPEED_ERROR rad, none from STILL_ERROR on (so a
+ * reversal turns on the spot rather than walking a loop off the path).
+ */
+export const FULL_SPEED_ERROR = Math.PI / 9;
+export const STILL_ERROR = Math.PI / 4;
 /** Random control: a new target speed and turn every RANDOM_SEGMENT s, eased towards with time constant RANDOM_EASE s. */
 export const RANDOM_SEGMENT = 2.0;
 export const RANDOM_EASE = 0.5;
@@ -125,6 +142,15 @@ export class PolylinePath {
   /** The point at arc length s (clamped to the path). */
   pointAt(s: number): [number, number] {
     s = Math.min(Math.max(s, 0), this.length);
+    const i = this.segmentAt(s);
+    const span = this.arc[i + 1] - this.arc[i];
+    const t = span > 0 ? (s - this.arc[i]) / span : 0;
+    const a = this.points[i], b = this.points[i + 1];
+    return [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t];
+  }
+
+  /** Index of the segment at arc length s (at a point, the segment leaving it; kept on the path). */
+  segmentAt(s: number): number {
     // The last point whose arc length is ≤ s (numpy searchsorted side="right" − 1), kept on a segment.
     let lo = 0, hi = this.arc.length;
     while (lo < hi) {
@@ -132,14 +158,48 @@ export class PolylinePath {
       if (this.arc[mid] <= s) lo = mid + 1;
       else hi = mid;
     }
-    const i = Math.min(Math.max(lo - 1, 0), this.points.length - 2);
-    const span = this.arc[i + 1] - this.arc[i];
-    const t = span > 0 ? (s - this.arc[i]) / span : 0;
-    const a = this.points[i], b = this.points[i + 1];
-    return [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t];
+    return Math.min(Math.max(lo - 1, 0), this.points.length - 2);
   }
 
-  /** Arc length of the nearest point to (x, z) on the segments overlapping [from, to] (0 if none does). */
+  /**
+   * Arc length of the first point after arc length `from` and up to `to` where the path's direction has turned more
+   * than `angle` rad from its direction at `from` (zero-length segments skipped), or Infinity if there is none.
+   */
+  bendAfter(from: number, to: number, angle: number): number {
+    let i = this.segmentAt(from);
+    while (i < this.points.length - 2 && this.arc[i + 1] === this.arc[i]) i++;
+    const a = this.points[i], b = this.points[i + 1];
+    const along = Math.atan2(b[0] - a[0], b[1] - a[1]);
+    for (let k = i + 1; k + 1 < this.points.length && this.arc[k] <= to; k++) {
+      if (this.arc[k + 1] === this.arc[k] || this.arc[k] <= from) continue;
+      const p = this.points[k], q = this.points[k + 1];
+      if (Math.abs(wrap(Math.atan2(q[0] - p[0], q[1] - p[1]) - along)) > angle) return this.arc[k];
+    }
+    return Infinity;
+  }
+
+  /**
+   * Arc length of the last point before arc length `from` and down to `to` (to ≤ from) where the path's direction
+   * differs by more than `angle` rad from its direction at `from` (zero-length segments skipped), or −Infinity if
+   * there is none.
+   */
+  bendBefore(from: number, to: number, angle: number): number {
+    let i = this.segmentAt(from);
+    while (i < this.points.length - 2 && this.arc[i + 1] === this.arc[i]) i++;
+    const a = this.points[i], b = this.points[i + 1];
+    const along = Math.atan2(b[0] - a[0], b[1] - a[1]);
+    for (let k = i; k > 0 && this.arc[k] >= to; k--) {
+      if (this.arc[k] === this.arc[k - 1]) continue;
+      const p = this.points[k - 1], q = this.points[k];
+      if (Math.abs(wrap(Math.atan2(q[0] - p[0], q[1] - p[1]) - along)) > angle) return this.arc[k];
+    }
+    return -Infinity;
+  }
+
+  /**
+   * Arc length of the nearest point to (x, z) on the path between arc lengths `from` and `to` (0 if the path has
+   * none there); of points as near (within TIE), the earliest.
+   */
   project(x: number, z: number, from: number, to: number): number {
     let best = Infinity, bestS = 0;
     for (let i = 0; i + 1 < this.points.length; i++) {
@@ -147,12 +207,16 @@ export class PolylinePath {
       const a = this.points[i], b = this.points[i + 1];
       const dx = b[0] - a[0], dz = b[1] - a[1];
       const len2 = dx * dx + dz * dz;
-      const t = len2 > 0 ? Math.min(Math.max(((x - a[0]) * dx + (z - a[1]) * dz) / len2, 0), 1) : 0;
+      const span = this.arc[i + 1] - this.arc[i];
+      // The part of the segment inside [from, to], as fractions of it.
+      const lo = span > 0 ? Math.max((from - this.arc[i]) / span, 0) : 0;
+      const hi = span > 0 ? Math.min((to - this.arc[i]) / span, 1) : 0;
+      const t = len2 > 0 ? Math.min(Math.max(((x - a[0]) * dx + (z - a[1]) * dz) / len2, lo), hi) : 0;
       const ex = a[0] + dx * t - x, ez = a[1] + dz * t - z;
       const d2 = ex * ex + ez * ez;
-      if (d2 < best) {
+      if (d2 < best - TIE) {
         best = d2;
-        bestS = this.arc[i] + t * (this.arc[i + 1] - this.arc[i]);
+        bestS = this.arc[i] + t * span;
       }
     }
     return bestS;
@@ -161,16 +225,30 @@ export class PolylinePath {
 
 /**
  * The signal that steers a walker at (x, z) facing `heading` along `path` at `speed` (pure pursuit towards
- * the point max(MIN_LOOKAHEAD, speed · LOOKAHEAD_SECONDS) further along), slowing over the last STOP_SECONDS
- * and zero at the end; and its new progress (arc length), searched near the last one.
+ * the point max(MIN_LOOKAHEAD, speed · LOOKAHEAD_SECONDS) further along, or a sharp bend before it: SHARP_BEND),
+ * slowing over the last STOP_SECONDS before the end or the bend, and zero at the end; and its new progress (arc
+ * length), searched near the last one and never going back (where a path doubles back, its two legs lie close).
  */
 export function controlAlongPath(path: PolylinePath, x: number, z: number, heading: number, progress: number, speed: number): { control: Control; progress: number } {
-  const s = path.project(x, z, progress - PROGRESS_BACK, progress + PROGRESS_AHEAD);
+  const s = path.project(x, z, progress, progress + PROGRESS_AHEAD);
   const remaining = path.length - s;
   if (remaining <= ARRIVED) return { control: [0, 0, 0], progress: s };
-  const target = path.pointAt(s + Math.max(MIN_LOOKAHEAD, speed * LOOKAHEAD_SECONDS));
+  const reach = Math.max(MIN_LOOKAHEAD, speed * LOOKAHEAD_SECONDS);
+  const ahead = s + reach;
+  let bend = path.bendAfter(s, ahead, SHARP_BEND);
+  let passed = path.bendBefore(s, s - reach, SHARP_BEND);
+  if (bend - s <= BEND_REACH) {
+    // At the bend: look past it, and leave it as from a stop.
+    passed = bend;
+    bend = path.bendAfter(bend, ahead, SHARP_BEND);
+  }
+  const target = path.pointAt(Math.min(ahead, bend));
   const want = Math.atan2(target[0] - x, target[1] - z);
-  const fwd = Math.min(speed, remaining / STOP_SECONDS);
+  // Slowing over STOP_SECONDS into the end or a bend, and speeding up as gently out of a bend.
+  const slowing = Math.min(remaining, Math.max(bend - s, BEND_REACH), Math.max(s - passed, BEND_REACH));
+  const error = Math.abs(wrap(want - heading));
+  const facing = Math.min(Math.max((STILL_ERROR - error) / (STILL_ERROR - FULL_SPEED_ERROR), 0), 1);
+  const fwd = Math.min(speed, slowing / STOP_SECONDS) * facing;
   return { control: controlTowardHeading(heading, want, fwd), progress: s };
 }
 

@@ -4,7 +4,7 @@
 // ARRIVED_SECONDS; its per-frame controls are the signal, and the root the motion is placed on
 // (vaeLstmCore.ts step 5). The model then makes the body for the whole signal in one go. The result keeps
 // the other followers' return shapes and stats, measured the same way (pathErrors on the hips, footStats).
-import { controlAlongPath, PolylinePath, stepRoot, type Root } from '../../motion/control';
+import { controlAlongPath, MAX_TURN_RATE, PolylinePath, stepRoot, wrap, type Root } from '../../motion/control';
 import { footStats } from '../../motion/footSkating';
 import { checkFollowRequest, optional } from '../../optimizer/options';
 import { moveBack } from '../../optimizer/path';
@@ -31,6 +31,19 @@ export function controlForPath(path: PolylinePath, start: Root, speed: number, f
   return Float64Array.from(out);
 }
 
+/** The path's total turning (rad): the sum of its direction changes at its points (zero-length segments skipped). */
+export function totalTurning(path: PolylinePath): number {
+  let total = 0, last: number | undefined;
+  for (let i = 0; i + 1 < path.points.length; i++) {
+    const [a, b] = [path.points[i], path.points[i + 1]];
+    if (a[0] === b[0] && a[1] === b[1]) continue;
+    const along = Math.atan2(b[0] - a[0], b[1] - a[1]);
+    if (last !== undefined) total += Math.abs(wrap(along - last));
+    last = along;
+  }
+  return total;
+}
+
 export async function followPathVae(core: VaeLstmCore, p: VaeLstmFollowPathParams, progress: (fraction: number) => void, signal?: AbortSignal): Promise<VaeLstmFollowPathChunk> {
   const started = performance.now();
   // Made near the origin and moved back to where the path is (as the other followers).
@@ -39,8 +52,11 @@ export async function followPathVae(core: VaeLstmCore, p: VaeLstmFollowPathParam
   const fps = core.fps;
   const path = new PolylinePath(ground.points());
   const start: Root = { x: ground.xs[0], z: ground.zs[0], heading: ground.headingAt(0) };
-  // As the other followers: 2.5× the time the pace needs, and 2 s, before giving up.
-  const control = controlForPath(path, start, speed, fps, Math.ceil(((path.length / speed) * 2.5 + 2) * fps));
+  // As the other followers, 2.5× the time the pace needs and 2 s before giving up; and twice the time its turns take
+  // at the most turning speed, for the root slows down into a sharp bend, turns and speeds up again (a run that
+  // doubles back four times needs 17 s where the pace needs 5).
+  const seconds = (path.length / speed) * 2.5 + 2 + (2 * totalTurning(path)) / MAX_TURN_RATE;
+  const control = controlForPath(path, start, speed, fps, Math.ceil(seconds * fps));
   progress(0.1);
   const frames = control.length / 3;
   const chunk = await core.generate({ frames, seed, control, footLock: lock }, signal, { root: start });
