@@ -417,7 +417,7 @@ export function buildTubes(L: Float64Array, colors: MannequinColors, detail = 1)
       const U = k('Arm'), F = k('ForeArm'), H = k('Hand');
       const dir = unit(sub(el, sh));
       const keys: Ring[] = [
-        ring(sh, 0.058, 0.056, on(U)),
+        ring(sh, 0.054, 0.054, on(U)),
         ring(lerp3(sh, el, 0.35), 0.048, 0.05, on(U)),
         ring(lerp3(sh, el, 0.85), 0.038, 0.04, blend(U, F, 0.15)),
         ring(el, 0.035, 0.037, blend(U, F, 0.5)),
@@ -426,7 +426,7 @@ export function buildTubes(L: Float64Array, colors: MannequinColors, detail = 1)
         ring(lerp3(el, wr, 0.95), 0.026, 0.03, blend(F, H, 0.2)),
       ];
       const rings = sample(keys, ds([4, 4, 3, 3, 3, 4]));
-      tubes.push({ rings: [...cap(rings[0], scale(dir, -1), 0.055 * s, d(4)).reverse(), ...rings, ...cap(rings[rings.length - 1], dir, 0.02 * s, d(2))], side: v(0, 0, 1), color });
+      tubes.push({ rings: [...cap(rings[0], scale(dir, -1), 0.035 * s, d(4)).reverse(), ...rings, ...cap(rings[rings.length - 1], dir, 0.02 * s, d(2))], side: v(0, 0, 1), color });
     }
 
     // Hand: a mitten, flat, its width along the body's front in the bind pose (palm to the thigh when hanging).
@@ -525,7 +525,7 @@ export function restMannequin(options: MannequinOptions = {}): Mannequin {
  * shader (figure.ts). Made once, shared.
  */
 let studioMatcap: THREE.DataTexture | null = null;
-function matcap(): THREE.DataTexture {
+export function matcap(): THREE.DataTexture {
   if (studioMatcap) return studioMatcap;
   const N = 128;
   const data = new Uint8Array(N * N * 4);

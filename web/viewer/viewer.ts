@@ -892,8 +892,8 @@ class CharacterLights {
   private readonly catcher: THREE.Mesh;
 
   constructor(camera: THREE.Camera) {
-    const sky = new THREE.HemisphereLight(0xdfe6ff, 0x3a3f52, 1.15);
-    this.key = new THREE.DirectionalLight(0xfff3e6, 1.5);
+    const sky = new THREE.HemisphereLight(0xdfe6ff, 0x3a3f52, 0.85);
+    this.key = new THREE.DirectionalLight(0xfff3e6, 2.0);
     this.key.position.set(1.6, 5, 2.4);
     this.key.castShadow = true;
     this.key.shadow.mapSize.set(1024, 1024);
