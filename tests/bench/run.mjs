@@ -12,6 +12,7 @@
 import { launchBrowser, startServer } from '../support/browser.mjs';
 import * as aclstm from './aclstm.mjs';
 import * as character from './character.mjs';
+import * as userCharacter from './userCharacter.mjs';
 import * as cleanup from './cleanup.mjs';
 import * as control from './control.mjs';
 import * as firstFrame from './firstFrame.mjs';
@@ -22,7 +23,7 @@ import * as peers from './peers.mjs';
 import * as playback from './playback.mjs';
 
 /** In the order `npm run bench` runs them. */
-const FAMILIES = [playback, generator, character, aclstm, control, peers, firstFrame, largeImport, cleanup, memory];
+const FAMILIES = [playback, generator, character, userCharacter, aclstm, control, peers, firstFrame, largeImport, cleanup, memory];
 const BENCHMARKS = FAMILIES.flatMap((family) => family.BENCHMARKS);
 
 async function main() {

@@ -138,7 +138,7 @@ export class MotionPlaygroundElement extends HTMLElement {
       return;
     }
     if (name === 'character') {
-      if (after === null) this.app.characters.clear();
+      if (after === null) this.app.clearCharacter();
       else void this.loadCharacterAttribute();
       return;
     }

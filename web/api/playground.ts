@@ -506,7 +506,7 @@ export function createPlayground(app: App): Playground {
       });
     },
     character: () => app.characters.info,
-    clearCharacter: () => app.characters.clear(),
+    clearCharacter: () => app.clearCharacter(),
     retarget(motion, options) {
       return guarded('retarget', () => {
         const o = options === undefined ? {} : checkKeys(options, ['footIK'], '{ footIK? }');

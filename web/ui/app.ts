@@ -406,6 +406,13 @@ export class App implements ModeHost {
     return info;
   }
 
+  /** Back to the mannequin (the Export menu's "on my character" goes with the character). */
+  clearCharacter(): void {
+    this.characters.clear();
+    this.onCharacter.row.hidden = true;
+    this.onCharacter.box.checked = false;
+  }
+
   /**
    * Imports dropped or picked files in the import worker: one .bvh, or an .amc with its .asf (dropped
    * together or the .asf first). Large ones show their progress; a failure leaves the scene as it was.

@@ -103,7 +103,8 @@ export class CharacterInput {
     this.viewer.setCharacterSource((motion, companion) => {
       const asset = companion ? (this.second ?? this.main) : this.main;
       if (!asset) return null;
-      const driver = new UserCharacterDriver(asset);
+      // Lit with a GPU (the 'high' tier), else a matcap, as the viewer does for its mannequin.
+      const driver = new UserCharacterDriver(asset, { lit: this.viewer.stats().quality === 'high' });
       if (driver.setMotion(motion)) return driver;
       driver.dispose();
       return null; // this motion does not retarget onto it (not a humanoid): the mannequin or stick figure

@@ -15,6 +15,7 @@ import type { Quat, Vec3 } from '../motion/math';
 import { mapRig, restPositions, retarget, type CharacterRig, type RetargetResult } from '../motion/retarget';
 import { quoteInput } from '../motion/text';
 import type { Motion } from '../motion/types';
+import { matcap } from './mannequin';
 
 /** Refused input (not a glTF, no skin, not a humanoid): the message says why, briefly. */
 export class CharacterFileError extends Error {
@@ -258,7 +259,11 @@ export class UserCharacterDriver implements CharacterView {
   private source: Motion | null = null;
   private readonly point = new THREE.Vector3();
 
-  constructor(readonly asset: CharacterAsset) {
+  /**
+   * `lit`: drawn with its own materials under the scene's lights (a GPU); else, as the mannequin under software GL,
+   * each material becomes a studio matcap keeping its colour and texture (no per-pixel lighting to pay for).
+   */
+  constructor(readonly asset: CharacterAsset, { lit = true }: { lit?: boolean } = {}) {
     const copy = cloneSkinned(asset.template);
     copy.updateMatrixWorld(true);
     // The copy's bones in rig order: the same place in the (cloned) tree as the template's.
@@ -293,7 +298,7 @@ export class UserCharacterDriver implements CharacterView {
       // Own materials, so that see-through on one copy leaves the others as they are.
       const own = (m: THREE.Material) => {
         if (!originals.has(m)) {
-          const c = m.clone();
+          const c = lit ? m.clone() : matcapOf(m);
           originals.set(m, c);
           this.materials.push(c);
         }
@@ -410,6 +415,19 @@ export class UserCharacterDriver implements CharacterView {
     for (const m of this.materials) m.dispose();
     // The copy shares its geometries and textures with the asset's template (disposed with the asset).
   }
+}
+
+/** A matcap material with `m`'s colour, texture and sidedness. */
+function matcapOf(m: THREE.Material): THREE.MeshMatcapMaterial {
+  const s = m as THREE.MeshStandardMaterial;
+  return new THREE.MeshMatcapMaterial({
+    matcap: matcap(),
+    color: s.color ? s.color.clone() : new THREE.Color(0xffffff),
+    map: s.map ?? null,
+    side: m.side,
+    alphaTest: m.alphaTest,
+    transparent: m.transparent,
+  });
 }
 
 /** Frames before a live window's new ones that are retargeted with them (planted feet and their lock carry over). */
