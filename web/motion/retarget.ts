@@ -69,6 +69,8 @@ const TYPICAL_HEIGHT = 1.7;
 const RELEASE_SECONDS = 0.15;
 /** A rig whose lowest rest foot point is within this height above y = 0 (m) stands on y = 0; else on that point. */
 const REST_FLOOR_SLACK = 0.15;
+/** The longest a leg may stretch in the foot IK, as a share of thigh + shin. */
+const REACH = 0.9999;
 /** The share of a foot's planted frames, lowest ankle first, taken as the foot standing flat. */
 const FLAT_SHARE = 0.25;
 /** The most a planted foot is kept above the floor (m) where the source's is higher (a contact's first and last frames). */
@@ -488,6 +490,8 @@ function plantFeet(
   };
   const blend = Math.max(1, Math.round(RELEASE_SECONDS * fps));
   const shifts: Vec3[][] = legs.map(() => new Array<Vec3>(F));
+  // Per leg and planted frame, the pinned foot point (0 ankle, 1 toe base); -1 in free frames.
+  const pinned: Int8Array[] = legs.map(() => new Int8Array(F).fill(-1));
   legs.forEach((leg, s) => {
     // Planted frames: pin the lowest point where it was (corrected) the frame before, at floor height.
     let previous: Vec3[] | null = null;
@@ -507,6 +511,7 @@ function plantFeet(
       const lift = Math.min(swingClearance[s][f], PLANTED_LIFT) * unitsPerMetre;
       const shift: Vec3 = [anchor[0] - points[low.i][0], lift - low.height, anchor[2] - points[low.i][2]];
       shifts[s][f] = shift;
+      pinned[s][f] = low.i;
       previous = points.map((p) => [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]] as Vec3);
     }
     // Free frames: the neighbouring contacts' corrections fading out (after) and in (before); the foot at least as
@@ -545,9 +550,20 @@ function plantFeet(
       const shift = shifts[s][f];
       if (Math.hypot(...shift) < 1e-9) return;
       const hip = pos(f, leg.thigh), knee = pos(f, leg.knee), ankle = pos(f, leg.ankle);
-      const target: Vec3 = [ankle[0] + shift[0], ankle[1] + shift[1], ankle[2] + shift[2]];
+      let target: Vec3 = [ankle[0] + shift[0], ankle[1] + shift[1], ankle[2] + shift[2]];
       const l1 = length(sub(knee, hip)), l2 = length(sub(ankle, knee));
-      const [newKnee, newAnkle] = twoBoneIK(hip, knee, target, l1, l2, 0.9999, null, 0);
+      const reach = REACH * (l1 + l2);
+      if (pinned[s][f] === 1 && length(sub(target, hip)) > reach) {
+        // Out of reach with the ball pinned (a push-off): the heel rises, the foot turning about the ball.
+        const ball = footPoints(f, leg)[1];
+        const pivot: Vec3 = [ball[0] + shift[0], ball[1] + shift[1], ball[2] + shift[2]];
+        const lifted = pivotAbout(hip, target, pivot, reach);
+        if (lifted) {
+          world[leg.ankle] = quatNormalize(quatMultiply(swingRotation(sub(target, pivot), sub(lifted, pivot)), world[leg.ankle]));
+          target = lifted;
+        }
+      }
+      const [newKnee, newAnkle] = twoBoneIK(hip, knee, target, l1, l2, REACH, null, 0);
       const thighTurn = rotationFromTwoVectors(sub(knee, hip), sub(ankle, hip), sub(newKnee, hip), sub(newAnkle, hip)) ?? swingRotation(sub(knee, hip), sub(newKnee, hip));
       const shinTurn = quatMultiply(swingRotation(quatRotate(thighTurn, sub(ankle, knee)), sub(newAnkle, newKnee)), thighTurn);
       // Every bone from the thigh down to (not including) the foot turns: the thigh by thighTurn, the shin and the
@@ -563,6 +579,27 @@ function plantFeet(
     refreshUnmapped(rig, world, mapped, restLocal);
     poseFrame(rig, world, [rootTranslations[f * 3], rootTranslations[f * 3 + 1], rootTranslations[f * 3 + 2]], restLocal, rotations, positions, f);
   }
+}
+
+/**
+ * The ankle nearest `ankle` that lies `reach` from the hip and as far from `pivot` as `ankle` does: the foot turned
+ * about its pinned ball until the leg reaches (footLock.ts pivotFoot); undefined when no turn reaches.
+ */
+function pivotAbout(hip: Vec3, ankle: Vec3, pivot: Vec3, reach: number): Vec3 | undefined {
+  const r = length(sub(ankle, pivot));
+  const toPivot = sub(pivot, hip);
+  const d = length(toPivot);
+  if (d >= reach + r || d <= Math.abs(reach - r) || d < 1e-9) return undefined;
+  const u: Vec3 = [toPivot[0] / d, toPivot[1] / d, toPivot[2] / d];
+  const a = (reach * reach - r * r + d * d) / (2 * d);
+  const rho = Math.sqrt(Math.max(reach * reach - a * a, 0));
+  const centre: Vec3 = [hip[0] + u[0] * a, hip[1] + u[1] * a, hip[2] + u[2] * a];
+  const rel = sub(ankle, centre);
+  const along = rel[0] * u[0] + rel[1] * u[1] + rel[2] * u[2];
+  const off: Vec3 = [rel[0] - u[0] * along, rel[1] - u[1] * along, rel[2] - u[2] * along];
+  const n = length(off);
+  if (n < 1e-9) return undefined;
+  return [centre[0] + (off[0] * rho) / n, centre[1] + (off[1] * rho) / n, centre[2] + (off[2] * rho) / n];
 }
 
 /** Whether bone `b` is `ancestor` or lies below it. */
