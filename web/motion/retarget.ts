@@ -514,6 +514,10 @@ function plantFeet(
       pinned[s][f] = low.i;
       previous = points.map((p) => [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]] as Vec3);
     }
+  });
+  lowerHips(rig, legs, shifts, pinned, pos, footPoints, blend, rootTranslations, positions);
+  legs.forEach((leg, s) => {
+    const planted = Array.from({ length: F }, (_, f) => contacts[f * 2 + s] > 0);
     // Free frames: the neighbouring contacts' corrections fading out (after) and in (before); the foot at least as
     // high above the floor as the source's (scaled).
     for (let f = 0; f < F; f++) {
@@ -578,6 +582,45 @@ function plantFeet(
     if (!changed) continue;
     refreshUnmapped(rig, world, mapped, restLocal);
     poseFrame(rig, world, [rootTranslations[f * 3], rootTranslations[f * 3 + 1], rootTranslations[f * 3 + 2]], restLocal, rotations, positions, f);
+  }
+}
+
+/**
+ * Lowers the whole character where a planted foot's pinned point is out of the leg's reach even with the foot
+ * turned about it (the ankle's distance beyond the ball): by the least drop that brings it within reach, eased in
+ * and out over `blend` frames. Planted feet keep their targets (their shifts grow by the drop); `positions` and
+ * `rootTranslations` are lowered in place.
+ */
+function lowerHips(
+  rig: CharacterRig, legs: LegBones[], shifts: Vec3[][], pinned: Int8Array[], pos: (f: number, b: number) => Vec3,
+  footPoints: (f: number, leg: LegBones) => Vec3[], blend: number, rootTranslations: Float32Array, positions: Float32Array,
+): void {
+  const F = rootTranslations.length / 3, B = rig.bones.length;
+  const need = new Float64Array(F);
+  for (let f = 0; f < F; f++) {
+    legs.forEach((leg, s) => {
+      const i = pinned[s][f];
+      if (i < 0) return;
+      const hip = pos(f, leg.thigh), knee = pos(f, leg.knee), ankle = pos(f, leg.ankle);
+      const points = footPoints(f, leg);
+      const shift = shifts[s][f];
+      const point: Vec3 = [points[i][0] + shift[0], points[i][1] + shift[1], points[i][2] + shift[2]];
+      const reach = REACH * (length(sub(knee, hip)) + length(sub(ankle, knee))) + (i > 0 ? 0.95 * length(sub(points[i], ankle)) : 0);
+      const v = sub(point, hip);
+      const across = v[0] * v[0] + v[2] * v[2];
+      if (across >= reach * reach) return;
+      need[f] = Math.max(need[f], -v[1] - Math.sqrt(reach * reach - across));
+    });
+  }
+  for (let f = 0; f < F; f++) {
+    let drop = 0;
+    for (let g = Math.max(0, f - blend); g <= Math.min(F - 1, f + blend); g++) {
+      drop = Math.max(drop, need[g] * (1 - smoothstep(Math.abs(f - g) / (blend + 1))));
+    }
+    if (!(drop > 0)) continue;
+    rootTranslations[f * 3 + 1] -= drop;
+    for (let b = 0; b < B; b++) positions[(f * B + b) * 3 + 1] -= drop;
+    legs.forEach((_, s) => pinned[s][f] >= 0 && (shifts[s][f][1] += drop));
   }
 }
 
