@@ -46,7 +46,7 @@ describe('the look: skeleton, character or both', { timeout: 240_000 }, () => {
       await walking(page);
       let s = await stats(page);
       assert.equal(s.look, 'character', 'the character is the default look');
-      assert.ok(s.characterVertices > 3000, `a smooth character is drawn (${s.characterVertices} vertices)`);
+      assert.ok(s.characterVertices > 1500, `a smooth character is drawn (${s.characterVertices} vertices)`);
       assert.deepEqual(await pressed(page), ['character']);
       assert.equal(new URL(page.url()).searchParams.get('look'), null, 'the default look stays out of the link');
 

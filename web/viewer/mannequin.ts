@@ -562,6 +562,26 @@ export interface MannequinOptions {
   lit?: boolean;
 }
 
+/**
+ * The last few surfaces made, by proportions (to the millimetre), colours and detail: every model's motion is on
+ * the canonical skeleton, so a new stream (a restart, a new seed) finds its surface here instead of building it
+ * again on the page's thread (tens of milliseconds). A geometry shared by two meshes may be disposed by one:
+ * three.js uploads it again for the other.
+ */
+const GEOMETRIES = new Map<string, THREE.BufferGeometry>();
+function cachedGeometry(lengths: Float64Array, colors: MannequinColors, lit: boolean): THREE.BufferGeometry {
+  const key = [lit, colors.body.getHex(), colors.left.getHex(), colors.right.getHex(), ...Array.from(lengths, (l) => Math.round(l * 1000))].join(',');
+  let geometry = GEOMETRIES.get(key);
+  if (!geometry) {
+    // Software GL pays for every triangle (figure.ts): there, half the rings and 14 vertices around each.
+    geometry = lit ? tubeGeometry(buildTubes(lengths, colors)) : tubeGeometry(buildTubes(lengths, colors, 0.5), 14);
+    if (GEOMETRIES.size >= 4) GEOMETRIES.delete(GEOMETRIES.keys().next().value!);
+  }
+  GEOMETRIES.delete(key);
+  GEOMETRIES.set(key, geometry); // most recent last
+  return geometry;
+}
+
 /** The mannequin for a motion's canonical points: a SkinnedMesh posed with `pose(points)`. */
 export class Mannequin {
   readonly mesh: THREE.SkinnedMesh;
@@ -574,8 +594,7 @@ export class Mannequin {
   constructor(points: Float32Array, frames: number, { colors = MANNEQUIN_COLORS, lit = true }: MannequinOptions = {}) {
     const lengths = measureBones(points, frames);
     const bind = bindPoints(lengths);
-    // Software GL pays for every triangle (figure.ts): there, half the rings and 14 vertices around each.
-    const geometry = lit ? tubeGeometry(buildTubes(lengths, colors)) : tubeGeometry(buildTubes(lengths, colors, 0.5), 14);
+    const geometry = cachedGeometry(lengths, colors, lit);
     this.vertexCount = geometry.getAttribute('position').count;
 
     // Bind rotations: the same solver on the bind pose.
