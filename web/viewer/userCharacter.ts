@@ -10,7 +10,8 @@
 import * as THREE from 'three';
 import { GLTFLoader, type GLTF } from 'three/examples/jsm/loaders/GLTFLoader.js';
 import { clone as cloneSkinned } from 'three/examples/jsm/utils/SkeletonUtils.js';
-import { CANONICAL_JOINTS, mapHumanoid, SkeletonMapError, type CanonicalJoint, type HumanoidMap } from '../motion/humanoid';
+import { CANONICAL_JOINTS, CANONICAL_PARENTS, SkeletonMapError, type CanonicalJoint, type HumanoidMap } from '../motion/humanoid';
+import { mapSkeleton, toCanonical, type SkeletonMapping } from '../motion/skeletonMap';
 import type { Quat, Vec3 } from '../motion/math';
 import { mapRig, restPositions, retarget, type CharacterRig, type RetargetResult } from '../motion/retarget';
 import { quoteInput } from '../motion/text';
@@ -257,6 +258,11 @@ export class UserCharacterDriver implements CharacterView {
   private result: RetargetResult | null = null;
   /** The motion `result` retargets. */
   private source: Motion | null = null;
+  /**
+   * The shown skeleton's canonical points (null: it is the canonical skeleton), found on its first window and kept
+   * for the next ones: a second of a dance (arms over the head) may not map on its own.
+   */
+  private sourceMapping: SkeletonMapping | null = null;
   private readonly point = new THREE.Vector3();
 
   /**
@@ -348,7 +354,9 @@ export class UserCharacterDriver implements CharacterView {
     const dropped = old && this.result ? liveOverlap(old, motion) : -1;
     const started = performance.now();
     try {
-      this.result = dropped >= 0 ? extendLive(this.result!, old!, motion, dropped, this.asset.rig) : retarget(motion, this.asset.rig);
+      if (dropped < 0) this.sourceMapping = isCanonical(motion) ? null : mapSkeleton(motion, 1);
+      const canonical = (m: Motion) => this.canonicalOf(m);
+      this.result = dropped >= 0 ? extendLive(this.result!, old!, motion, dropped, this.asset.rig, canonical) : retarget(canonical(motion), this.asset.rig);
     } catch {
       this.result = null;
       this.source = null;
@@ -393,6 +401,13 @@ export class UserCharacterDriver implements CharacterView {
     this.group.position.set(dx, 0, dz);
   }
 
+  /** `m` on the canonical skeleton through the mapping kept (retarget maps a motion that is not). */
+  private canonicalOf(m: Motion): Motion {
+    if (!this.sourceMapping) return m;
+    const positions = toCanonical(m, { ...this.sourceMapping, scale: 1 });
+    return { fps: m.fps, frames: m.frames, joints: [...CANONICAL_JOINTS], parents: [...CANONICAL_PARENTS], positions, ...(m.contacts ? { contacts: m.contacts } : {}) };
+  }
+
   /** Shows a motion already retargeted onto this rig (the exporter's copy uses the one the page shows). */
   setResult(result: RetargetResult): void {
     this.result = result;
@@ -430,6 +445,11 @@ function matcapOf(m: THREE.Material): THREE.MeshMatcapMaterial {
   });
 }
 
+/** Whether the motion is on the canonical skeleton (every model's output). */
+function isCanonical(m: Motion): boolean {
+  return m.joints.length === CANONICAL_JOINTS.length && m.joints.every((name, k) => name === CANONICAL_JOINTS[k]);
+}
+
 /** Frames before a live window's new ones that are retargeted with them (planted feet and their lock carry over). */
 const LIVE_CONTEXT = 30;
 
@@ -453,7 +473,7 @@ function liveOverlap(previous: Motion, next: Motion): number {
 }
 
 /** The retargeting of `next` from that of `previous` (`dropped` frames off its start): its new frames retargeted. */
-function extendLive(old: RetargetResult, previous: Motion, next: Motion, dropped: number, rig: CharacterRig): RetargetResult {
+function extendLive(old: RetargetResult, previous: Motion, next: Motion, dropped: number, rig: CharacterRig, canonical: (m: Motion) => Motion): RetargetResult {
   const kept = previous.frames - dropped;
   const fresh = next.frames - kept;
   const B = rig.bones.length;
@@ -466,7 +486,7 @@ function extendLive(old: RetargetResult, previous: Motion, next: Motion, dropped
     positions: next.positions.subarray(from * stride, next.frames * stride),
     contacts: next.contacts?.subarray(from * 2, next.frames * 2),
   };
-  const r = fresh > 0 ? retarget(part, rig) : null;
+  const r = fresh > 0 ? retarget(canonical(part), rig) : null;
   const splice = (a: Float32Array, b: Float32Array | undefined, per: number): Float32Array => {
     const out = new Float32Array(next.frames * per);
     out.set(a.subarray(dropped * per, previous.frames * per));
