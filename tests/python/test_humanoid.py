@@ -21,7 +21,7 @@ KINDS = {
     "CMU BVH": (("LeftUpLeg", "LeftLeg", "LeftFoot", "LeftToeBase", "LeftArm", "LeftForeArm", "LeftHand"),
                 lambda n: n.replace("Left", "Right"), {"Hips": "Hips", "Neck": "Spine1", "Head": "Head"}),
     "Indian dance BVH": (("LeftHip", "LeftKnee", "LeftAnkle", "LeftToe", "LeftShoulder", "LeftElbow", "LeftWrist"),
-                         lambda n: n.replace("Left", "Right"), {"Hips": "Hips", "Neck": "Neck", "Head": "Head"}),
+                         lambda n: n.replace("Left", "Right"), {"Hips": "Hips", "Neck": "Chest2", "Head": "Head"}),
     "Bandai Namco BVH": (("UpperLeg_L", "LowerLeg_L", "Foot_L", "Toes_L", "UpperArm_L", "LowerArm_L", "Hand_L"),
                          lambda n: n.replace("_L", "_R"), {"Hips": "Hips", "Neck": "Neck", "Head": "Head"}),
     "CMU ASF": (("lhipjoint", "lfemur", "ltibia", "lfoot", "lclavicle", "lhumerus", "lradius"),
@@ -90,70 +90,20 @@ def wrong_points(kind: str, names: list[str], source: list[int]) -> list[str]:
 
 
 # The mapper's misses on the corpus today, each a real error (the rest of the points checked are right, and no side is
-# ever swapped). Fix them in web/motion/humanoid.ts and here alike, then delete them from this table:
-# - CMU BVH subjects 08 and 09: Neck1 lies nearer the shoulders than Spine1, the neck base (the importer drops the
-#   zero-length joint the scheme names Neck, so no name holds the neck base there);
-# - CMU BVH without names: the wrist goes to the finger base (CMU's humerus is ~1.48 × its radius, not 1.27, so a
-#   forearm through the palm fits the proportion better);
-# - CMU ASF: on subjects whose radius is short against the humerus (05, 32, 38, 55; without names most subjects)
-#   the wrist goes one or two bones on, to lwrist or lhand, despite the scheme naming lradius; without names the
-#   neck base goes one up, to lowerneck;
-# - Bandai Namco without names: the shoulder goes to the clavicle's start (its upper arm is ~1.09 × its forearm, so
-#   clavicle + upper arm fits the proportion better); Indian dance without names: the right wrist to RFingers.
+# ever swapped). Fix them in web/motion/humanoid.ts and here alike, then delete them from this table. Only anonymous
+# ASF skeletons remain (an ASF file always names its bones, so a user never meets them):
+# - the wrist goes one bone on, to lwrist (2 cm), where the thumb branches off: the mapper takes a joint where several
+#   bones start for the likelier wrist, which is right for CMU BVH, Mixamo and the 3ds Max conversion;
+# - subject 39's neck base goes one up, to lowerneck: its shoulders stand more than half a shoulder width above the
+#   thorax along the torso.
 KNOWN_MISSES = {
-    "07_04.bvh.gz (anonymous)": "LeftHand=LeftHandIndex1 RightHand=RightHandIndex1",
-    "07_05.bvh.gz (anonymous)": "LeftHand=LeftHandIndex1 RightHand=RightHandIndex1",
-    "07_12.bvh.gz (anonymous)": "LeftHand=LeftHandIndex1 RightHand=RightHandIndex1",
-    "08_05.bvh.gz": "Neck=Neck1",
-    "08_05.bvh.gz (anonymous)": "LeftHand=LeftHandIndex1 RightHand=RightHandIndex1 Neck=Neck1",
-    "08_07.bvh.gz": "Neck=Neck1",
-    "08_07.bvh.gz (anonymous)": "LeftHand=LeftHandIndex1 RightHand=RightHandIndex1 Neck=Neck1",
-    "08_11.bvh.gz": "Neck=Neck1",
-    "08_11.bvh.gz (anonymous)": "LeftHand=LeftHandIndex1 RightHand=RightHandIndex1 Neck=Neck1",
-    "09_01.bvh.gz": "Neck=Neck1",
-    "09_01.bvh.gz (anonymous)": "LeftHand=LeftHandIndex1 RightHand=RightHandIndex1 Neck=Neck1",
-    "09_02.bvh.gz": "Neck=Neck1",
-    "09_02.bvh.gz (anonymous)": "LeftHand=LeftHandIndex1 RightHand=RightHandIndex1 Neck=Neck1",
-    "09_03.bvh.gz": "Neck=Neck1",
-    "09_03.bvh.gz (anonymous)": "LeftHand=LeftHandIndex1 RightHand=RightHandIndex1 Neck=Neck1",
-    "09_04.bvh.gz": "Neck=Neck1",
-    "09_04.bvh.gz (anonymous)": "LeftHand=LeftHandIndex1 RightHand=RightHandIndex1 Neck=Neck1",
-    "09_05.bvh.gz": "Neck=Neck1",
-    "09_05.bvh.gz (anonymous)": "LeftHand=LeftHandIndex1 RightHand=RightHandIndex1 Neck=Neck1",
-    "09_06.bvh.gz": "Neck=Neck1",
-    "09_06.bvh.gz (anonymous)": "LeftHand=LeftHandIndex1 RightHand=RightHandIndex1 Neck=Neck1",
-    "09_07.bvh.gz": "Neck=Neck1",
-    "09_07.bvh.gz (anonymous)": "LeftHand=LeftHandIndex1 RightHand=RightHandIndex1 Neck=Neck1",
-    "09_08.bvh.gz": "Neck=Neck1",
-    "09_08.bvh.gz (anonymous)": "LeftHand=LeftHandIndex1 RightHand=RightHandIndex1 Neck=Neck1",
-    "09_09.bvh.gz": "Neck=Neck1",
-    "09_09.bvh.gz (anonymous)": "LeftHand=LeftHandIndex1 RightHand=RightHandIndex1 Neck=Neck1",
-    "09_10.bvh.gz": "Neck=Neck1",
-    "09_10.bvh.gz (anonymous)": "LeftHand=LeftHandIndex1 RightHand=RightHandIndex1 Neck=Neck1",
-    "94_01 (Indian dance) (anonymous)": "RightHand=RFingers",
-    "dataset-2_run_active_001 (anonymous)": "LeftArm=Shoulder_L RightArm=Shoulder_R",
-    "dataset-2_walk_elderly_003 (anonymous)": "LeftArm=Shoulder_L RightArm=Shoulder_R",
-    "dataset-2_walk-turn-left_feminine_010 (anonymous)": "LeftArm=Shoulder_L RightArm=Shoulder_R",
-    "dataset-2_walk-turn-right_masculine_020 (anonymous)": "LeftArm=Shoulder_L RightArm=Shoulder_R",
-    "dataset-2_run_exhausted_030 (anonymous)": "LeftArm=Shoulder_L RightArm=Shoulder_R",
-    "dataset-2_walk_youthful_005 (anonymous)": "LeftArm=Shoulder_L RightArm=Shoulder_R",
-    "05_01 (ASF/AMC)": "LeftHand=lhand RightHand=rhand",
-    "05_01 (ASF/AMC) (anonymous)": "LeftHand=lhand RightHand=rhand",
-    "06_01 (ASF/AMC) (anonymous)": "RightHand=rwrist Neck=lowerneck",
-    "08_01 (ASF/AMC) (anonymous)": "LeftHand=lwrist Neck=lowerneck",
-    "09_11 (ASF/AMC) (anonymous)": "RightHand=rwrist Neck=lowerneck",
-    "10_04 (ASF/AMC) (anonymous)": "LeftHand=lwrist RightHand=rwrist Neck=lowerneck",
-    "105_01 (ASF/AMC) (anonymous)": "RightHand=rwrist Neck=lowerneck",
-    "13_11 (ASF/AMC) (anonymous)": "RightHand=rwrist Neck=lowerneck",
-    "32_01 (ASF/AMC)": "LeftHand=lwrist",
+    "05_01 (ASF/AMC) (anonymous)": "LeftHand=lwrist RightHand=rwrist",
+    "06_01 (ASF/AMC) (anonymous)": "RightHand=rwrist",
     "32_01 (ASF/AMC) (anonymous)": "LeftHand=lwrist RightHand=rwrist",
-    "38_01 (ASF/AMC)": "LeftHand=lwrist",
     "38_01 (ASF/AMC) (anonymous)": "LeftHand=lwrist RightHand=rwrist",
     "39_01 (ASF/AMC) (anonymous)": "Neck=lowerneck",
-    "43_01 (ASF/AMC) (anonymous)": "LeftHand=lwrist Neck=lowerneck",
-    "49_01 (ASF/AMC) (anonymous)": "LeftHand=lwrist RightHand=rwrist",
-    "55_01 (ASF/AMC)": "RightHand=rwrist",
-    "55_01 (ASF/AMC) (anonymous)": "LeftHand=lwrist RightHand=rwrist",
+    "43_01 (ASF/AMC) (anonymous)": "LeftHand=lwrist",
+    "55_01 (ASF/AMC) (anonymous)": "RightHand=rwrist",
 }
 
 

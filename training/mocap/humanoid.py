@@ -182,17 +182,29 @@ SAMPLED_FRAMES = 48
 COINCIDENT = 0.003
 # Human proportions (Winter, Biomechanics and Motor Control of Human Movement, segment lengths ÷ height).
 UPPER_ARM_TO_FOREARM = 0.186 / 0.146
+# Upper arm ÷ forearm ratios found in real skeletons: from about 1.0 (Bandai Namco) to 2.2 (CMU subjects whose radius
+# is short); within this range the ratio costs only a tie-breaking WEAK share of its squared log distance from
+# Winter's, outside it the full squared log distance to the range.
+UPPER_ARM_RANGE = (0.95, 2.3)
+WEAK = 0.1
 HAND_TO_FOREARM = 0.7
 FOOT_TO_LEG = 0.26
-# Costs (squared log ratios): a limb without a foot or hand beyond; a named hint; a helper joint.
+# Costs (squared log ratios): a limb without a foot or hand beyond; a joint the naming scheme names for the point
+# (enough to outweigh any proportion: names are hints, but a scheme that matched is rarely wrong); a helper joint.
 NO_FOOT = 0.15
 NO_HAND = 0.1
-NAME_HINT = 0.1
+# A wrist candidate where several bones start (thumb and fingers) gains this much (CMU's short hands).
+BRANCHING_WRIST = NO_HAND / 2
+NAME_HINT = 1.0
 HELPER = 0.2
 # How much longer (log ratio) a foot or hand may be than the proportion at no cost. Shorter costs nothing: rigs cut
 # hands at the palm and feet at the ball (CMU's hands are a fifth of the forearm).
 EXTREMITY_SLACK = 0.7
+# How far (half shoulder widths) the shoulders may stand above the neck base along the torso.
+NECK_BELOW = 0.5
 HELPER_NAME = re.compile(r"twist|roll|share|helper|corrective|jiggle|adjust|pole|target|ctrl|control", re.IGNORECASE)
+# Inverse-kinematics bones (Unreal's ik_foot_l, ik_hand_gun …): targets at a hand's or foot's place, not limbs.
+IK_NAME = re.compile(r"(^|[^a-z])ik([^a-z]|$)", re.IGNORECASE)
 # A later candidate replaces the best so far only when better by more than this (the page's rule, for equal ties).
 TIE = 1e-12
 
@@ -334,9 +346,10 @@ def _nearest(candidates: list[int], cost: Callable[[int], float]) -> int:
     return best
 
 
-def _limb_points(t: _Tree, top: int, tip: int, names: Sequence[str]) -> list[int]:
+def _limb_points(t: _Tree, top: int, tip: int, names: Sequence[str], named_any: Callable[[int], bool]) -> list[int]:
     """A limb's distinct points from `top` (excluded) to `tip`: runs of joints of (almost) no length count as one
-    point, represented by the deepest joint that is not a helper; points at the top's own place are dropped."""
+    point, represented by a joint the naming scheme names (CMU's LeftHand, not the LeftFingerBase at its place), else
+    the deepest joint that is not a helper; points at the top's own place are dropped."""
     eps = COINCIDENT * t.height
     groups: list[list[int]] = []
     for j in t.path_down(top, tip):
@@ -346,7 +359,9 @@ def _limb_points(t: _Tree, top: int, tip: int, names: Sequence[str]) -> list[int
             groups[-1].append(j)
         else:
             groups.append([j])
-    return [next((j for j in reversed(g) if not HELPER_NAME.search(names[j])), g[-1]) for g in groups]
+    return [next((j for j in g if named_any(j)), None)
+            if any(named_any(j) for j in g) else next((j for j in reversed(g) if not HELPER_NAME.search(names[j])), g[-1])
+            for g in groups]
 
 
 class _Hints:
@@ -367,6 +382,9 @@ class _Hints:
     def named(self, j: int, point: str) -> bool:
         return self.useful and self.source[CANONICAL_JOINTS.index(point)] == j
 
+    def named_any(self, j: int) -> bool:
+        return self.useful and j in self.source
+
     def hint(self, j: int, point: str) -> float:
         return (-NAME_HINT if self.named(j, point) else 0.0) + (HELPER if HELPER_NAME.search(self.names[j]) else 0.0)
 
@@ -380,7 +398,7 @@ def _named_or_nearest(candidates: list[int], hints: _Hints, point: str, cost: Ca
 def _fit_leg(t: _Tree, pelvis: int, leg_root: int, hints: _Hints, side: str, names: Sequence[str]) -> dict[str, int] | None:
     """A leg's points (socket, knee, ankle, toe base?, toe end?) below `pelvis` down to its farthest leaf."""
     tip = t.farthest_leaf(leg_root, pelvis)
-    pts = _limb_points(t, pelvis, tip, names)
+    pts = _limb_points(t, pelvis, tip, names, hints.named_any)
     if len(pts) < 3:
         return None
 
@@ -418,7 +436,7 @@ def _fit_leg(t: _Tree, pelvis: int, leg_root: int, hints: _Hints, side: str, nam
 def _fit_arm(t: _Tree, chest: int, arm_root: int, hints: _Hints, side: str, names: Sequence[str]) -> dict[str, int] | None:
     """An arm's points (shoulder, elbow, wrist, hand end?) below `chest` down to its farthest leaf."""
     tip = t.farthest_leaf(arm_root, chest)
-    pts = _limb_points(t, chest, tip, names)
+    pts = _limb_points(t, chest, tip, names, hints.named_any)
     if len(pts) < 3:
         return None
 
@@ -433,8 +451,19 @@ def _fit_arm(t: _Tree, chest: int, arm_root: int, hints: _Hints, side: str, name
                 upper, fore = arc(pts[s], pts[e]), arc(pts[e], pts[w])
                 hand = arc(pts[w], tip)
                 clavicle = t.arc[pts[s]] - t.arc[chest]
-                cost = _sq(math.log(upper / fore / UPPER_ARM_TO_FOREARM)) + (
-                    NO_HAND if w == len(pts) - 1 else _slack(math.log(hand / (HAND_TO_FOREARM * fore))))
+                ratio = upper / fore
+                cost = WEAK * _sq(math.log(ratio / UPPER_ARM_TO_FOREARM)) + _sq(
+                    math.log(max(1.0, UPPER_ARM_RANGE[0] / ratio, ratio / UPPER_ARM_RANGE[1])))
+                # The hand: a wrist with nothing beyond costs NO_HAND; a hand much longer than the forearm allows
+                # costs fully, any other length weakly against the typical one, and never as much as no hand at all.
+                cost += NO_HAND if w == len(pts) - 1 else (
+                    _slack(math.log(hand / (HAND_TO_FOREARM * fore)))
+                    + min(WEAK * _sq(math.log(hand / (HAND_TO_FOREARM * fore))), NO_HAND / 2))
+                # A wrist is where the thumb and fingers part: a joint with several children is the likelier wrist.
+                if len(t.children[pts[w]]) >= 2:
+                    cost -= BRANCHING_WRIST
+                # From the chest's branch to the shoulder is about a forearm long (the canonical clavicle); weakly.
+                cost += WEAK * _sq(math.log(max(clavicle, 1e-9 * t.height) / fore))
                 if clavicle > upper:
                     cost += _sq(math.log(clavicle / upper))
                 cost += hint(pts[s], f"{side}Arm") + hint(pts[e], f"{side}ForeArm") + hint(pts[w], f"{side}Hand")
@@ -515,6 +544,19 @@ def _refuse(missing: str) -> SkeletonMapError:
     return SkeletonMapError(f"this skeleton is not a humanoid the playground can map: {missing}")
 
 
+def _main_tree_root(t: _Tree) -> int:
+    """The root of the tree with the most bone length (a file may hold props or a second figure beside the body)."""
+    total = [0.0] * len(t.parents)
+    for j in range(len(t.parents) - 1, -1, -1):
+        if t.parents[j] >= 0:
+            total[t.parents[j]] += total[j] + t.bone[j]
+    best = -1
+    for j, p in enumerate(t.parents):
+        if p < 0 and (best < 0 or total[j] > total[best] + TIE):
+            best = j
+    return best
+
+
 def map_humanoid(joints: Sequence[str], parents: Sequence[int], positions: np.ndarray) -> HumanoidMap:
     """The canonical points of a humanoid skeleton: `joints` (names), `parents` (-1 for a root, each parent listed
     before its children; joints of a second tree are never taken for a limb's) and world `positions` (frames, joints,
@@ -540,7 +582,17 @@ def map_humanoid(joints: Sequence[str], parents: Sequence[int], positions: np.nd
     names = joints
     hints = _Hints(names)
     hint, named = hints.hint, hints.named
-    leaves = [j for j, c in enumerate(t.children) if not c]
+    # Extremities are leaves of the main tree (the one with the most bone length: a prop beside the figure is not a
+    # foot), neither helpers themselves (a twist bone's end) nor below an IK bone (an IK hand sits where the hand is;
+    # a helper inside a limb, such as an inline twist bone, leaves the limb's end an extremity).
+    main_root = _main_tree_root(t)
+    below_ik = [False] * J
+    for j in range(J):
+        below_ik[j] = bool(IK_NAME.search(names[j])) or (parents[j] >= 0 and below_ik[parents[j]])
+    leaves = [j for j, c in enumerate(t.children)
+              if not c and not below_ik[j] and not HELPER_NAME.search(names[j]) and t.is_below(j, main_root)]
+    if not leaves:
+        raise _refuse("no two legs (no second foot near the floor)")
 
     def lowest(candidates: list[int]) -> int:
         best = candidates[0]
@@ -597,6 +649,13 @@ def map_humanoid(joints: Sequence[str], parents: Sequence[int], positions: np.nd
             head_end, skull = skull, parent
     top = t.lca(pelvis, chest)
     hips = top if abs(t.lift[top] - t.lift[pelvis]) <= 0.1 * t.height else pelvis
+    # A joint the scheme names the hips, above the one found and near it (a Biped's thighs hang from its spine).
+    k = hips
+    while k >= 0:
+        if named(k, "Hips") and abs(t.lift[k] - t.lift[hips]) <= 0.15 * t.height:
+            hips = k
+            break
+        k = t.parents[k]
 
     # 4. Limbs, sides still unknown (A, B).
     legs = [_fit_leg(t, pelvis, r, hints, "Left", names) for r in leg_roots]
@@ -623,17 +682,31 @@ def map_humanoid(joints: Sequence[str], parents: Sequence[int], positions: np.nd
     right = {"leg": legs_other[1] if leg_a_is_left else legs_other[0],
              "arm": arms_other[1] if arm_a_is_left else arms_other[0]}
 
-    # 5. The neck base: from the chest up towards the head, the one named so, else the joint nearest the shoulders (a
-    # little bias to the chest).
+    # 5. The neck base: the joint from the chest up that the naming scheme names so; else the first one (from the
+    # chest's branch up) that the shoulders do not stand well above: the shoulders' midpoint at most NECK_BELOW half
+    # shoulder widths above it along the torso (hips → head). CMU's thorax lies 0.3–0.45 below its shoulders and its
+    # next neck joint 0.1–0.16 above them; Bandai's chest 1.3 below, its neck 0.36 above.
     shoulders = [left["arm"]["Arm"], right["arm"]["Arm"]]
     neck_path = [chest] + [j for j in t.path_down(chest, skull) if j != skull]
 
-    def near_shoulders(j: int) -> float:
-        return _median([(_dist(t.at(f, j), t.at(f, shoulders[0])) + _dist(t.at(f, j), t.at(f, shoulders[1]))) / 2
-                        for f in t.frames])
+    def shoulders_above(j: int) -> float:
+        values = []
+        for f in t.frames:
+            hips_at, head_at, l, r, at = t.at(f, hips), t.at(f, skull), t.at(f, shoulders[0]), t.at(f, shoulders[1]), t.at(f, j)
+            up = [head_at[a] - hips_at[a] for a in range(3)]
+            n = math.hypot(up[0], up[1], up[2]) or 1.0
+            rise = 0.0
+            for a in range(3):
+                rise += ((l[a] + r[a]) / 2 - at[a]) * (up[a] / n)
+            values.append(rise / (_dist(l, r) / 2 or 1.0))
+        return _median(values)
 
-    neck = _named_or_nearest(neck_path, hints, "Neck",
-                             lambda j: near_shoulders(j) * (1 + hint(j, "Neck") / 2) + 0.1 * (t.arc[j] - t.arc[chest]))
+    unnamed_else = [j for j in neck_path if not named(j, "Neck1") and not named(j, "Head")]
+    neck = next((j for j in neck_path if named(j, "Neck")), None)
+    if neck is None:
+        neck = next((j for j in unnamed_else if shoulders_above(j) <= NECK_BELOW), None)
+    if neck is None:
+        neck = unnamed_else[-1] if unnamed_else else chest
 
     source = [-1] * len(CANONICAL_JOINTS)
 

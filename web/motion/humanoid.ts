@@ -205,19 +205,35 @@ const SAMPLED_FRAMES = 48;
 const COINCIDENT = 0.003;
 /** Human proportions (Winter, Biomechanics and Motor Control of Human Movement, segment lengths ÷ height). */
 const UPPER_ARM_TO_FOREARM = 0.186 / 0.146;
+/**
+ * Upper arm ÷ forearm ratios found in real skeletons: from about 1.0 (Bandai Namco) to 2.2 (CMU subjects whose
+ * radius is short); within this range the ratio costs only a tie-breaking WEAK share of its squared log distance
+ * from Winter's, outside it the full squared log distance to the range.
+ */
+const UPPER_ARM_RANGE: readonly [number, number] = [0.95, 2.3];
+const WEAK = 0.1;
 const HAND_TO_FOREARM = 0.7;
 const FOOT_TO_LEG = 0.26;
-/** Costs (squared log ratios): a limb without a foot or hand beyond; a named hint; a helper joint. */
+/**
+ * Costs (squared log ratios): a limb without a foot or hand beyond; a joint the naming scheme names for the point
+ * (enough to outweigh any proportion: names are hints, but a scheme that matched is rarely wrong); a helper joint.
+ */
 const NO_FOOT = 0.15;
 const NO_HAND = 0.1;
-const NAME_HINT = 0.1;
+/** A wrist candidate where several bones start (thumb and fingers) gains this much (CMU's short hands). */
+const BRANCHING_WRIST = NO_HAND / 2;
+const NAME_HINT = 1;
 const HELPER = 0.2;
 /**
  * How much longer (log ratio) a foot or hand may be than the proportion at no cost. Shorter costs nothing: rigs cut
  * hands at the palm and feet at the ball (CMU's hands are a fifth of the forearm).
  */
 const EXTREMITY_SLACK = 0.7;
+/** How far (half shoulder widths) the shoulders may stand above the neck base along the torso. */
+const NECK_BELOW = 0.5;
 const HELPER_NAME = /twist|roll|share|helper|corrective|jiggle|adjust|pole|target|ctrl|control/i;
+/** Inverse-kinematics bones (Unreal's ik_foot_l, ik_hand_gun …): targets at a hand's or foot's place, not limbs. */
+const IK_NAME = /(^|[^a-z])ik([^a-z]|$)/i;
 
 interface Tree {
   parents: readonly number[];
@@ -281,6 +297,17 @@ function dist(a: readonly number[], b: readonly number[]): number {
   return Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
 }
 
+/** The root of the tree with the most bone length (a file may hold props or a second figure beside the body). */
+function mainTreeRoot(t: Tree): number {
+  const total = new Float64Array(t.parents.length);
+  for (let j = t.parents.length - 1; j >= 0; j--) if (t.parents[j] >= 0) total[t.parents[j]] += total[j] + t.bone[j];
+  let best = -1;
+  t.parents.forEach((p, j) => {
+    if (p < 0 && (best < 0 || total[j] > total[best] + 1e-12)) best = j;
+  });
+  return best;
+}
+
 function lca(t: Tree, a: number, b: number): number {
   while (t.depth[a] > t.depth[b]) a = t.parents[a];
   while (t.depth[b] > t.depth[a]) b = t.parents[b];
@@ -325,9 +352,10 @@ function leavesUnder(t: Tree, j: number): number[] {
 
 /**
  * A limb's distinct points from `top` (excluded) to `tip`: runs of joints of (almost) no length count as one point,
- * represented by the deepest joint that is not a helper; points at the top's own place are dropped.
+ * represented by a joint the naming scheme names (CMU's LeftHand, not the LeftFingerBase at its place), else the
+ * deepest joint that is not a helper; points at the top's own place are dropped.
  */
-function limbPoints(t: Tree, top: number, tip: number, names: readonly string[]): number[] {
+function limbPoints(t: Tree, top: number, tip: number, names: readonly string[], namedAny: (j: number) => boolean): number[] {
   const eps = COINCIDENT * t.height;
   const groups: number[][] = [];
   for (const j of pathDown(t, top, tip)) {
@@ -335,17 +363,17 @@ function limbPoints(t: Tree, top: number, tip: number, names: readonly string[])
     if (groups.length && t.bone[j] < eps) groups[groups.length - 1].push(j);
     else groups.push([j]);
   }
-  return groups.map((g) => [...g].reverse().find((j) => !HELPER_NAME.test(names[j])) ?? g[g.length - 1]);
+  return groups.map((g) => g.find(namedAny) ?? [...g].reverse().find((j) => !HELPER_NAME.test(names[j])) ?? g[g.length - 1]);
 }
 
 type Hint = (j: number, point: CanonicalJoint) => number;
-type Hints = { hint: Hint; named: (j: number, point: CanonicalJoint) => boolean };
+type Hints = { hint: Hint; named: (j: number, point: CanonicalJoint) => boolean; namedAny: (j: number) => boolean };
 
 /**
  * The naming scheme that places the most points (when it places at least 6), whether it names joint j as a point,
  * and the cost of a name for a point: a scheme's name for it lowers it, a helper's name raises it.
  */
-function hintsFor(names: readonly string[]): { hint: Hint; named: (j: number, point: CanonicalJoint) => boolean; scheme: string } {
+function hintsFor(names: readonly string[]): Hints & { scheme: string } {
   let best = { scheme: '', placed: 0, source: [] as number[] };
   for (const m of matchSchemes(names)) {
     const placed = m.source.filter((j) => j >= 0).length;
@@ -354,16 +382,17 @@ function hintsFor(names: readonly string[]): { hint: Hint; named: (j: number, po
   const useful = best.placed >= 6;
   const named = (j: number, point: CanonicalJoint) => useful && best.source[CANONICAL_JOINTS.indexOf(point)] === j;
   const hint: Hint = (j, point) => (named(j, point) ? -NAME_HINT : 0) + (HELPER_NAME.test(names[j]) ? HELPER : 0);
-  return { hint, named, scheme: useful ? best.scheme : '' };
+  const namedAny = (j: number) => useful && best.source.includes(j);
+  return { hint, named, namedAny, scheme: useful ? best.scheme : '' };
 }
 
 const sq = (x: number) => x * x;
 const slack = (x: number) => sq(Math.max(0, x - EXTREMITY_SLACK));
 
 /** A leg's points (socket, knee, ankle, toe base?, toe end?) below `pelvis` down to its farthest leaf. */
-function fitLeg(t: Tree, pelvis: number, legRoot: number, { hint, named }: Hints, side: 'Left' | 'Right', names: readonly string[]) {
+function fitLeg(t: Tree, pelvis: number, legRoot: number, { hint, named, namedAny }: Hints, side: 'Left' | 'Right', names: readonly string[]) {
   const tip = farthestLeaf(t, legRoot, pelvis);
-  const pts = limbPoints(t, pelvis, tip, names);
+  const pts = limbPoints(t, pelvis, tip, names, namedAny);
   if (pts.length < 3) return undefined;
   const arc = (a: number, b: number) => t.arc[b] - t.arc[a];
   const socket = pts[0];
@@ -392,9 +421,9 @@ function fitLeg(t: Tree, pelvis: number, legRoot: number, { hint, named }: Hints
 }
 
 /** An arm's points (shoulder, elbow, wrist, hand end?) below `chest` down to its farthest leaf. */
-function fitArm(t: Tree, chest: number, armRoot: number, { hint, named }: Hints, side: 'Left' | 'Right', names: readonly string[]) {
+function fitArm(t: Tree, chest: number, armRoot: number, { hint, named, namedAny }: Hints, side: 'Left' | 'Right', names: readonly string[]) {
   const tip = farthestLeaf(t, armRoot, chest);
-  const pts = limbPoints(t, chest, tip, names);
+  const pts = limbPoints(t, chest, tip, names, namedAny);
   if (pts.length < 3) return undefined;
   const arc = (a: number, b: number) => t.arc[b] - t.arc[a];
   let best: { cost: number; s: number; e: number; w: number } | undefined;
@@ -404,7 +433,15 @@ function fitArm(t: Tree, chest: number, armRoot: number, { hint, named }: Hints,
         const upper = arc(pts[s], pts[e]), fore = arc(pts[e], pts[w]);
         const hand = arc(pts[w], tip);
         const clavicle = t.arc[pts[s]] - t.arc[chest];
-        let cost = sq(Math.log(upper / fore / UPPER_ARM_TO_FOREARM)) + (w === pts.length - 1 ? NO_HAND : slack(Math.log(hand / (HAND_TO_FOREARM * fore))));
+        const ratio = upper / fore;
+        let cost = WEAK * sq(Math.log(ratio / UPPER_ARM_TO_FOREARM)) + sq(Math.log(Math.max(1, UPPER_ARM_RANGE[0] / ratio, ratio / UPPER_ARM_RANGE[1])));
+        // The hand: a wrist with nothing beyond costs NO_HAND; a hand much longer than the forearm allows costs
+        // fully, any other length weakly against the typical one, and never as much as no hand at all.
+        cost += w === pts.length - 1 ? NO_HAND : slack(Math.log(hand / (HAND_TO_FOREARM * fore))) + Math.min(WEAK * sq(Math.log(hand / (HAND_TO_FOREARM * fore))), NO_HAND / 2);
+        // A wrist is where the thumb and fingers part: a joint with several children is the likelier wrist.
+        if (t.children[pts[w]].length >= 2) cost -= BRANCHING_WRIST;
+        // From the chest's branch to the shoulder is about a forearm long (the canonical clavicle); weakly.
+        cost += WEAK * sq(Math.log(Math.max(clavicle, 1e-9 * t.height) / fore));
         if (clavicle > upper) cost += sq(Math.log(clavicle / upper));
         cost += hint(pts[s], `${side}Arm`) + hint(pts[e], `${side}ForeArm`) + hint(pts[w], `${side}Hand`);
         if (!best || cost < best.cost - 1e-12) best = { cost, s, e, w };
@@ -504,12 +541,20 @@ function refuse(missing: string): never {
 export function mapHumanoid(sk: PosedSkeleton): HumanoidMap {
   const J = sk.joints.length;
   if (J < 3 || sk.frames < 1) refuse(`it has ${J} joint${J === 1 ? '' : 's'}, not legs, arms and a head`);
+  if (sk.parents.some((p, j) => p >= j)) throw new SkeletonMapError('the skeleton\'s parents must come before their children');
   const t = treeOf(sk);
   if (!(t.height > 0)) refuse('its joints all lie at one height, so no legs can be told');
   const names = sk.joints;
   const hints = hintsFor(names);
   const { hint, named, scheme } = hints;
-  const leaves = t.children.flatMap((c, j) => (c.length === 0 ? [j] : []));
+  // Extremities are leaves of the main tree (the one with the most bone length: a prop beside the figure is not a
+  // foot), neither helpers themselves (a twist bone's end) nor below an IK bone (an IK hand sits where the hand is;
+  // a helper inside a limb, such as an inline twist bone, leaves the limb's end an extremity).
+  const mainRoot = mainTreeRoot(t);
+  const belowIK = new Array<boolean>(J).fill(false);
+  for (let j = 0; j < J; j++) belowIK[j] = IK_NAME.test(names[j]) || (sk.parents[j] >= 0 && belowIK[sk.parents[j]]);
+  const leaves = t.children.flatMap((c, j) => (c.length === 0 && !belowIK[j] && !HELPER_NAME.test(names[j]) && isBelow(t, j, mainRoot) ? [j] : []));
+  if (leaves.length === 0) refuse('no two legs (no second foot near the floor)');
   const lowest = (set: number[]) => set.reduce((a, b) => (t.lift[b] < t.lift[a] - 1e-12 ? b : a));
 
   // 1. Feet: the lowest leaf, and the lowest leaf a leg's length away along the tree.
@@ -550,7 +595,10 @@ export function mapHumanoid(sk: PosedSkeleton): HumanoidMap {
   }
   const hips = (() => {
     const top = lca(t, pelvis, chest);
-    return Math.abs(t.lift[top] - t.lift[pelvis]) <= 0.1 * t.height ? top : pelvis;
+    const found = Math.abs(t.lift[top] - t.lift[pelvis]) <= 0.1 * t.height ? top : pelvis;
+    // A joint the scheme names the hips, above the one found and near it (a Biped's thighs hang from its spine).
+    for (let k = found; k >= 0; k = t.parents[k]) if (named(k, 'Hips') && Math.abs(t.lift[k] - t.lift[found]) <= 0.15 * t.height) return k;
+    return found;
   })();
 
   // 4. Limbs, sides still unknown (A, B).
@@ -573,12 +621,22 @@ export function mapHumanoid(sk: PosedSkeleton): HumanoidMap {
   const left = { leg: legAisLeft ? legs[0]! : legs[1]!, arm: armAisLeft ? arms[0]! : arms[1]! };
   const right = { leg: legAisLeft ? legsOther[1]! : legsOther[0]!, arm: armAisLeft ? armsOther[1]! : armsOther[0]! };
 
-  // 5. The neck base: from the chest up towards the head, the joint nearest the shoulders (a little bias to the chest).
+  // 5. The neck base: the joint from the chest up that the naming scheme names so; else the first one (from the
+  // chest's branch up) that the shoulders do not stand well above: the shoulders' midpoint at most NECK_BELOW
+  // half shoulder widths above it along the torso (hips → head). CMU's thorax lies 0.3–0.45 below its shoulders
+  // and its next neck joint 0.1–0.16 above them; Bandai's chest 1.3 below, its neck 0.36 above.
   const shoulders = [left.arm.Arm, right.arm.Arm];
   const neckPath = [chest, ...pathDown(t, chest, skull).filter((j) => j !== skull)];
-  const nearShoulders = (j: number) =>
-    median(t.frames.map((f) => (dist(t.at(f, j), t.at(f, shoulders[0])) + dist(t.at(f, j), t.at(f, shoulders[1]))) / 2));
-  const neck = neckPath.find((j) => named(j, 'Neck')) ?? nearest(neckPath, (j) => nearShoulders(j) * (1 + hint(j, 'Neck') / 2) + 0.1 * (t.arc[j] - t.arc[chest]));
+  const shouldersAbove = (j: number) =>
+    median(t.frames.map((f) => {
+      const hipsAt = t.at(f, hips), headAt = t.at(f, skull), l = t.at(f, shoulders[0]), r = t.at(f, shoulders[1]), at = t.at(f, j);
+      const up = [0, 1, 2].map((a) => headAt[a] - hipsAt[a]);
+      const n = Math.hypot(up[0], up[1], up[2]) || 1;
+      const rise = [0, 1, 2].reduce((sum, a) => sum + ((l[a] + r[a]) / 2 - at[a]) * (up[a] / n), 0);
+      return rise / (dist(l, r) / 2 || 1);
+    }));
+  const unnamedElse = neckPath.filter((j) => !named(j, 'Neck1') && !named(j, 'Head'));
+  const neck = neckPath.find((j) => named(j, 'Neck')) ?? unnamedElse.find((j) => shouldersAbove(j) <= NECK_BELOW) ?? unnamedElse[unnamedElse.length - 1] ?? chest;
 
   const source = CANONICAL_JOINTS.map(() => -1);
   const put = (point: CanonicalJoint, j: number) => (source[CANONICAL_JOINTS.indexOf(point)] = j);
