@@ -9,6 +9,8 @@ import { lowFootSliding } from '../../web/motion/footSkating';
 import { atRate, canonicalView, floorHeight } from '../../web/motion/motionStats';
 import type { CharacterRig, RetargetResult } from '../../web/motion/retarget';
 import type { Motion } from '../../web/motion/types';
+import { readFileSync } from 'node:fs';
+import { fileURLToPath } from 'node:url';
 import { readCorpus } from './corpus';
 
 /** Body proportions (metres) of a test figure standing facing +z, its left at +x. */
@@ -196,6 +198,48 @@ export const RIGS: RigSpec[] = [
   },
 ];
 
+/**
+ * A CharacterRig from a GLB file's first skin, as a glTF loader gives it: the skin's joints in parent-first order,
+ * each one's node rotation and translation; the root's with its ancestors' transforms (the armature) folded in.
+ */
+export function rigFromGlb(bytes: Uint8Array): CharacterRig {
+  const view = new DataView(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+  const jsonLength = view.getUint32(12, true);
+  const gltf = JSON.parse(new TextDecoder().decode(bytes.subarray(20, 20 + jsonLength))) as {
+    nodes: Array<{ name?: string; children?: number[]; rotation?: Quat; translation?: Vec3 }>;
+    skins: Array<{ joints: number[] }>;
+  };
+  const parentOf = new Map<number, number>();
+  gltf.nodes.forEach((n, i) => n.children?.forEach((c) => parentOf.set(c, i)));
+  const joints = new Set(gltf.skins[0].joints);
+  const depth = (i: number): number => (parentOf.has(i) ? 1 + depth(parentOf.get(i)!) : 0);
+  const order = [...joints].sort((a, b) => depth(a) - depth(b));
+  const index = new Map(order.map((node, i) => [node, i]));
+  const rotation = (i: number): Quat => gltf.nodes[i].rotation ?? [0, 0, 0, 1];
+  const translation = (i: number): Vec3 => gltf.nodes[i].translation ?? [0, 0, 0];
+  const restRotations: Quat[] = [];
+  const restTranslations: Vec3[] = [];
+  const parents = order.map((node) => {
+    let p = parentOf.get(node);
+    let q = rotation(node), t = translation(node);
+    // Fold the transforms of non-joint ancestors (the armature) into the bone.
+    while (p !== undefined && !joints.has(p)) {
+      t = (([a, b, c], [x, y, z]) => [a + x, b + y, c + z] as Vec3)(translation(p), quatRotate(rotation(p), t));
+      q = quatMultiply(rotation(p), q);
+      p = parentOf.get(p);
+    }
+    restRotations.push(q);
+    restTranslations.push(t);
+    return p === undefined ? -1 : index.get(p)!;
+  });
+  return { bones: order.map((i) => gltf.nodes[i].name ?? `node ${i}`), parents, restRotations, restTranslations };
+}
+
+/** The project's CC0 test character (Unreal-style names, its root turned from z up). */
+export function quaterniusRig(): CharacterRig {
+  return rigFromGlb(readFileSync(fileURLToPath(new URL('../../../shared/characters/quaternius-human-male.glb', import.meta.url))));
+}
+
 /** The source motions: CMU walk and run (BVH), an acLSTM salsa, and a model-like canonical walk with contacts. */
 export interface Source { label: string; motion: Motion }
 
@@ -244,8 +288,8 @@ export interface Measures {
   sourceSliding: number;
   sliding: number;
   /** Over the source's planted frames (its contacts, else its labels): the character's foot height above the floor
-   *  (the lower of its heel (ankle) and ball (toe base), each less its height in the rig's rest pose): mean, 95th
-   *  percentile and largest |height|, metres. */
+   *  (the lowest of its heel (ankle), ball (toe base) and, where the rig has a bone there, toe tip, each less its
+   *  height in the rig's rest pose): mean, 95th percentile and largest |height|, metres. */
   plantedMean: number;
   planted95: number;
   plantedMax: number;
@@ -324,14 +368,14 @@ export function measure(source: Motion, result: RetargetResult): Measures {
   const feet = ['Left', 'Right'].map((side) => ['Foot', 'ToeBase', ...(withTips ? ['ToeBase_end'] : [])].map((n) => idx(`${side}${n}` as CanonicalJoint)));
   const floor = plantedLow(view, result.contacts, feet) - plantedLow(src, result.contacts, feet);
 
-  // Planted heights: heel and ball, each less its rest height above the rig's rest floor.
+  // Planted heights: heel, ball and toe tip (a bone's, not a derived one), each less its rest height above the rig's rest floor.
   const rest = result.restCanonical;
   const allFoot = ['Left', 'Right'].flatMap((side) => ['Foot', 'ToeBase', 'ToeBase_end'].map((n) => idx(`${side}${n}` as CanonicalJoint)));
   const restLow = Math.min(...allFoot.map((k) => rest[k * 3 + 1]));
   const restFloor = restLow >= 0 && restLow <= 0.15 ? 0 : restLow;
   const heights: number[] = [];
   ['Left', 'Right'].forEach((side, s) => {
-    const sole = ['Foot', 'ToeBase'].map((n) => idx(`${side}${n}` as CanonicalJoint));
+    const sole = ['Foot', 'ToeBase', ...(withTips ? ['ToeBase_end'] : [])].map((n) => idx(`${side}${n}` as CanonicalJoint));
     for (let f = 0; f < view.frames; f++) {
       if (result.contacts[f * 2 + s]) heights.push(Math.abs(Math.min(...sole.map((k) => view.positions[(f * K + k) * 3 + 1] - (rest[k * 3 + 1] - restFloor)))));
     }

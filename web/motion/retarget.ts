@@ -234,9 +234,6 @@ function legLength(points: ArrayLike<number>, frames: number): number {
   return total / (2 * frames);
 }
 
-/** Per canonical point: 0 or 1 for the left or right foot and toe (their segments' slope is aligned), else -1. */
-const FOOT_POINTS_SIDE = CANONICAL_JOINTS.map((n) => (['LeftFoot', 'LeftToeBase'].includes(n) ? 0 : ['RightFoot', 'RightToeBase'].includes(n) ? 1 : -1));
-
 /** A direction's slope: its angle above the ground (radians, negative below). */
 const pitchOf = (d: Vec3): number => Math.atan2(d[1], Math.hypot(d[0], d[2]));
 
@@ -266,6 +263,9 @@ interface LegBones {
   thigh: number;
   knee: number;
   ankle: number;
+  /** The toe bone and the toe-tip bone, -1 where the rig has none. */
+  toe: number;
+  tip: number;
   /** Foot points (ankle, toe, toe end) as offsets in the ankle bone's frame (rig units), and each one's rest height above the floor (m). */
   offsets: Vec3[];
   clearance: number[];
@@ -311,16 +311,20 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
   // the planted frames where its ankle is lowest: flat on the floor, not landing on the heel or the ball); the foot
   // and toes are turned down by the difference, so that a flat foot of the source is flat on the character too (toes
   // neither floating nor sunk when the heel is down).
-  const footPitch = (['Left', 'Right'] as const).map((side, s) => {
-    const [ankle, toe] = [at(`${side}Foot`), at(`${side}ToeBase`)];
-    const planted: Array<{ height: number; pitch: number }> = [];
-    for (let f = 0; f < F; f++) {
-      if (contacts[f * 2 + s]) planted.push({ height: srcAt(f, ankle)[1], pitch: pitchOf(sub(srcAt(f, toe), srcAt(f, ankle))) });
+  const footPointsOf = (side: 'Left' | 'Right') => ['Foot', 'ToeBase', 'ToeBase_end'].map((n) => at(`${side}${n}` as CanonicalJoint));
+  const slopeOffset = new Float64Array(K);
+  (['Left', 'Right'] as const).forEach((side, s) => {
+    const [ankle, toe, tip] = footPointsOf(side);
+    const flatFrames: number[] = [];
+    for (let f = 0; f < F; f++) if (contacts[f * 2 + s]) flatFrames.push(f);
+    flatFrames.sort((f, g) => srcAt(f, ankle)[1] - srcAt(g, ankle)[1]);
+    flatFrames.length = Math.min(flatFrames.length, Math.ceil(flatFrames.length * FLAT_SHARE));
+    if (!flatFrames.length) return;
+    // The foot (ankle → toe base) and the toes (toe base → tip) each by their own slopes.
+    for (const [from, to] of [[ankle, toe], [toe, tip]]) {
+      const sourceFlat = median(flatFrames.map((f) => pitchOf(sub(srcAt(f, to), srcAt(f, from)))));
+      slopeOffset[from] = sourceFlat - pitchOf(sub(restAt(to), restAt(from)));
     }
-    planted.sort((a, b) => a.height - b.height);
-    const flattest = planted.slice(0, Math.max(1, Math.ceil(planted.length * FLAT_SHARE)));
-    const sourceFlat = planted.length ? median(flattest.map((p) => p.pitch)) : NaN;
-    return Number.isFinite(sourceFlat) ? sourceFlat - pitchOf(sub(restAt(toe), restAt(ankle))) : 0;
   });
   const restRef = RULES.map((rule) => (rule.twist ? rule.twist(restAt) : ([0, 0, 0] as Vec3)));
   const boneOf = mapping.source;
@@ -329,11 +333,10 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
   const restLocal = rig.restRotations.map(quatNormalize);
 
   // Heights: the rig's rest floor, its ankles' height above it; the source's planted ankle height.
-  const footPointsOf = (side: 'Left' | 'Right') => ['Foot', 'ToeBase', 'ToeBase_end'].map((n) => at(`${side}${n}` as CanonicalJoint));
   const restFootPoints = (['Left', 'Right'] as const).flatMap(footPointsOf);
-  // The points a planted foot stands on: the ankle (heel) and the toe base. Not the toe tip, which is often derived
-  // along the foot (skeletonMap.ts) and dips below the floor when the heel lifts, in the source too.
-  const solePointsOf = (side: 'Left' | 'Right') => ['Foot', 'ToeBase'].map((n) => at(`${side}${n}` as CanonicalJoint));
+  // The points a foot stands on: the ankle (heel), the toe base (ball) and the toe tip where the rig has a bone there
+  // (skeletonMap.ts derives one along the foot where it has none: a guess the foot does not stand on).
+  const solePointsOf = (side: 'Left' | 'Right') => ['Foot', 'ToeBase', 'ToeBase_end'].map((n) => at(`${side}${n}` as CanonicalJoint));
   const restLowest = Math.min(...restFootPoints.map((k) => restAt(k)[1]));
   const restFloor = restLowest >= 0 && restLowest <= REST_FLOOR_SLACK ? 0 : restLowest;
   const characterAnkle = (restAt(at('LeftFoot'))[1] + restAt(at('RightFoot'))[1]) / 2 - restFloor;
@@ -374,6 +377,8 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
       thigh: boneOf[at(`${side}UpLeg`)],
       knee: boneOf[at(`${side}Leg`)],
       ankle,
+      toe: boneOf[at(`${side}ToeBase`)],
+      tip: boneOf[at(`${side}ToeBase_end`)],
       offsets: points.map((k) => quatRotate(inverseAnkle, sub(restAt(k), restAt(at(`${side}Foot`))).map((v) => v * unitsPerMetre) as Vec3)),
       clearance: points.map((k) => restAt(k)[1] - restFloor),
     };
@@ -397,8 +402,7 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
         continue;
       }
       let dir = sub(p(e), p(k));
-      const footSide = FOOT_POINTS_SIDE[k];
-      if (footSide >= 0) dir = pitchDown(dir, footPitch[footSide]);
+      if (slopeOffset[k] !== 0) dir = pitchDown(dir, slopeOffset[k]);
       const aligned = rule.twist ? alignFrames(restDir[k], restRef[k], dir, rule.twist(p)) : undefined;
       delta[k] = aligned ?? quatNormalize(quatMultiply(swingRotation(quatRotate(parentDelta, restDir[k]), dir), parentDelta));
     }
@@ -472,17 +476,21 @@ function plantFeet(
   const B = rig.bones.length;
   const F = worlds.length;
   const pos = (f: number, b: number): Vec3 => [positions[(f * B + b) * 3], positions[(f * B + b) * 3 + 1], positions[(f * B + b) * 3 + 2]];
+  // A foot's points: rigid with the foot bone, but a toe-tip bone, which the toes' own rotation carries.
   const footPoints = (f: number, leg: LegBones): Vec3[] => {
     const a = pos(f, leg.ankle);
-    return leg.offsets.map((o) => {
+    return leg.offsets.map((o, i) => {
+      if (i === 2 && leg.tip >= 0) return pos(f, leg.tip);
       const d = quatRotate(worlds[f][leg.ankle], o);
       return [a[0] + d[0], a[1] + d[1], a[2] + d[2]] as Vec3;
     });
   };
-  // Height of a foot above the floor: its lowest point relative to that point's rest height (rig units).
+  // Height of a foot above the floor: its lowest point relative to that point's rest height (rig units); a derived
+  // toe tip does not count.
   const lowest = (points: Vec3[], leg: LegBones): { i: number; height: number } => {
     let i = 0, height = Infinity;
     points.forEach((p, n) => {
+      if (n === 2 && leg.tip < 0) return;
       const h = p[1] - leg.clearance[n] * unitsPerMetre;
       if (h < height) [i, height] = [n, h];
     });
@@ -490,7 +498,7 @@ function plantFeet(
   };
   const blend = Math.max(1, Math.round(RELEASE_SECONDS * fps));
   const shifts: Vec3[][] = legs.map(() => new Array<Vec3>(F));
-  // Per leg and planted frame, the pinned foot point (0 ankle, 1 toe base); -1 in free frames.
+  // Per leg and planted frame, the pinned foot point (0 ankle, 1 toe base, 2 toe tip); -1 in free frames.
   const pinned: Int8Array[] = legs.map(() => new Int8Array(F).fill(-1));
   legs.forEach((leg, s) => {
     // Planted frames: pin the lowest point where it was (corrected) the frame before, at floor height.
@@ -557,13 +565,16 @@ function plantFeet(
       let target: Vec3 = [ankle[0] + shift[0], ankle[1] + shift[1], ankle[2] + shift[2]];
       const l1 = length(sub(knee, hip)), l2 = length(sub(ankle, knee));
       const reach = REACH * (l1 + l2);
-      if (pinned[s][f] === 1 && length(sub(target, hip)) > reach) {
-        // Out of reach with the ball pinned (a push-off): the heel rises, the foot turning about the ball.
-        const ball = footPoints(f, leg)[1];
+      if (pinned[s][f] > 0 && length(sub(target, hip)) > reach) {
+        // Out of reach with the ball or the toe tip pinned (a push-off): the heel rises, the foot turning about it.
+        const ball = footPoints(f, leg)[pinned[s][f]];
         const pivot: Vec3 = [ball[0] + shift[0], ball[1] + shift[1], ball[2] + shift[2]];
         const lifted = pivotAbout(hip, target, pivot, reach);
         if (lifted) {
-          world[leg.ankle] = quatNormalize(quatMultiply(swingRotation(sub(target, pivot), sub(lifted, pivot)), world[leg.ankle]));
+          const turn = swingRotation(sub(target, pivot), sub(lifted, pivot));
+          world[leg.ankle] = quatNormalize(quatMultiply(turn, world[leg.ankle]));
+          // Turning about the toe tip, the toes turn with the foot (about the ball they stay flat on the floor).
+          if (pinned[s][f] === 2 && leg.toe >= 0 && mapped[leg.toe]) world[leg.toe] = quatNormalize(quatMultiply(turn, world[leg.toe]));
           target = lifted;
         }
       }
