@@ -633,7 +633,10 @@ def map_humanoid(joints: Sequence[str], parents: Sequence[int], positions: np.nd
         return any(t.is_below(j, r) for r in arm_roots)
 
     # 3. Head: where the remaining leaves of the upper body meet, above the chest.
-    head_leaves = [l for l in upper if not in_arms(l) and t.is_below(l, chest) and l != chest and t.lift[l] > t.lift[chest]]
+    # Leaves above the chest on average; when none is (a dancer bowing through the frames looked at), any beside the arms.
+    beside_arms = [l for l in upper if not in_arms(l) and t.is_below(l, chest) and l != chest]
+    raised = [l for l in beside_arms if t.lift[l] > t.lift[chest]]
+    head_leaves = raised or beside_arms
     if not head_leaves:
         raise _refuse("no head (nothing above the shoulders)")
     skull = head_leaves[0]

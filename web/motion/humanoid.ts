@@ -582,7 +582,10 @@ export function mapHumanoid(sk: PosedSkeleton): HumanoidMap {
   const inArms = (j: number) => armRoots.some((r) => isBelow(t, j, r));
 
   // 3. Head: where the remaining leaves of the upper body meet, above the chest.
-  const headLeaves = upper.filter((l) => !inArms(l) && isBelow(t, l, chest) && l !== chest && t.lift[l] > t.lift[chest]);
+  // Leaves above the chest on average; when none is (a dancer bowing through the frames looked at), any beside the arms.
+  const besideArms = upper.filter((l) => !inArms(l) && isBelow(t, l, chest) && l !== chest);
+  const raised = besideArms.filter((l) => t.lift[l] > t.lift[chest]);
+  const headLeaves = raised.length ? raised : besideArms;
   if (headLeaves.length === 0) refuse('no head (nothing above the shoulders)');
   let skull = headLeaves.reduce((a, b) => lca(t, a, b));
   let headEnd = -1;
