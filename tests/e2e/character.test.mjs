@@ -2,7 +2,7 @@
 // playground.loadCharacter (a URL, a Blob, bytes), dropped on the page, named by the element's `character` attribute
 // or the page's `character=` URL parameter; rigs of other namings made in the page with three.js's GLTFExporter
 // (tests/support/characterRigs.mjs: Mixamo-prefixed and 0.01-scaled in an A-pose, VRM 0.x and 1.0 humanoid maps, a
-// skeleton facing −z); Compare with two characters side by side; bad files refused with a short message that keeps
+// skeleton facing −z); every mode drawing it live; Compare with two characters side by side; bad files refused with a short message that keeps
 // the character and motion shown; the export of the animated character read back by three.js's GLTFLoader.
 // The CC0 character ../shared/characters/quaternius-human-male.glb is served to the page by a route, never copied.
 import assert from 'node:assert/strict';
@@ -81,6 +81,17 @@ describe('your own character', { timeout: 600_000 }, () => {
     });
     assert.deepEqual([r.joints, r.first, r.frames], [66, 'root', r.shown]);
     assert.ok(r.low > -0.05 && r.low < 0.08, `the left ball's lowest height ${r.low} m`);
+    // The look switch applies to it: none drawn with the stick figure, see-through with it in Both.
+    const looks = await page.evaluate(async () => {
+      const pg = window.playground;
+      const seen = {};
+      for (const look of ['skeleton', 'both', 'character']) {
+        pg.setView({ look });
+        seen[look] = pg.stats().characterVertices;
+      }
+      return seen;
+    });
+    assert.deepEqual(looks, { skeleton: 0, both: 7399, character: 7399 });
     // Back to the mannequin.
     await page.evaluate(() => window.playground.clearCharacter());
     await waitUntil(page, () => window.playground.stats().characterVertices !== 7399, null, { message: 'the mannequin is back' });
@@ -294,5 +305,44 @@ describe('your own character', { timeout: 600_000 }, () => {
     assert.equal(stats.companionVertices, companion.vertices, 'the companion is the second character');
     assert.notEqual(companion.vertices, 7399);
     await page.evaluate(() => $ui('mode-clip').click());
+  });
+  test('every mode draws the character live: Random walk, Dance, Steer stream it chunk after chunk, Path walks it', async () => {
+    const { page } = suite;
+    await loadQuaternius();
+    /** In the page: from the first frame the character is drawn until the stream holds `frames` frames, the frames it was not. */
+    const watch = (frames) =>
+      page.evaluate(
+        (frames) =>
+          new Promise((resolve) => {
+            let drawn = 0, missed = 0;
+            const step = () => {
+              const on = window.playground.stats().characterVertices === 7399;
+              if (on) drawn++;
+              else if (drawn) missed++;
+              if ((window.playground.current()?.frames ?? 0) >= frames && drawn) resolve({ drawn, missed, frames: window.playground.current().frames });
+              else requestAnimationFrame(step);
+            };
+            requestAnimationFrame(step);
+          }),
+        frames,
+      );
+    for (const mode of ['walk', 'dance', 'steer']) {
+      await page.evaluate((mode) => $ui(`mode-${mode}`).click(), mode);
+      const r = await Promise.race([watch(240), new Promise((resolve) => setTimeout(() => resolve(null), 240_000))]);
+      assert.ok(r, `${mode}: the stream reached 8 s with the character drawn`);
+      assert.equal(r.missed, 0, `${mode}: the character stayed drawn over ${r.drawn} frames (${r.frames} streamed frames)`);
+    }
+    await page.evaluate(() => {
+      const el = document.querySelector('motion-playground');
+      el.setAttribute('model', 'latent-erd');
+      el.setAttribute('path', '0,0;3,1.5;6,0');
+      el.setAttribute('mode', 'path');
+    });
+    await waitUntil(page, () => window.playground.current()?.frames > 60 && window.playground.stats().characterVertices === 7399, null, { timeout: 180_000, message: 'Path mode walks the path as the character' });
+    await page.evaluate(() => {
+      const el = document.querySelector('motion-playground');
+      el.removeAttribute('path');
+      el.setAttribute('mode', 'clip');
+    });
   });
 });
