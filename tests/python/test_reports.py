@@ -20,8 +20,9 @@ FIGURES = {"generator": "generator.png", "refiner": "refiner.png", "aclstm": "ac
 # The other pages in docs/models are not reports of a model, so they need no summary (their table cells are checked):
 # refiner-notes.md and refiner-browser.md are parts of refiner.md, which its writer copies in; aclstm-pilots.md is the
 # acLSTM's pilot runs (history, linked from aclstm.md, written by training/aclstm/pilots.py); weights.md measures how
-# every model's weights are stored (linked from the generator and acLSTM reports).
-NOT_REPORTS = ["refiner-notes", "refiner-browser", "aclstm-pilots", "weights"]
+# every model's weights are stored (linked from the generator and acLSTM reports); retarget.md measures retargeting onto
+# characters' own rigs (web/motion/retarget.ts, no model; written by npm run evaluate:retarget).
+NOT_REPORTS = ["refiner-notes", "refiner-browser", "aclstm-pilots", "weights", "retarget"]
 SUMMARY_LABELS = ["What it does", "In the page", None, None, "Not met"]
 LONGEST_CELL = 200
 

@@ -58,11 +58,13 @@ describe('mapRig', () => {
     expect(name('RightArm')).toMatch(/Right|_r$|right|_R$/);
   });
 
-  it('uses a humanoid map the file gives (VRM) as it is', () => {
+  it('uses a humanoid map the file gives (VRM) as it is; the mapper finds the same bones without it', () => {
     const rig = rigs[3].rig;
-    const own = mapRig(rig);
-    const given: HumanoidMap = { ...own, scheme: 'VRM file' };
-    expect(mapRig({ ...rig, humanoid: given })).toBe(given);
+    const given: HumanoidMap = rig.humanoid!;
+    expect(given.scheme).toBe('VRM file');
+    expect(mapRig(rig)).toBe(given);
+    const found = mapRig({ ...rig, humanoid: undefined });
+    given.source.forEach((bone, k) => bone >= 0 && expect(rig.bones[found.source[k]]).toBe(rig.bones[bone]));
     const broken = { ...given, source: given.source.map((j, k) => (CANONICAL_JOINTS[k] === 'LeftFoot' ? -1 : j)) };
     expect(() => mapRig({ ...rig, humanoid: broken })).toThrow(/no bone for LeftFoot/);
   });

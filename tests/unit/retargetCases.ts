@@ -3,7 +3,7 @@
 // a model-like canonical walk with contacts) and the measures of the issue's "Done when".
 import { parseBVH } from '../../web/motion/bvh';
 import { labelContacts } from '../../web/motion/contactLabels';
-import { CANONICAL_JOINTS, type CanonicalJoint } from '../../web/motion/humanoid';
+import { CANONICAL_JOINTS, type CanonicalJoint, type HumanoidMap } from '../../web/motion/humanoid';
 import { quatConjugate, quatFromAxisAngle, quatMultiply, quatNormalize, quatRotate, rotationFromTwoVectors, sub, type Quat, type Vec3 } from '../../web/motion/math';
 import { lowFootSliding } from '../../web/motion/footSkating';
 import { atRate, canonicalView, floorHeight } from '../../web/motion/motionStats';
@@ -81,6 +81,8 @@ interface RigSpec {
   facingMinusZ: boolean;
   orientation: Orientation;
   seed: number;
+  /** Give the rig the humanoid map a VRM file carries (bone names looked up) instead of letting mapRig find one. */
+  vrmMap?: boolean;
 }
 
 function random(seed: number): () => number {
@@ -133,7 +135,25 @@ export function buildRig(spec: RigSpec): CharacterRig {
     restRotations.push(quatNormalize(quatMultiply(inverse, world.get(g)!)));
     restTranslations.push(p ? quatRotate(inverse, sub(worldPos.get(g)!, worldPos.get(p)!)) : worldPos.get(g)!);
   });
-  return { bones, parents, restRotations, restTranslations };
+  const rig: CharacterRig = { bones, parents, restRotations, restTranslations };
+  if (spec.vrmMap) rig.humanoid = vrmHumanoid(rig, spec.facingMinusZ ? [0, -1] : [0, 1]);
+  return rig;
+}
+
+/** VRM humanoid bone names at the canonical points (a VRM file's own map names these; the rest are derived). */
+const VRM_POINTS: Partial<Record<CanonicalJoint, string>> = {
+  Hips: 'hips', Spine: 'spine', Spine1: 'chest', Neck: 'neck', Head: 'head',
+  ...Object.fromEntries((['Left', 'Right'] as const).flatMap((side) => {
+    const s = side.toLowerCase();
+    return [['UpLeg', 'UpperLeg'], ['Leg', 'LowerLeg'], ['Foot', 'Foot'], ['ToeBase', 'Toes'], ['Arm', 'UpperArm'], ['ForeArm', 'LowerArm'], ['Hand', 'Hand']]
+      .map(([point, bone]) => [`${side}${point}`, `${s}${bone}`]);
+  })),
+};
+
+/** The humanoid map a VRM loader gives: its bone names looked up, nothing inferred from the pose. */
+function vrmHumanoid(rig: CharacterRig, facing: [number, number]): HumanoidMap {
+  const source = CANONICAL_JOINTS.map((point) => (VRM_POINTS[point] ? rig.bones.indexOf(VRM_POINTS[point]!) : -1));
+  return { source, scheme: 'VRM file', facing, sidesBy: 'names', height: NaN };
 }
 
 const sided = (left: Record<string, string>): Record<string, string> => {
@@ -178,14 +198,14 @@ export const RIGS: RigSpec[] = [
     units: 1, facingMinusZ: false, orientation: 'random', seed: 3,
   },
   {
-    label: 'VRM (VRM humanoid names and map, metres, T-pose, facing −z)',
+    label: 'VRM (VRM humanoid names and the file\'s own humanoid map, metres, T-pose, facing −z, identity rest rotations)',
     names: {
       hips: 'hips', spine0: 'spine', spine1: 'chest', spine2: 'upperChest', neck: 'neck', head: 'head',
       ...sided({ clav: '{c}Shoulder', upperArm: '{c}UpperArm', foreArm: '{c}LowerArm', hand: '{c}Hand', finger: '{c}MiddleProximal', fingerEnd: '{c}MiddleIntermediate',
         thigh: '{c}UpperLeg', shin: '{c}LowerLeg', foot: '{c}Foot', toe: '{c}Toes' }),
     },
     body: { ...AVERAGE, thigh: 0.4, shin: 0.42, torso: 0.42, head: 0.26, upperArm: 0.24, foreArm: 0.21, shoulder: 0.15, hipWidth: 0.08 },
-    units: 1, facingMinusZ: true, orientation: 'identity', seed: 4,
+    units: 1, facingMinusZ: true, orientation: 'identity', seed: 4, vrmMap: true,
   },
   {
     label: 'Bandai-style (UpperLeg_L …, metres, A-pose, bone-along-y rest rotations, short legs)',

@@ -288,8 +288,13 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
 
   // The rig: rest world pose, map, units, rest canonical points (metres).
   const rest = restWorld(rig);
-  const mapping = mapRig(rig);
-  const unitsPerMetre = 10 ** Math.round(Math.log10(mapping.height / TYPICAL_HEIGHT));
+  const found = mapRig(rig);
+  // The rest pose's height (its vertical extent), not the map's: a map the file gives may not carry one.
+  const restYs = rest.positions.map((p) => p[1]);
+  const restHeight = Math.max(...restYs) - Math.min(...restYs);
+  if (!(restHeight > 0)) describeRigError('its rest pose has no height (every bone at one level)');
+  const mapping: HumanoidMap = found.height > 0 ? found : { ...found, height: restHeight };
+  const unitsPerMetre = 10 ** Math.round(Math.log10(restHeight / TYPICAL_HEIGHT));
   const restFlat = Float32Array.from(rest.positions.flat());
   const restCanonical = toCanonical(
     { fps: 30, frames: 1, joints: rig.bones, parents: rig.parents, positions: restFlat },
