@@ -35,7 +35,7 @@ function forwardKinematics(rig: CharacterRig, result: RetargetResult): Float32Ar
       const p = rig.parents[b];
       if (p < 0) {
         world[b] = local;
-        pos[b] = b === 0 ? [result.rootTranslations[f * 3], result.rootTranslations[f * 3 + 1], result.rootTranslations[f * 3 + 2]] : rig.restTranslations[b];
+        pos[b] = b === result.rootBone ? [result.rootTranslations[f * 3], result.rootTranslations[f * 3 + 1], result.rootTranslations[f * 3 + 2]] : rig.restTranslations[b];
       } else {
         world[b] = quatMultiply(world[p], local);
         const d = quatRotate(world[p], rig.restTranslations[b]);
@@ -139,6 +139,37 @@ describe('retarget: the result drives the rig', () => {
       }
     }
     expect(lengthError).toBeLessThan(1e-4);
+  });
+
+  it('moves the root the hips hang from when a helper root comes first, and keeps the helper at rest', () => {
+    const base = rigs[0].rig;
+    // A helper bone (an IK target, say) as a root of its own, before the skeleton's root.
+    const rig: CharacterRig = {
+      bones: ['ik_target', ...base.bones], parents: [-1, ...base.parents.map((p) => (p < 0 ? -1 : p + 1))],
+      restRotations: [[0, 0, 0, 1], ...base.restRotations], restTranslations: [[0.5, 0, 0.5], ...base.restTranslations],
+    };
+    const result = retarget(sources[0].motion, rig);
+    expect(result.rootBone).toBe(1);
+    const fk = forwardKinematics(rig, result);
+    let worst = 0;
+    for (let i = 0; i < fk.length; i++) worst = Math.max(worst, Math.abs(fk[i] - result.motion.positions[i]));
+    expect(worst).toBeLessThan(1e-4);
+    const B = rig.bones.length, last = result.motion.frames - 1;
+    expect(Array.from(result.motion.positions.subarray(last * B * 3, last * B * 3 + 3))).toEqual([0.5, 0, 0.5]);
+    // The rest of the character moves as it does without the helper.
+    const plain = resultOf(0, 0).motion.positions;
+    expect(Math.abs(result.motion.positions[(last * B + 1) * 3] - plain[last * (B - 1) * 3])).toBeLessThan(1e-5);
+  });
+
+  it('retargets a single frame, and uses the contacts a motion carries', () => {
+    const model = sources[3].motion;
+    const one = { ...model, frames: 1, positions: model.positions.slice(0, CANONICAL_JOINTS.length * 3), contacts: model.contacts!.slice(0, 2) };
+    const result = retarget(one, rigs[1].rig);
+    expect(result.motion.frames).toBe(1);
+    expect(result.motion.positions.every(Number.isFinite)).toBe(true);
+    const full = retarget(model, rigs[1].rig);
+    expect(Array.from(full.contacts)).toEqual(Array.from(model.contacts!));
+    expect(full.motion.contacts).toBe(full.contacts);
   });
 
   it('detects the rig units: centimetres for the Mixamo rig, metres for the others', () => {

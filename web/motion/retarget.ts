@@ -51,6 +51,8 @@ export interface RetargetResult {
   rotations: Float32Array;
   /** frames × 3: the root bone's local translation per frame (in the rig's units). */
   rootTranslations: Float32Array;
+  /** Added: the bone `rootTranslations` moves: the root the hips hang from (bone 0 in most rigs); other roots keep their rest. */
+  rootBone: number;
   /** The rig's humanoid map used (canonical point -> bone), and what canonical points the rig lacks (derived). */
   mapping: HumanoidMap;
   /** Character leg length / source leg length: how proportions were scaled. */
@@ -370,9 +372,9 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
   const hipsBone = boneOf[at('Hips')];
   let rootOfHips = hipsBone;
   while (rig.parents[rootOfHips] >= 0) rootOfHips = rig.parents[rootOfHips];
-  if (rootOfHips !== 0) describeRigError(`the hips (${rig.bones[hipsBone]}) do not hang from the first bone (${rig.bones[0]})`);
+  const rootBone = rootOfHips;
   // The root's rest offset from the hips: the bones between keep their rest rotations, so it is constant.
-  const hipsFromRoot = sub(rest.positions[hipsBone], rest.positions[0]);
+  const hipsFromRoot = sub(rest.positions[hipsBone], rest.positions[rootBone]);
 
   const legs: LegBones[] = (['Left', 'Right'] as const).map((side) => {
     const ankle = boneOf[at(`${side}Foot`)];
@@ -425,15 +427,15 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
     const hips = sub(hipJoints, quatRotate(delta[at('Hips')], restHipJoints));
     const root = sub(hips.map((v) => v * unitsPerMetre) as Vec3, hipsFromRoot);
     rootTranslations.set(root, f * 3);
-    poseFrame(rig, world, root, restLocal, rotations, positions, f);
+    poseFrame(rig, world, rootBone, root, restLocal, rotations, positions, f);
   }
 
   const mapped = pointOfBone.map((k) => k >= 0);
-  if (footIK) plantFeet(rig, legs, worlds, mapped, contacts, swingClearance, source.fps, unitsPerMetre, rootTranslations, restLocal, rotations, positions);
+  if (footIK) plantFeet(rig, legs, worlds, mapped, contacts, swingClearance, source.fps, unitsPerMetre, rootBone, rootTranslations, restLocal, rotations, positions);
 
   for (let i = 0; i < positions.length; i++) positions[i] /= unitsPerMetre;
   const motion: Motion = { fps: source.fps, frames: F, joints: [...rig.bones], parents: [...rig.parents], positions, contacts };
-  return { motion, rotations, rootTranslations, mapping, scale, unitsPerMetre, restCanonical, contacts };
+  return { motion, rotations, rootTranslations, rootBone, mapping, scale, unitsPerMetre, restCanonical, contacts };
 }
 
 /**
@@ -441,14 +443,14 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
  * world), writes the local rotations and the positions (rig units; FK with three.js semantics: a bone's position is
  * its parent's plus the parent's world rotation applied to the bone's rest translation).
  */
-function poseFrame(rig: CharacterRig, world: Quat[], root: Vec3, restLocal: Quat[], rotations: Float32Array, positions: Float32Array, f: number): void {
+function poseFrame(rig: CharacterRig, world: Quat[], rootBone: number, root: Vec3, restLocal: Quat[], rotations: Float32Array, positions: Float32Array, f: number): void {
   const B = rig.bones.length;
   for (let b = 0; b < B; b++) {
     const parent = rig.parents[b];
     let local: Quat;
     if (parent < 0) {
       local = world[b];
-      const t = b === 0 ? root : rig.restTranslations[b];
+      const t = b === rootBone ? root : rig.restTranslations[b];
       positions.set(t, (f * B + b) * 3);
     } else {
       local = quatNormalize(quatMultiply(quatConjugate(world[parent]), world[b]));
@@ -476,7 +478,7 @@ function refreshUnmapped(rig: CharacterRig, world: Quat[], mapped: boolean[], re
  */
 function plantFeet(
   rig: CharacterRig, legs: LegBones[], worlds: Quat[][], mapped: boolean[], contacts: Uint8Array, swingClearance: Float64Array[], fps: number, unitsPerMetre: number,
-  rootTranslations: Float32Array, restLocal: Quat[], rotations: Float32Array, positions: Float32Array,
+  rootBone: number, rootTranslations: Float32Array, restLocal: Quat[], rotations: Float32Array, positions: Float32Array,
 ): void {
   const B = rig.bones.length;
   const F = worlds.length;
@@ -528,7 +530,7 @@ function plantFeet(
       previous = points.map((p) => [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]] as Vec3);
     }
   });
-  lowerHips(rig, legs, shifts, pinned, pos, footPoints, blend, rootTranslations, positions);
+  lowerHips(rig, legs, shifts, pinned, pos, footPoints, blend, rootBone, rootTranslations, positions);
   legs.forEach((leg, s) => {
     const planted = Array.from({ length: F }, (_, f) => contacts[f * 2 + s] > 0);
     // Free frames: the neighbouring contacts' corrections fading out (after) and in (before); the foot at least as
@@ -597,7 +599,7 @@ function plantFeet(
     });
     if (!changed) continue;
     refreshUnmapped(rig, world, mapped, restLocal);
-    poseFrame(rig, world, [rootTranslations[f * 3], rootTranslations[f * 3 + 1], rootTranslations[f * 3 + 2]], restLocal, rotations, positions, f);
+    poseFrame(rig, world, rootBone, [rootTranslations[f * 3], rootTranslations[f * 3 + 1], rootTranslations[f * 3 + 2]], restLocal, rotations, positions, f);
   }
 }
 
@@ -609,9 +611,11 @@ function plantFeet(
  */
 function lowerHips(
   rig: CharacterRig, legs: LegBones[], shifts: Vec3[][], pinned: Int8Array[], pos: (f: number, b: number) => Vec3,
-  footPoints: (f: number, leg: LegBones) => Vec3[], blend: number, rootTranslations: Float32Array, positions: Float32Array,
+  footPoints: (f: number, leg: LegBones) => Vec3[], blend: number, rootBone: number, rootTranslations: Float32Array, positions: Float32Array,
 ): void {
-  const F = rootTranslations.length / 3, B = rig.bones.length;
+  const F = rootTranslations.length / 3;
+  const moved = rig.bones.flatMap((_, b) => (isBelow(rig.parents, b, rootBone) ? [b] : []));
+  const B = rig.bones.length;
   const need = new Float64Array(F);
   for (let f = 0; f < F; f++) {
     legs.forEach((leg, s) => {
@@ -635,7 +639,7 @@ function lowerHips(
     }
     if (!(drop > 0)) continue;
     rootTranslations[f * 3 + 1] -= drop;
-    for (let b = 0; b < B; b++) positions[(f * B + b) * 3 + 1] -= drop;
+    for (const b of moved) positions[(f * B + b) * 3 + 1] -= drop;
     legs.forEach((_, s) => pinned[s][f] >= 0 && (shifts[s][f][1] += drop));
   }
 }
