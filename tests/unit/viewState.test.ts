@@ -16,6 +16,16 @@ describe('view state (attributes and links)', () => {
     expect(parseView((k) => again.get(k)).view).toEqual(view);
   });
 
+  test('the look (issue 40): read, written to links and snippets, a bad one refused', () => {
+    const q = new URLSearchParams('mode=walk&look=both');
+    const { view, errors } = parseView((k) => q.get(k));
+    expect(errors).toEqual([]);
+    expect(view).toEqual({ mode: 'walk', look: 'both' });
+    expect(viewQuery({ mode: 'dance', look: 'skeleton' })).toBe('mode=dance&look=skeleton');
+    expect(embedSnippet({ mode: 'walk', look: 'skeleton' }, '/m.js')).toMatch(/<motion-playground mode="walk" look="skeleton" /);
+    expect(parseViewValue('look', 'boxes')).toEqual({ error: 'look="boxes": must be one of skeleton, character, both' });
+  });
+
   test('refuses bad values with a reason and keeps the rest', () => {
     const q = new URLSearchParams('mode=fly&seed=-1&temperature=9&refine=maybe&style=<b>x</b>&path=1,2,3');
     const { view, errors } = parseView((k) => q.get(k));
