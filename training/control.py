@@ -30,10 +30,10 @@ LOOKAHEAD_SECONDS = 0.6
 MIN_LOOKAHEAD = 0.5
 # The follower searches for itself along the path from its last arc length to PROGRESS_AHEAD further, so a
 # path that crosses itself is not short-cut (as web/optimizer trackArc), and never behind it: where a path
-# doubles back, the leg it walked lies under the leg it walks. Where stretches of the path lie within TIE
-# (squared metres) of each other, the nearest is the earliest.
+# doubles back, the leg it walked lies under the leg it walks. Of the stretches within NEAR_TIE metres as near as
+# the nearest, it is on the earliest: the leg it came up and the leg it goes back on lie within a drawing's jitter.
 PROGRESS_AHEAD = 1.2
-TIE = 1e-9
+NEAR_TIE = 0.05
 # It slows down over the last STOP_SECONDS of travel so it stops at the end instead of overshooting, and
 # stands still once it is within ARRIVED metres of the end (else the slow-down never quite finishes).
 STOP_SECONDS = 0.5
@@ -150,10 +150,10 @@ class PolylinePath:
             k -= 1
         return -math.inf
 
-    def project(self, x: float, z: float, s_from: float, s_to: float) -> float:
+    def project(self, x: float, z: float, s_from: float, s_to: float, tie: float = 0.0) -> float:
         """Arc length of the nearest point to (x, z) on the path between arc lengths s_from and s_to (0 if the
-        path has none there); of points as near (within TIE), the earliest."""
-        best, best_s = math.inf, 0.0
+        path has none there); of points less than `tie` m farther than the nearest, the earliest."""
+        arcs, distances = [], []
         for i in range(len(self.points) - 1):
             if self.arc[i + 1] < s_from or self.arc[i] > s_to:
                 continue
@@ -165,17 +165,24 @@ class PolylinePath:
             lo = max((s_from - self.arc[i]) / span, 0.0) if span > 0 else 0.0
             hi = min((s_to - self.arc[i]) / span, 1.0) if span > 0 else 0.0
             t = min(max(((x - a[0]) * d[0] + (z - a[1]) * d[1]) / len2, lo), hi) if len2 > 0 else 0.0
-            e = a + d * t - (x, z)
-            if float(e @ e) < best - TIE:
-                best, best_s = float(e @ e), float(self.arc[i] + t * span)
-        return best_s
+            # Held at its end where the path goes on inside the window: the next segment has that point or a nearer one.
+            if t == 1 and i + 2 < len(self.points) and self.arc[i + 1] <= s_to:
+                continue
+            ex, ez = a[0] + d[0] * t - x, a[1] + d[1] * t - z
+            arcs.append(float(self.arc[i] + t * span))
+            distances.append(math.sqrt(ex * ex + ez * ez))
+        nearest = min(distances, default=math.inf)
+        for s, dist in zip(arcs, distances):
+            if dist <= nearest + tie:
+                return s
+        return 0.0
 
 
 def control_along_path(path: PolylinePath, x: float, z: float, heading: float, progress: float, speed: float):
     """The signal that steers a walker at (x, z) facing `heading` along `path` at `speed` (pure pursuit, towards
     a sharp bend before the look-ahead point: SHARP_BEND), and its new progress (arc length) along the path,
     searched from the last one on."""
-    s = path.project(x, z, progress, progress + PROGRESS_AHEAD)
+    s = path.project(x, z, progress, progress + PROGRESS_AHEAD, NEAR_TIE)
     remaining = path.length - s
     if remaining <= ARRIVED:
         return np.array([0.0, 0.0, 0.0]), s

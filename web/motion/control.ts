@@ -29,8 +29,11 @@ export const MIN_LOOKAHEAD = 0.5;
  * it: where a path doubles back, the leg it walked lies under the leg it walks.
  */
 export const PROGRESS_AHEAD = 1.2;
-/** Where stretches of a path lie within this squared distance (m²) of each other, the nearest is the earliest. */
-const TIE = 1e-9;
+/**
+ * Of the stretches of the path within NEAR_TIE m as near the walker as the nearest, it is on the earliest: where a path
+ * doubles back, the leg it came up and the leg it goes back on lie within a drawing's jitter of each other.
+ */
+export const NEAR_TIE = 0.05;
 /** It slows down over the last STOP_SECONDS of travel so it stops at the end, and stands still within ARRIVED metres of it. */
 export const STOP_SECONDS = 0.5;
 export const ARRIVED = 0.05;
@@ -198,10 +201,10 @@ export class PolylinePath {
 
   /**
    * Arc length of the nearest point to (x, z) on the path between arc lengths `from` and `to` (0 if the path has
-   * none there); of points as near (within TIE), the earliest.
+   * none there); of points less than `tie` m farther than the nearest, the earliest.
    */
-  project(x: number, z: number, from: number, to: number): number {
-    let best = Infinity, bestS = 0;
+  project(x: number, z: number, from: number, to: number, tie = 0): number {
+    const arcs: number[] = [], distances: number[] = [];
     for (let i = 0; i + 1 < this.points.length; i++) {
       if (this.arc[i + 1] < from || this.arc[i] > to) continue;
       const a = this.points[i], b = this.points[i + 1];
@@ -212,14 +215,15 @@ export class PolylinePath {
       const lo = span > 0 ? Math.max((from - this.arc[i]) / span, 0) : 0;
       const hi = span > 0 ? Math.min((to - this.arc[i]) / span, 1) : 0;
       const t = len2 > 0 ? Math.min(Math.max(((x - a[0]) * dx + (z - a[1]) * dz) / len2, lo), hi) : 0;
+      // Held at its end where the path goes on inside the window: the next segment has that point or a nearer one.
+      if (t === 1 && i + 2 < this.points.length && this.arc[i + 1] <= to) continue;
       const ex = a[0] + dx * t - x, ez = a[1] + dz * t - z;
-      const d2 = ex * ex + ez * ez;
-      if (d2 < best - TIE) {
-        best = d2;
-        bestS = this.arc[i] + t * span;
-      }
+      arcs.push(this.arc[i] + t * span);
+      distances.push(Math.sqrt(ex * ex + ez * ez));
     }
-    return bestS;
+    const nearest = Math.min(...distances);
+    for (let k = 0; k < arcs.length; k++) if (distances[k] <= nearest + tie) return arcs[k];
+    return 0;
   }
 }
 
@@ -230,7 +234,7 @@ export class PolylinePath {
  * length), searched near the last one and never going back (where a path doubles back, its two legs lie close).
  */
 export function controlAlongPath(path: PolylinePath, x: number, z: number, heading: number, progress: number, speed: number): { control: Control; progress: number } {
-  const s = path.project(x, z, progress, progress + PROGRESS_AHEAD);
+  const s = path.project(x, z, progress, progress + PROGRESS_AHEAD, NEAR_TIE);
   const remaining = path.length - s;
   if (remaining <= ARRIVED) return { control: [0, 0, 0], progress: s };
   const reach = Math.max(MIN_LOOKAHEAD, speed * LOOKAHEAD_SECONDS);
