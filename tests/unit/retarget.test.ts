@@ -172,6 +172,25 @@ describe('retarget: the result drives the rig', () => {
     expect(full.motion.contacts).toBe(full.contacts);
   });
 
+  it('a live window retargeted with the whole stream\'s calibration poses its frames as the whole stream\'s retargeting does', () => {
+    const stream = sources[3].motion;
+    const J = stream.joints.length, B = rigs[4].rig.bones.length;
+    const whole = retarget(stream, rigs[4].rig, { footIK: false });
+    const from = 40, frames = 31;
+    const window = { ...stream, frames, positions: stream.positions.slice(from * J * 3, (from + frames) * J * 3), contacts: stream.contacts!.slice(from * 2, (from + frames) * 2) };
+    const same = retarget(window, rigs[4].rig, { footIK: false, calibration: whole.calibration });
+    const own = retarget(window, rigs[4].rig, { footIK: false });
+    const gap = (r: RetargetResult) => {
+      let worst = 0;
+      for (let i = 0; i < frames * B * 3; i++) worst = Math.max(worst, Math.abs(r.motion.positions[i] - whole.motion.positions[from * B * 3 + i]));
+      return worst;
+    };
+    expect(gap(same)).toBeLessThan(1e-5);
+    // Measured on the window alone, the numbers differ (here the feet's slopes and the ankles' height), and so does the pose.
+    expect(gap(own)).toBeGreaterThan(1e-3);
+    expect(() => retarget(window, rigs[4].rig, { calibration: { ...whole.calibration, footSlopes: [0] } })).toThrow(/calibration/);
+  });
+
   it('detects the rig units: centimetres for the Mixamo rig, metres for the others', () => {
     expect(rigs.map((_, r) => resultOf(r, 0).unitsPerMetre)).toEqual([1, 100, 1, 1, 1]);
     const mixamo = resultOf(1, 0), cmu = resultOf(0, 0);

@@ -42,6 +42,24 @@ export interface CharacterRig {
 export interface RetargetOptions {
   /** keep planted feet planted with two-bone IK on the character's legs (default true) */
   footIK?: boolean;
+  /**
+   * Added: the numbers a retarget measured on a source (RetargetResult.calibration), to use instead of measuring them
+   * on this motion: for a live stream retargeted window by window, so that the scale, the hips' height and the feet's
+   * slope do not change from one window to the next.
+   */
+  calibration?: RetargetCalibration;
+}
+
+/** What retarget measures on the source to set the retargeting (all from its canonical points, metres). */
+export interface RetargetCalibration {
+  /** Character leg length / source leg length. */
+  scale: number;
+  /** The source's ankle height when planted (the character's ankles stand as high as theirs at rest then). */
+  sourceAnkle: number;
+  /** The height of the source's lowest foot point when planted: its feet's floor. */
+  sourceSole: number;
+  /** Radians the left foot, left toes, right foot and right toes are turned down (the rig's rest slope against the source's flat foot). */
+  footSlopes: number[];
 }
 
 export interface RetargetResult {
@@ -63,6 +81,8 @@ export interface RetargetResult {
   restCanonical: Float32Array;
   /** Added: the source's foot contacts used for the foot IK (frames × 2, left, right; 1 = planted). */
   contacts: Uint8Array;
+  /** Added: the numbers measured on the source (or given in options.calibration) that set this retargeting. */
+  calibration: RetargetCalibration;
 }
 
 /** A human's height (m), to tell a rig's units: units per metre is the power of ten nearest height / this. */
@@ -83,7 +103,8 @@ const PARALLEL_SINE = 0.08;
 const BEND_WEIGHT = 6;
 
 const K = CANONICAL_JOINTS.length;
-const at = (name: CanonicalJoint): number => CANONICAL_JOINTS.indexOf(name);
+const CANONICAL_INDEX = new Map<string, number>(CANONICAL_JOINTS.map((name, k) => [name, k]));
+const at = (name: CanonicalJoint): number => CANONICAL_INDEX.get(name)!;
 
 type Points = (k: number) => Vec3;
 type Twist = (p: Points) => Vec3;
@@ -273,22 +294,38 @@ interface LegBones {
   clearance: number[];
 }
 
-/** Retargets `source` (any humanoid Motion: every model's canonical output or an import) onto `rig`. */
-export function retarget(source: Motion, rig: CharacterRig, options: RetargetOptions = {}): RetargetResult {
+/** What a rig gives every retargeting onto it: read once per rig object (see prepared). */
+interface PreparedRig {
+  rest: { rotations: Quat[]; positions: Vec3[] };
+  restLocal: Quat[];
+  mapping: HumanoidMap;
+  unitsPerMetre: number;
+  restCanonical: Float32Array;
+  restAt: (k: number) => Vec3;
+  characterLeg: number;
+  /** Per canonical point the rig bone there (-1: derived), and per bone its canonical point (-1: none). */
+  boneOf: number[];
+  pointOfBone: number[];
+  mapped: boolean[];
+  restRef: Vec3[];
+  restFloor: number;
+  characterAnkle: number;
+  /** The rest offset (m) from the hips point to the legs' hip joints' midpoint. */
+  restHipJoints: Vec3;
+  rootBone: number;
+  hipsFromRoot: Vec3;
+  legs: LegBones[];
+}
+
+/** The per-rig work, kept per rig object: a rig changed in place after a retarget is not read again (pass a new object). */
+const preparedRigs = new WeakMap<CharacterRig, PreparedRig>();
+
+const footPointsOf = (side: 'Left' | 'Right') => ['Foot', 'ToeBase', 'ToeBase_end'].map((n) => at(`${side}${n}` as CanonicalJoint));
+
+function prepared(rig: CharacterRig): PreparedRig {
+  const known = preparedRigs.get(rig);
+  if (known) return known;
   checkRig(rig);
-  const F = source.frames;
-  if (!(F >= 1) || !(source.fps > 0)) throw new Error(`retarget: the motion needs frames and a positive fps (got ${F} frames at ${source.fps} fps)`);
-  const B = rig.bones.length;
-  const footIK = options.footIK ?? true;
-
-  // The source's canonical points and contacts.
-  const src = sourceCanonical(source);
-  const srcAt = (f: number, k: number): Vec3 => [src[(f * K + k) * 3], src[(f * K + k) * 3 + 1], src[(f * K + k) * 3 + 2]];
-  const contacts = source.contacts && source.contacts.length === F * 2
-    ? Uint8Array.from(source.contacts)
-    : labelContacts(src, new Uint8Array(F * 2), CANONICAL_JOINTS, source.fps);
-
-  // The rig: rest world pose, map, units, rest canonical points (metres).
   const rest = restWorld(rig);
   const found = mapRig(rig);
   // The rest pose's height (its vertical extent), not the map's: a map the file gives may not carry one.
@@ -297,29 +334,68 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
   if (!(restHeight > 0)) describeRigError('its rest pose has no height (every bone at one level)');
   const mapping: HumanoidMap = found.height > 0 ? found : { ...found, height: restHeight };
   const unitsPerMetre = 10 ** Math.round(Math.log10(restHeight / TYPICAL_HEIGHT));
-  const restFlat = Float32Array.from(rest.positions.flat());
   const restCanonical = toCanonical(
-    { fps: 30, frames: 1, joints: rig.bones, parents: rig.parents, positions: restFlat },
+    { fps: 30, frames: 1, joints: rig.bones, parents: rig.parents, positions: Float32Array.from(rest.positions.flat()) },
     { scheme: mapping.scheme, source: mapping.source, scale: 1 / unitsPerMetre },
   );
   const restAt = (k: number): Vec3 => [restCanonical[k * 3], restCanonical[k * 3 + 1], restCanonical[k * 3 + 2]];
-
-  const sourceLeg = legLength(src, F);
   const characterLeg = legLength(restCanonical, 1);
-  if (!(sourceLeg > 1e-4) || !(characterLeg > 1e-4)) throw new SkeletonMapError(`retarget: ${sourceLeg > 1e-4 ? 'the character' : 'the motion'}'s legs have no length`);
-  const scale = characterLeg / sourceLeg;
+  if (!(characterLeg > 1e-4)) throw new SkeletonMapError("retarget: the character's legs have no length");
+  const boneOf = mapping.source;
+  const pointOfBone = new Array<number>(rig.bones.length).fill(-1);
+  boneOf.forEach((b, k) => b >= 0 && pointOfBone[b] < 0 && (pointOfBone[b] = k));
 
-  // Where each segment points: the first target point far enough from the bone's point in the rest and the source.
-  const minSegment = 0.01 * characterLeg;
-  const segmentEnd = RULES.map((rule, k) => rule.to.find((e) =>
-    length(sub(restAt(e), restAt(k))) > minSegment && length(sub(srcAt(0, e), srcAt(0, k))) > minSegment * (sourceLeg / characterLeg)) ?? -1);
-  const restDir = segmentEnd.map((e, k) => (e >= 0 ? sub(restAt(e), restAt(k)) : ([0, 0, 0] as Vec3)));
+  // Heights: the rig's rest floor and its ankles' height above it.
+  const restLowest = Math.min(...(['Left', 'Right'] as const).flatMap(footPointsOf).map((k) => restAt(k)[1]));
+  const restFloor = restLowest >= 0 && restLowest <= REST_FLOOR_SLACK ? 0 : restLowest;
+  const characterAnkle = (restAt(at('LeftFoot'))[1] + restAt(at('RightFoot'))[1]) / 2 - restFloor;
+
+  const hipsBone = boneOf[at('Hips')];
+  let rootBone = hipsBone;
+  while (rig.parents[rootBone] >= 0) rootBone = rig.parents[rootBone];
+
+  // The points a foot stands on: the ankle (heel), the toe base (ball) and the toe tip where the rig has a bone there
+  // (skeletonMap.ts derives one along the foot where it has none: a guess the foot does not stand on).
+  const legs: LegBones[] = (['Left', 'Right'] as const).map((side) => {
+    const ankle = boneOf[at(`${side}Foot`)];
+    const inverseAnkle = quatConjugate(rest.rotations[ankle]);
+    return {
+      thigh: boneOf[at(`${side}UpLeg`)],
+      knee: boneOf[at(`${side}Leg`)],
+      ankle,
+      toe: boneOf[at(`${side}ToeBase`)],
+      tip: boneOf[at(`${side}ToeBase_end`)],
+      offsets: footPointsOf(side).map((k) => quatRotate(inverseAnkle, sub(restAt(k), restAt(at(`${side}Foot`))).map((v) => v * unitsPerMetre) as Vec3)),
+      clearance: footPointsOf(side).map((k) => restAt(k)[1] - restFloor),
+    };
+  });
+  const rig1: PreparedRig = {
+    rest, restLocal: rig.restRotations.map(quatNormalize), mapping, unitsPerMetre, restCanonical, restAt, characterLeg,
+    boneOf, pointOfBone, mapped: pointOfBone.map((k) => k >= 0),
+    restRef: RULES.map((rule) => (rule.twist ? rule.twist(restAt) : ([0, 0, 0] as Vec3))),
+    restFloor, characterAnkle,
+    restHipJoints: sub(midpoint(restAt(at('LeftUpLeg')), restAt(at('RightUpLeg'))), restAt(at('Hips'))),
+    // The root's rest offset from the hips: the bones between keep their rest rotations, so it is constant.
+    rootBone, hipsFromRoot: sub(rest.positions[hipsBone], rest.positions[rootBone]),
+    legs,
+  };
+  preparedRigs.set(rig, rig1);
+  return rig1;
+}
+
+/**
+ * The numbers measured on the source that set how it is retargeted (see RetargetOptions.calibration). They are
+ * measured on the motion given unless given.
+ */
+function calibrate(src: Float32Array, F: number, contacts: Uint8Array, rig: PreparedRig): RetargetCalibration {
+  const srcAt = (f: number, k: number): Vec3 => [src[(f * K + k) * 3], src[(f * K + k) * 3 + 1], src[(f * K + k) * 3 + 2]];
+  const sourceLeg = legLength(src, F);
+  if (!(sourceLeg > 1e-4)) throw new SkeletonMapError("retarget: the motion's legs have no length");
   // Feet: the rig's flat foot (its rest) may slope more or less than the source's flat foot (its median slope over
   // the planted frames where its ankle is lowest: flat on the floor, not landing on the heel or the ball); the foot
   // and toes are turned down by the difference, so that a flat foot of the source is flat on the character too (toes
   // neither floating nor sunk when the heel is down).
-  const footPointsOf = (side: 'Left' | 'Right') => ['Foot', 'ToeBase', 'ToeBase_end'].map((n) => at(`${side}${n}` as CanonicalJoint));
-  const slopeOffset = new Float64Array(K);
+  const slopes = [0, 0, 0, 0];
   (['Left', 'Right'] as const).forEach((side, s) => {
     const [ankle, toe, tip] = footPointsOf(side);
     const flatFrames: number[] = [];
@@ -328,28 +404,20 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
     flatFrames.length = Math.min(flatFrames.length, Math.ceil(flatFrames.length * FLAT_SHARE));
     if (!flatFrames.length) return;
     // The foot (ankle → toe base) and the toes (toe base → tip) each by their own slopes.
-    for (const [from, to] of [[ankle, toe], [toe, tip]]) {
+    [[ankle, toe], [toe, tip]].forEach(([from, to], i) => {
       const sourceFlat = median(flatFrames.map((f) => pitchOf(sub(srcAt(f, to), srcAt(f, from)))));
-      slopeOffset[from] = sourceFlat - pitchOf(sub(restAt(to), restAt(from)));
-    }
+      slopes[s * 2 + i] = sourceFlat - pitchOf(sub(rig.restAt(to), rig.restAt(from)));
+    });
   });
-  const restRef = RULES.map((rule) => (rule.twist ? rule.twist(restAt) : ([0, 0, 0] as Vec3)));
-  const boneOf = mapping.source;
-  const pointOfBone = new Array<number>(B).fill(-1);
-  boneOf.forEach((b, k) => b >= 0 && pointOfBone[b] < 0 && (pointOfBone[b] = k));
-  const restLocal = rig.restRotations.map(quatNormalize);
-
-  // Heights: the rig's rest floor, its ankles' height above it; the source's planted ankle height.
-  const restFootPoints = (['Left', 'Right'] as const).flatMap(footPointsOf);
-  // The points a foot stands on: the ankle (heel), the toe base (ball) and the toe tip where the rig has a bone there
-  // (skeletonMap.ts derives one along the foot where it has none: a guess the foot does not stand on).
-  const solePointsOf = (side: 'Left' | 'Right') => ['Foot', 'ToeBase', 'ToeBase_end'].map((n) => at(`${side}${n}` as CanonicalJoint));
-  const restLowest = Math.min(...restFootPoints.map((k) => restAt(k)[1]));
-  const restFloor = restLowest >= 0 && restLowest <= REST_FLOOR_SLACK ? 0 : restLowest;
-  const characterAnkle = (restAt(at('LeftFoot'))[1] + restAt(at('RightFoot'))[1]) / 2 - restFloor;
+  // The source's ankles' height when planted (else their lowest), and the height of its feet's lowest point then.
   const plantedAnkles: number[] = [];
+  const plantedLows: number[] = [];
   for (let f = 0; f < F; f++) {
-    (['Left', 'Right'] as const).forEach((side, s) => contacts[f * 2 + s] && plantedAnkles.push(srcAt(f, at(`${side}Foot`))[1]));
+    (['Left', 'Right'] as const).forEach((side, s) => {
+      if (!contacts[f * 2 + s]) return;
+      plantedAnkles.push(srcAt(f, at(`${side}Foot`))[1]);
+      plantedLows.push(Math.min(...footPointsOf(side).map((k) => srcAt(f, k)[1])));
+    });
   }
   let sourceAnkle = median(plantedAnkles);
   if (!Number.isFinite(sourceAnkle)) {
@@ -357,39 +425,48 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
     for (let f = 0; f < F; f++) lows.push(Math.min(srcAt(f, at('LeftFoot'))[1], srcAt(f, at('RightFoot'))[1]));
     sourceAnkle = median(lows);
   }
+  const sourceSole = Number.isFinite(median(plantedLows)) ? median(plantedLows) : 0;
+  return { scale: rig.characterLeg / sourceLeg, sourceAnkle, sourceSole, footSlopes: slopes };
+}
+
+function checkCalibration(c: RetargetCalibration): RetargetCalibration {
+  const ok = c && c.scale > 0 && Number.isFinite(c.sourceAnkle) && Number.isFinite(c.sourceSole) && c.footSlopes?.length === 4 && c.footSlopes.every(Number.isFinite);
+  if (!ok) throw new Error('retarget: options.calibration is not one a retarget returned (scale, sourceAnkle, sourceSole, four footSlopes)');
+  return c;
+}
+
+/** Retargets `source` (any humanoid Motion: every model's canonical output or an import) onto `rig`. */
+export function retarget(source: Motion, rig: CharacterRig, options: RetargetOptions = {}): RetargetResult {
+  const prep = prepared(rig);
+  const F = source.frames;
+  if (!(F >= 1) || !(source.fps > 0)) throw new Error(`retarget: the motion needs frames and a positive fps (got ${F} frames at ${source.fps} fps)`);
+  const B = rig.bones.length;
+  const footIK = options.footIK ?? true;
+  const { rest, restLocal, mapping, unitsPerMetre, restCanonical, restAt, characterLeg, pointOfBone, restRef, characterAnkle, restHipJoints, rootBone, hipsFromRoot, legs, mapped } = prep;
+
+  // The source's canonical points and contacts.
+  const src = sourceCanonical(source);
+  const srcAt = (f: number, k: number): Vec3 => [src[(f * K + k) * 3], src[(f * K + k) * 3 + 1], src[(f * K + k) * 3 + 2]];
+  const contacts = source.contacts && source.contacts.length === F * 2
+    ? Uint8Array.from(source.contacts)
+    : labelContacts(src, new Uint8Array(F * 2), CANONICAL_JOINTS, source.fps);
+  const calibration = options.calibration ? checkCalibration(options.calibration) : calibrate(src, F, contacts, prep);
+  const { scale, sourceAnkle, sourceSole } = calibration;
+  const slopeOffset = new Float64Array(K);
+  [at('LeftFoot'), at('LeftToeBase'), at('RightFoot'), at('RightToeBase')].forEach((k, i) => (slopeOffset[k] = calibration.footSlopes[i]));
+
+  // Where each segment points: the first target point far enough from the bone's point in the rest and the source.
+  const minSegment = 0.01 * characterLeg;
+  const segmentEnd = RULES.map((rule, k) => rule.to.find((e) =>
+    length(sub(restAt(e), restAt(k))) > minSegment && length(sub(srcAt(0, e), srcAt(0, k))) > minSegment / scale) ?? -1);
+  const restDir = segmentEnd.map((e, k) => (e >= 0 ? sub(restAt(e), restAt(k)) : ([0, 0, 0] as Vec3)));
+
   // Each source foot's height above the floor per frame (its lowest point less where that lies when planted), scaled
   // up for a taller character but not down for a shorter one (toe clearance in the swing is a few centimetres
   // whatever one's size): a swinging foot of the character clears the floor at least as far, so it does not scuff it.
-  const sourceFootPoints = (['Left', 'Right'] as const).map(solePointsOf);
-  const lowestOf = (f: number, s: number) => Math.min(...sourceFootPoints[s].map((k) => srcAt(f, k)[1]));
-  const plantedLows: number[] = [];
-  for (let f = 0; f < F; f++) for (let s = 0; s < 2; s++) if (contacts[f * 2 + s]) plantedLows.push(lowestOf(f, s));
-  const sourceSole = Number.isFinite(median(plantedLows)) ? median(plantedLows) : 0;
+  const sourceFootPoints = (['Left', 'Right'] as const).map(footPointsOf);
+  const lowestOf = (f: number, s: number) => Math.min(...sourceFootPoints[s].map((k) => src[(f * K + k) * 3 + 1]));
   const swingClearance = [0, 1].map((s) => Float64Array.from({ length: F }, (_, f) => Math.max(0, lowestOf(f, s) - sourceSole) * Math.max(1, scale)));
-
-  // The rest offset (m) from the hips point to the legs' hip joints' midpoint.
-  const restHipJoints = sub(midpoint(restAt(at('LeftUpLeg')), restAt(at('RightUpLeg'))), restAt(at('Hips')));
-  const hipsBone = boneOf[at('Hips')];
-  let rootOfHips = hipsBone;
-  while (rig.parents[rootOfHips] >= 0) rootOfHips = rig.parents[rootOfHips];
-  const rootBone = rootOfHips;
-  // The root's rest offset from the hips: the bones between keep their rest rotations, so it is constant.
-  const hipsFromRoot = sub(rest.positions[hipsBone], rest.positions[rootBone]);
-
-  const legs: LegBones[] = (['Left', 'Right'] as const).map((side) => {
-    const ankle = boneOf[at(`${side}Foot`)];
-    const inverseAnkle = quatConjugate(rest.rotations[ankle]);
-    const points = solePointsOf(side);
-    return {
-      thigh: boneOf[at(`${side}UpLeg`)],
-      knee: boneOf[at(`${side}Leg`)],
-      ankle,
-      toe: boneOf[at(`${side}ToeBase`)],
-      tip: boneOf[at(`${side}ToeBase_end`)],
-      offsets: points.map((k) => quatRotate(inverseAnkle, sub(restAt(k), restAt(at(`${side}Foot`))).map((v) => v * unitsPerMetre) as Vec3)),
-      clearance: points.map((k) => restAt(k)[1] - restFloor),
-    };
-  });
 
   const rotations = new Float32Array(F * B * 4);
   const rootTranslations = new Float32Array(F * 3);
@@ -398,7 +475,9 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
 
   // Pass 1: the pose from the source's rotations; per bone its world rotation (mapped bones: R × rest world).
   for (let f = 0; f < F; f++) {
-    const p: Points = (k) => srcAt(f, k);
+    const points: Vec3[] = [];
+    for (let k = 0; k < K; k++) points.push(srcAt(f, k));
+    const p: Points = (k) => points[k];
     const delta: Quat[] = new Array(K);
     for (let k = 0; k < K; k++) {
       const rule = RULES[k];
@@ -430,12 +509,11 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
     poseFrame(rig, world, rootBone, root, restLocal, rotations, positions, f);
   }
 
-  const mapped = pointOfBone.map((k) => k >= 0);
   if (footIK) plantFeet(rig, legs, worlds, mapped, contacts, swingClearance, source.fps, unitsPerMetre, rootBone, rootTranslations, restLocal, rotations, positions);
 
   for (let i = 0; i < positions.length; i++) positions[i] /= unitsPerMetre;
   const motion: Motion = { fps: source.fps, frames: F, joints: [...rig.bones], parents: [...rig.parents], positions, contacts };
-  return { motion, rotations, rootTranslations, rootBone, mapping, scale, unitsPerMetre, restCanonical, contacts };
+  return { motion, rotations, rootTranslations, rootBone, mapping, scale, unitsPerMetre, restCanonical, contacts, calibration };
 }
 
 /**
@@ -456,7 +534,10 @@ function poseFrame(rig: CharacterRig, world: Quat[], rootBone: number, root: Vec
       local = quatNormalize(quatMultiply(quatConjugate(world[parent]), world[b]));
       const o = quatRotate(world[parent], rig.restTranslations[b]);
       const pp = (f * B + parent) * 3;
-      positions.set([positions[pp] + o[0], positions[pp + 1] + o[1], positions[pp + 2] + o[2]], (f * B + b) * 3);
+      const at3 = (f * B + b) * 3;
+      positions[at3] = positions[pp] + o[0];
+      positions[at3 + 1] = positions[pp + 1] + o[1];
+      positions[at3 + 2] = positions[pp + 2] + o[2];
     }
     // Keep w ≥ 0 so that consecutive frames interpolate the short way.
     if (local[3] < 0) local = [-local[0], -local[1], -local[2], -local[3]];
@@ -562,6 +643,12 @@ function plantFeet(
     }
   });
 
+  // Per leg, the mapped bones the IK turns: from the thigh down to the knee (exclusive), and from the knee down to the
+  // foot (exclusive); the foot and what hangs from it keep their world rotations.
+  const turned = legs.map((leg) => {
+    const between = rig.bones.flatMap((_, b) => (mapped[b] && isBelow(rig.parents, b, leg.thigh) && !isBelow(rig.parents, b, leg.ankle) ? [b] : []));
+    return { thigh: between.filter((b) => !isBelow(rig.parents, b, leg.knee)), shin: between.filter((b) => isBelow(rig.parents, b, leg.knee)) };
+  });
   for (let f = 0; f < F; f++) {
     const world = worlds[f];
     let changed = false;
@@ -590,11 +677,8 @@ function plantFeet(
       const shinTurn = quatMultiply(swingRotation(quatRotate(thighTurn, sub(ankle, knee)), sub(newAnkle, newKnee)), thighTurn);
       // Every bone from the thigh down to (not including) the foot turns: the thigh by thighTurn, the shin and the
       // bones between it and the foot by shinTurn; the foot keeps its world rotation.
-      for (let b = leg.thigh; b < B; b++) {
-        if (b === leg.ankle || !isBelow(rig.parents, b, leg.thigh) || isBelow(rig.parents, b, leg.ankle)) continue;
-        if (!mapped[b]) continue;
-        world[b] = quatNormalize(quatMultiply(isBelow(rig.parents, b, leg.knee) ? shinTurn : thighTurn, world[b]));
-      }
+      for (const b of turned[s].thigh) world[b] = quatNormalize(quatMultiply(thighTurn, world[b]));
+      for (const b of turned[s].shin) world[b] = quatNormalize(quatMultiply(shinTurn, world[b]));
       changed = true;
     });
     if (!changed) continue;
