@@ -8,6 +8,12 @@ export type GroundPoint = [number, number];
 
 /** Spacing of the resampled path (m): fine enough that nearest-point error from resampling is < 1 mm. */
 export const PATH_SPACING = 0.05;
+/**
+ * A reversal (cusp) is where the path turns by more than this (rad, 120°) within ±CUSP_SPAN of a point: the
+ * walker must get to it, stop, turn round and walk back, so the follower treats it specially (pathFollower.ts).
+ */
+export const CUSP_TURN = (2 * Math.PI) / 3;
+const CUSP_SPAN = 0.15;
 /** A path must be at least this long to follow (m). */
 export const MIN_PATH_LENGTH = 0.5;
 /** And at most this long: 200 m is minutes of walking. */
@@ -115,6 +121,8 @@ export class GroundPath {
   readonly zs: Float64Array;
   readonly length: number;
   readonly spacing: number;
+  /** Arc lengths of the path's reversals (CUSP_TURN), in order. */
+  readonly cusps: number[];
 
   private constructor(points: GroundPoint[]) {
     this.xs = Float64Array.from(points, (p) => p[0]);
@@ -123,6 +131,44 @@ export class GroundPath {
     for (let i = 1; i < points.length; i++) length += Math.hypot(this.xs[i] - this.xs[i - 1], this.zs[i] - this.zs[i - 1]);
     this.length = length;
     this.spacing = length / Math.max(1, points.length - 1);
+    this.cusps = this.findCusps();
+  }
+
+  /**
+   * Reversals: points where the direction from CUSP_SPAN back to the point and from the point to CUSP_SPAN on
+   * differ by more than CUSP_TURN; of each run of such points, the one farthest along the way it came (the tip).
+   */
+  private findCusps(): number[] {
+    const n = this.xs.length;
+    const k = Math.max(1, Math.round(CUSP_SPAN / this.spacing));
+    const cusps: number[] = [];
+    // The run of points past CUSP_TURN now, where it started, and its point farthest along the direction it
+    // came in (the tip).
+    let run: { first: number; tip: number; reach: number } | null = null;
+    for (let i = 1; i < n - 1; i++) {
+      const a = Math.max(0, i - k), b = Math.min(n - 1, i + k);
+      const inX = this.xs[i] - this.xs[a], inZ = this.zs[i] - this.zs[a];
+      const outX = this.xs[b] - this.xs[i], outZ = this.zs[b] - this.zs[i];
+      const turn = Math.abs(angleDifference(Math.atan2(outX, outZ), Math.atan2(inX, inZ)));
+      if (turn > CUSP_TURN) {
+        if (!run) run = { first: i, tip: i, reach: -Infinity };
+        const from = Math.max(0, run.first - k);
+        const dx: number = this.xs[run.first] - this.xs[from], dz: number = this.zs[run.first] - this.zs[from];
+        const along: number = (this.xs[i] - this.xs[from]) * dx + (this.zs[i] - this.zs[from]) * dz;
+        if (along > run.reach) run = { ...run, tip: i, reach: along };
+      } else if (run) {
+        cusps.push(run.tip * this.spacing);
+        run = null;
+      }
+    }
+    if (run) cusps.push(run.tip * this.spacing);
+    return cusps;
+  }
+
+  /** The first reversal after arc length s (Infinity if none). */
+  nextCusp(s: number): number {
+    for (const c of this.cusps) if (c > s) return c;
+    return Infinity;
   }
 
   /**
@@ -159,26 +205,30 @@ export class GroundPath {
   /**
    * Nearest point to (x, z) among arc lengths [from, to] (clamped): its arc length and distance. The
    * follower searches a window around its last position so a path that crosses itself (figure eight)
-   * is not short-cut.
+   * is not short-cut. With `backCost`, each metre of arc before `backFrom` counts as that many metres
+   * farther (a path that runs back over itself then projects onto its later stretch, not the earlier).
    */
-  project(x: number, z: number, from = 0, to = this.length): { s: number; distance: number } {
+  project(x: number, z: number, from = 0, to = this.length, backFrom = -Infinity, backCost = 0): { s: number; distance: number } {
     const n = this.count;
     const i0 = Math.max(0, Math.floor(from / this.spacing) - 1);
     const i1 = Math.min(n - 2, Math.ceil(to / this.spacing));
-    let best = Infinity, bestS = 0;
+    let best = Infinity, bestS = 0, bestD = Infinity;
     for (let i = i0; i <= i1; i++) {
       const ax = this.xs[i], az = this.zs[i];
       const dx = this.xs[i + 1] - ax, dz = this.zs[i + 1] - az;
       const len2 = dx * dx + dz * dz;
       const t = len2 > 0 ? Math.min(Math.max(((x - ax) * dx + (z - az) * dz) / len2, 0), 1) : 0;
       const ex = ax + dx * t - x, ez = az + dz * t - z;
-      const d2 = ex * ex + ez * ez;
-      if (d2 < best) {
-        best = d2;
-        bestS = (i + t) * this.spacing;
+      const d = Math.sqrt(ex * ex + ez * ez);
+      const s = (i + t) * this.spacing;
+      const cost = d + backCost * Math.max(0, backFrom - s);
+      if (cost < best) {
+        best = cost;
+        bestS = s;
+        bestD = d;
       }
     }
-    return { s: bestS, distance: Math.sqrt(best) };
+    return { s: bestS, distance: bestD };
   }
 
   /** Distance from (x, z) to the whole path. */
