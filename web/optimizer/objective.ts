@@ -2,6 +2,7 @@
 // the contact term needs the feet, so it runs forward kinematics on each particle's frames.
 import { decodeFeatures, type RootStart } from '../model/featureDecode';
 import type { GeneratorInfo } from '../model/generatorInfo';
+import { findLegs, footPoints } from '../motion/legs';
 import type { RolloutResult } from './rollout';
 
 /** Eq. (18)'s σ_con for the path follower: a planted toe moving 1 cm in a frame (0.3 m/s) costs 1. */
@@ -65,4 +66,38 @@ export function lastToes(info: GeneratorInfo, positions: Float32Array, contacts:
     z: [at(0, 2), at(1, 2)],
     planted: [contacts[f * 2] === 1, contacts[f * 2 + 1] === 1],
   };
+}
+
+/** Heights (m) below which the low-foot term weighs a foot point's step fully, and from which not at all. */
+const LOW_FOOT_FULL = 0.02;
+const LOW_FOOT_NONE = 0.06;
+
+/**
+ * Low-foot term, the contact term by foot height instead of the model's bits (what lowFootSliding measures,
+ * web/motion/footSkating.ts): per foot and frame pair, the foot's lowest point (ankle, toe or toe tip) in the
+ * first frame costs |Δ (x, z)|² / σ², weighted 1 up to LOW_FOOT_FULL above the floor and smoothly 0 at
+ * LOW_FOOT_NONE (higher of the two frames; a smooth weight, so no particle gains by lifting a foot just past
+ * lowFootSliding's 4 cm). The bits miss a foot that skims the floor in its swing (toe tip 2–3 cm up at
+ * 3 m/s): ranking by this term picks the particles that lift it, which the foot lock (it holds planted feet
+ * only) cannot do afterwards.
+ */
+export function lowFootCost(info: GeneratorInfo, features: Float32Array, start: RootStart, sigma: number, previousPose: Float32Array | null = null): number {
+  const decoded = decodeFeatures(info, features, start);
+  const J = info.skeleton.joints.length;
+  const frames = features.length / info.onnx.dim;
+  // The pose before the window (the last committed frame) links the window's first frame to what came before.
+  const pose = (f: number) => (f < 0 ? previousPose : decoded.positions.subarray(f * J * 3, (f + 1) * J * 3));
+  let cost = 0;
+  for (const points of findLegs(info.skeleton.joints, 'the low-foot term').map(footPoints)) {
+    for (let f = previousPose ? 0 : 1; f < frames; f++) {
+      const a = pose(f - 1)!, b = pose(f)!;
+      let low = points[0];
+      for (const j of points) if (a[j * 3 + 1] < a[low * 3 + 1]) low = j;
+      const h = Math.max(a[low * 3 + 1], b[low * 3 + 1]);
+      if (h >= LOW_FOOT_NONE) continue;
+      const t = Math.min(Math.max((h - LOW_FOOT_FULL) / (LOW_FOOT_NONE - LOW_FOOT_FULL), 0), 1);
+      cost += (1 - t * t * (3 - 2 * t)) * ((b[low * 3] - a[low * 3]) ** 2 + (b[low * 3 + 2] - a[low * 3 + 2]) ** 2) / (sigma * sigma);
+    }
+  }
+  return cost;
 }
