@@ -1,9 +1,11 @@
 // What scripts/evaluate-control.mjs (the generator with the MAP optimiser) and scripts/evaluate-latent-erd.mjs
 // measure alike, so the two reports compare directly: the live-control scenarios and small helpers.
 
-/** Control scenarios of docs/models/control.md: a change at t = 3 s from a steady start. */
+/** Control scenarios of docs/models/control.md: a change at t = 3 s from a steady start; each runs `seconds` (default SIM_SECONDS). */
 export const SCENARIOS = {
   'turn 90°': { kind: 'heading', change: 90, schedule: [{ t: 0, speed: 1.2, heading: 0 }, { t: 3, speed: 1.2, heading: Math.PI / 2 }] },
+  // Issue 43's schedule, run 8 s as it was reported (the others run SIM_SECONDS): the Steer sliding target is on it.
+  'turn 90°, 8 s': { kind: 'heading', change: 90, seconds: 8, schedule: [{ t: 0, speed: 1.2, heading: 0 }, { t: 3, speed: 1.2, heading: Math.PI / 2 }] },
   'turn 180°': { kind: 'heading', change: 180, schedule: [{ t: 0, speed: 1.2, heading: 0 }, { t: 3, speed: 1.2, heading: Math.PI }] },
   'speed 0.8 → 1.5 m/s': { kind: 'speed', schedule: [{ t: 0, speed: 0.8, heading: 0 }, { t: 3, speed: 1.5, heading: 0 }] },
   'speed 1.5 → 0.8 m/s': { kind: 'speed', schedule: [{ t: 0, speed: 1.5, heading: 0 }, { t: 3, speed: 0.8, heading: 0 }] },

@@ -66,7 +66,7 @@ async function simulateOne(page, scenario, seed) {
       const { footSkating } = await import('/motion/footSkating.ts');
       return { skating: footSkating(m), fps: m.fps, frames: m.frames, speed: Array.from(m.speed), heading: Array.from(m.heading), computeMs: Array.from(m.computeMs) };
     },
-    { schedule: scenario.schedule, seed, seconds: SIM_SECONDS, gait: scenario.gait },
+    { schedule: scenario.schedule, seed, seconds: scenario.seconds ?? SIM_SECONDS, gait: scenario.gait },
   );
 }
 
