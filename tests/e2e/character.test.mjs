@@ -98,7 +98,7 @@ describe('your own character', { timeout: 600_000 }, () => {
     assert.equal(await page.evaluate(() => window.playground.character()), null);
   });
 
-  test('rigs of other namings load and retarget facing the source: Mixamo 0.01 in an A-pose, VRM 0.x and 1.0 maps, facing −z', async () => {
+  test('rigs of other namings load and retarget facing the source: Mixamo 0.01 in an A-pose, VRM 0.x and 1.0 maps, facing −z, a helper root first', async () => {
     const results = await suite.page.evaluate(async (rigsUrl) => {
       const rigs = await import(rigsUrl);
       const pg = window.playground;
@@ -107,6 +107,7 @@ describe('your own character', { timeout: 600_000 }, () => {
         vrm0: { naming: 'vrm', vrm: 0 },
         vrm1: { naming: 'vrm', vrm: 1, pose: 'A' },
         backwards: { naming: 'vrm', facing: -1 },
+        helperRoot: { naming: 'mixamo', helperRoot: true },
       };
       const src = window.walk;
       const SJ = src.joints.length;
@@ -125,7 +126,7 @@ describe('your own character', { timeout: 600_000 }, () => {
           cos += (a[0] * b[0] + a[2] * b[2]) / (Math.hypot(a[0], a[2]) * Math.hypot(b[0], b[2]) || 1);
           hipY += p(hips, f)[1];
         }
-        out[key] = { mapSource: info.mapSource, height: info.height, leftUpLeg: info.mapping.LeftUpLeg, leftHand: info.mapping.LeftHand, missing: info.missing, cos: cos / m.frames, hipY: hipY / m.frames };
+        out[key] = { first: info.bones[0], mapSource: info.mapSource, height: info.height, leftUpLeg: info.mapping.LeftUpLeg, leftHand: info.mapping.LeftHand, missing: info.missing, cos: cos / m.frames, hipY: hipY / m.frames };
       }
       return out;
     }, RIGS);
@@ -135,6 +136,7 @@ describe('your own character', { timeout: 600_000 }, () => {
     assert.equal(results.vrm0.mapSource, 'vrm0');
     assert.equal(results.vrm1.mapSource, 'vrm1');
     assert.equal(results.vrm0.leftUpLeg, 'leftUpperLeg');
+    assert.equal(results.helperRoot.first, 'ik_root', 'the helper root is the rig\'s first bone');
     for (const [key, r] of Object.entries(results)) {
       assert.ok(Math.abs(r.height - 1.72) < 0.03, `${key}: height ${r.height} m (the body is 1.72 m, whatever its units)`);
       assert.ok(r.cos > 0.95, `${key}: the character's hip line follows the source's (mean cosine ${r.cos.toFixed(3)})`);
@@ -263,19 +265,29 @@ describe('your own character', { timeout: 600_000 }, () => {
       const rigs = await import(rigsUrl);
       const pg = window.playground;
       const clip = { ...window.walk, frames: 90, positions: window.walk.positions.slice(0, 90 * window.walk.joints.length * 3), contacts: undefined };
-      const bytes = await pg.exportGLB(clip, { character: true, name: 'hero-walk' });
-      const expected = pg.retarget(clip);
-      const back = await rigs.playBack(bytes, clip.fps, clip.frames, expected.joints);
-      let worst = 0;
-      expected.joints.forEach((_, k) => {
-        for (let f = 0; f < clip.frames; f++) {
-          for (let i = 0; i < 3; i++) worst = Math.max(worst, Math.abs(back.positions[k][f * 3 + i] - expected.positions[(f * expected.joints.length + k) * 3 + i]));
-        }
-      });
+      /** The export of the loaded character read back, against retarget(): the worst bone position error (m). */
+      const roundTrip = async () => {
+        const bytes = await pg.exportGLB(clip, { character: true, name: 'hero-walk' });
+        const expected = pg.retarget(clip);
+        const back = await rigs.playBack(bytes, clip.fps, clip.frames, expected.joints);
+        let worst = 0;
+        expected.joints.forEach((_, k) => {
+          for (let f = 0; f < clip.frames; f++) {
+            for (let i = 0; i < 3; i++) worst = Math.max(worst, Math.abs(back.positions[k][f * 3 + i] - expected.positions[(f * expected.joints.length + k) * 3 + i]));
+          }
+        });
+        return { bytes, back, worst };
+      };
+      // A rig whose first bone is a helper root beside the hips' tree: the root the hips hang from is moved.
+      await pg.loadCharacter(await rigs.makeRig({ naming: 'mixamo', helperRoot: true }));
+      const helper = await roundTrip();
+      await pg.loadCharacter('characters/quaternius-human-male.glb');
+      const { bytes, back, worst } = await roundTrip();
       const bvh = pg.exportBVH(clip, { character: true });
       const fromBvh = await pg.importMotion(bvh, 'bvh');
-      return { bytes: bytes.length, isUint8: bytes instanceof Uint8Array, ...back, positions: undefined, worst, bvhJoints: fromBvh.joints, bvhFrames: fromBvh.frames, plain: pg.exportGLB(clip) instanceof Uint8Array };
+      return { bytes: bytes.length, isUint8: bytes instanceof Uint8Array, ...back, positions: undefined, worst, helperWorst: helper.worst, bvhJoints: fromBvh.joints, bvhFrames: fromBvh.frames, plain: pg.exportGLB(clip) instanceof Uint8Array };
     }, RIGS);
+    assert.ok(r.helperWorst < 0.001, `helper-root rig: worst bone position error ${(r.helperWorst * 1000).toFixed(3)} mm`);
     assert.ok(r.isUint8 && r.bytes > 100_000, `${r.bytes} bytes`);
     assert.equal(r.plain, true, 'the plain export is still bytes, not a promise');
     assert.equal(r.skinnedMeshes, 1);

@@ -56,9 +56,10 @@ function boneName(point, naming) {
  *   naming 'vrm' | 'mixamo'; scale: the armature's scale (Mixamo's 0.01: bones in centimetres under a 0.01 node);
  *   pose 'T' | 'A' (arms 45° down); facing 1 (+z) or -1 (−z: the armature turned 180°); vrm: 0 or 1 writes a VRM 0.x
  *   or 1.0 humanoid map into the file's extensions; legs: false leaves the legs out (not a humanoid); skin: false
- *   writes a plain mesh; vertices: about how many the skinned mesh has (default ~2,000).
+ *   writes a plain mesh; vertices: about how many the skinned mesh has (default ~2,000); helperRoot: a bone of its
+ *   own before the hips' tree (the rig's first bone is then not the hips' root).
  */
-export async function makeRig({ naming = 'vrm', scale = 1, pose = 'T', facing = 1, vrm = null, legs = true, skin = true, vertices = 2000 } = {}) {
+export async function makeRig({ naming = 'vrm', scale = 1, pose = 'T', facing = 1, vrm = null, legs = true, skin = true, vertices = 2000, helperRoot = false } = {}) {
   const points = BODY.filter(([p]) => legs || !/Leg|Foot|Toes/.test(p));
   const unit = 1 / scale;
   const bones = new Map();
@@ -78,11 +79,18 @@ export async function makeRig({ naming = 'vrm', scale = 1, pose = 'T', facing = 
   armature.name = 'Armature';
   armature.scale.setScalar(scale);
   if (facing < 0) armature.rotation.y = Math.PI;
+  if (helperRoot) {
+    // A root bone of its own before the hips (an engine's IK root, say), a sibling of the hips' tree.
+    const helper = new THREE.Bone();
+    helper.name = 'ik_root';
+    armature.add(helper);
+    bones.set('ikRoot', helper);
+  }
   armature.add(bones.get('hips'));
   const scene = new THREE.Scene();
   scene.add(armature);
   armature.updateMatrixWorld(true);
-  const list = [...bones.values()];
+  const list = [...bones.values()].sort((a, b) => (a.name === 'ik_root' ? -1 : b.name === 'ik_root' ? 1 : 0));
   const geometry = limbGeometry(list, vertices, armature);
   const material = new THREE.MeshStandardMaterial({ color: 0x7fa0d0, roughness: 0.7 });
   if (skin) {

@@ -19,16 +19,17 @@ export async function exportCharacterGLB(asset: CharacterAsset, result: Retarget
     const times = new Float32Array(frames);
     const rotations = bones.map(() => new Float32Array(frames * 4));
     const rootPositions = new Float32Array(frames * 3);
+    const rootBone = bones[result.rootBone ?? 0]; // the root the hips hang from (retarget.ts)
     for (let f = 0; f < frames; f++) {
       times[f] = f / fps;
       copy.update(f, f, 0);
       for (let k = 0; k < B; k++) bones[k].quaternion.toArray(rotations[k], f * 4);
-      bones[0].position.toArray(rootPositions, f * 3);
+      rootBone.position.toArray(rootPositions, f * 3);
     }
     copy.rest(); // the nodes' own transforms in the file are the rest pose the skin was bound in
     // Tracks name their bones by uuid: bone names need not be unique in three.js (GLTFLoader cleans them).
     const tracks: THREE.KeyframeTrack[] = bones.map((bone, k) => new THREE.QuaternionKeyframeTrack(`${bone.uuid}.quaternion`, times, rotations[k]));
-    tracks.push(new THREE.VectorKeyframeTrack(`${bones[0].uuid}.position`, times, rootPositions));
+    tracks.push(new THREE.VectorKeyframeTrack(`${rootBone.uuid}.position`, times, rootPositions));
     const clip = new THREE.AnimationClip(name, frames > 1 ? (frames - 1) / fps : 0, tracks);
     const root = copy.mannequin.mesh;
     root.name = name;

@@ -389,7 +389,7 @@ export class UserCharacterDriver implements CharacterView {
       const bone = this.bones[root.bone];
       // Rotations of roots are relative to the scene: take the armature's rotation off.
       bone.quaternion.premultiply(root.parentRotationInverse);
-      if (root.bone !== 0) continue;
+      if (root.bone !== (r.rootBone ?? 0)) continue; // the root the hips hang from moves; other roots keep their rest
       const T = r.rootTranslations, o0 = i0 * 3, o1 = i1 * 3, S = this.sceneScale;
       this.point.set(
         (T[o0] + (T[o1] - T[o0]) * a) * S,
