@@ -228,6 +228,60 @@ describe('retarget: the result drives the rig', () => {
   });
 });
 
+/** World rotations (frames × bones) by FK of a result's local rotations. */
+function worldRotations(rig: CharacterRig, result: RetargetResult): Quat[][] {
+  const B = rig.bones.length;
+  return Array.from({ length: result.motion.frames }, (_, f) => {
+    const world: Quat[] = [];
+    for (let b = 0; b < B; b++) {
+      const o = (f * B + b) * 4;
+      const local: Quat = [result.rotations[o], result.rotations[o + 1], result.rotations[o + 2], result.rotations[o + 3]];
+      world[b] = rig.parents[b] < 0 ? local : quatMultiply(world[rig.parents[b]], local);
+    }
+    return world;
+  });
+}
+
+const cross = (a: Vec3, b: Vec3): Vec3 => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const angleOf = (a: Vec3, b: Vec3) => (Math.acos(Math.max(-1, Math.min(1, (a[0] * b[0] + a[1] * b[1] + a[2] * b[2]) / (Math.hypot(...a) * Math.hypot(...b))))) * 180) / Math.PI;
+
+describe('retarget: limbs twist as they bend', () => {
+  // The bones' directions alone leave a thigh or upper arm free to twist about itself, which a skinned mesh shows.
+  // A knee or elbow must bend about its own hinge: the axis that is the hinge in the rig's rest pose (across the limb,
+  // square to the body's forward), carried by the thigh's or upper arm's world rotation, against the axis the limb
+  // actually bends about on the character (square to its two bones).
+  it.each([...rigs.map(({ spec, rig }) => [spec.label.split(' (')[0], rig] as const), ['Quaternius (GLB)', quaternius] as const])('%s', (_, rig) => {
+    for (const s of [0, 2]) {
+      const result = retarget(sources[s].motion, rig);
+      const worlds = worldRotations(rig, result);
+      const rest: Quat[] = [];
+      rig.parents.forEach((p, b) => (rest[b] = p < 0 ? rig.restRotations[b] : quatMultiply(rest[p], rig.restRotations[b])));
+      const R = result.restCanonical, P = result.motion.positions, B = rig.bones.length;
+      const restAt = (name: string): Vec3 => { const k = CANONICAL_JOINTS.indexOf(name as never); return [R[k * 3], R[k * 3 + 1], R[k * 3 + 2]]; };
+      const sub3 = (a: Vec3, b: Vec3): Vec3 => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+      const forward = cross(sub3(restAt('LeftUpLeg'), restAt('RightUpLeg')), [0, 1, 0]);
+      for (const [upper, middle, lower, bendsForward] of [['LeftUpLeg', 'LeftLeg', 'LeftFoot', false], ['RightUpLeg', 'RightLeg', 'RightFoot', false], ['LeftArm', 'LeftForeArm', 'LeftHand', true], ['RightArm', 'RightForeArm', 'RightHand', true]] as const) {
+        const [a, b, c] = [upper, middle, lower].map((n) => result.mapping.source[CANONICAL_JOINTS.indexOf(n)]);
+        // The rest hinge: across the upper bone, square to the way the lower bone swings (forward for the forearm, back for the shin).
+        const swing: Vec3 = bendsForward ? forward : [-forward[0], -forward[1], -forward[2]];
+        const hingeRest = cross(sub3(restAt(middle), restAt(upper)), swing);
+        const local = quatRotate([-rest[a][0], -rest[a][1], -rest[a][2], rest[a][3]], hingeRest);
+        const angles: number[] = [];
+        for (let f = 0; f < result.motion.frames; f++) {
+          const at = (j: number): Vec3 => [P[(f * B + j) * 3], P[(f * B + j) * 3 + 1], P[(f * B + j) * 3 + 2]];
+          const u = sub3(at(b), at(a)), l = sub3(at(c), at(b));
+          if (angleOf(u, l) < 30) continue;
+          angles.push(angleOf(quatRotate(worlds[f][a], local), cross(u, l)));
+        }
+        if (angles.length < 5) continue;
+        const mean = angles.reduce((x, y) => x + y, 0) / angles.length;
+        expect(mean, `${upper}: mean angle between its rest hinge and the axis it bends about`).toBeLessThan(10);
+        expect(Math.max(...angles), `${upper}: the largest angle between its rest hinge and the axis it bends about`).toBeLessThan(45);
+      }
+    }
+  });
+});
+
 describe('retarget: the issue\'s measures on 5 rigs × 4 sources', () => {
   // rig × source: mean limb-bone angle ≤ 10°; lowest-foot sliding ≤ the source's + 0.03 m/s; planted feet on the floor.
   const cases = RIGS.flatMap((spec, r) => ['walk', 'run', 'dance', 'model-like walk'].map((what, s) => [spec.label.split(' (')[0], what, r, s] as const));

@@ -23,7 +23,7 @@
 import { labelContacts } from './contactLabels';
 import { twoBoneIK, smoothstep } from './footLock';
 import { CANONICAL_JOINTS, mapHumanoid, SkeletonMapError, type CanonicalJoint, type HumanoidMap } from './humanoid';
-import { cross, length, normalize, quatConjugate, quatFromAxisAngle, quatIdentity, quatMultiply, quatNormalize, quatRotate, rotationFromTwoVectors, sub, swingRotation, type Quat, type Vec3 } from './math';
+import { cross, dot, length, normalize, quatConjugate, quatFromAxisAngle, quatIdentity, quatMultiply, quatNormalize, quatRotate, rotationFromTwoVectors, sub, swingRotation, type Quat, type Vec3 } from './math';
 import { mapSkeleton, toCanonical } from './skeletonMap';
 import type { Motion } from './types';
 
@@ -91,6 +91,8 @@ const TYPICAL_HEIGHT = 1.7;
 const RELEASE_SECONDS = 0.15;
 /** A rig whose lowest rest foot point is within this height above y = 0 (m) stands on y = 0; else on that point. */
 const REST_FLOOR_SLACK = 0.15;
+/** How far ahead of the knee (a share of the leg's length) the IK's bend is aimed: enough to bend a straight leg forward. */
+const KNEE_POLE = 0.05;
 /** The longest a leg may stretch in the foot IK, as a share of thigh + shin. */
 const REACH = 0.9999;
 /** The share of a foot's planted frames, lowest ankle first, taken as the foot standing flat. */
@@ -99,8 +101,9 @@ const FLAT_SHARE = 0.25;
 const PLANTED_LIFT = 0.02;
 /** Below this sine of the angle between a segment and its twist reference, the reference is not trusted. */
 const PARALLEL_SINE = 0.08;
-/** How strongly a knee's or elbow's bend sets the limb's twist against the fallback forward (per leg length). */
-const BEND_WEIGHT = 6;
+/** A knee or elbow bent less than BEND_FROM twists the limb by the fallback forward, more than BEND_FULL by its bend (radians). */
+const BEND_FROM = (5 * Math.PI) / 180;
+const BEND_FULL = (25 * Math.PI) / 180;
 
 const K = CANONICAL_JOINTS.length;
 const CANONICAL_INDEX = new Map<string, number>(CANONICAL_JOINTS.map((name, k) => [name, k]));
@@ -119,33 +122,35 @@ interface SegmentRule {
 
 const hipLine: Twist = (p) => sub(p(at('LeftUpLeg')), p(at('RightUpLeg')));
 const shoulderLine: Twist = (p) => sub(p(at('LeftArm')), p(at('RightArm')));
-const torsoForward = (p: Points): Vec3 => normalize(cross(sub(p(at('Neck')), p(at('Hips'))), hipLine(p)));
-const chestForward = (p: Points): Vec3 => normalize(cross(sub(p(at('Neck')), p(at('Spine1'))), shoulderLine(p)));
+/** Where the chest faces: left (right → left shoulder) × up (chest → neck base). */
+const chestForward = (p: Points): Vec3 => normalize(cross(shoulderLine(p), sub(p(at('Neck')), p(at('Spine1')))));
 
-/** The knee's forward: where the foot points, plus the knee's offset ahead of the hip–ankle line when bent. */
-function kneeTwist(side: 'Left' | 'Right'): Twist {
-  const [hip, knee, ankle, toe] = ['UpLeg', 'Leg', 'Foot', 'ToeBase'].map((n) => at(`${side}${n}` as CanonicalJoint));
-  return (p) => {
-    const h = p(hip), k = p(knee), a = p(ankle);
-    const leg = length(sub(k, h)) + length(sub(a, k)) || 1;
-    const mid: Vec3 = [(h[0] + a[0]) / 2, (h[1] + a[1]) / 2, (h[2] + a[2]) / 2];
-    const foot = normalize(sub(p(toe), a));
-    const bend = sub(k, mid);
-    return [foot[0] + (BEND_WEIGHT * bend[0]) / leg, foot[1] + (BEND_WEIGHT * bend[1]) / leg, foot[2] + (BEND_WEIGHT * bend[2]) / leg];
-  };
+/**
+ * A limb's twist reference: the way its middle joint points out of the line through its ends (the knee forward, the
+ * elbow back), which is the hinge's own plane, where the limb is bent; `straight` (the foot's or the chest's forward)
+ * where it is straight, blended between BEND_FROM and BEND_FULL of bend, so the twist does not jump.
+ */
+function bendTwist(root: Vec3, middle: Vec3, end: Vec3, straight: Vec3, sign: number): Vec3 {
+  const upper = sub(middle, root), lower = sub(end, middle);
+  const bend = Math.acos(Math.max(-1, Math.min(1, dot(upper, lower) / ((length(upper) * length(lower)) || 1))));
+  const w = smoothstep((bend - BEND_FROM) / (BEND_FULL - BEND_FROM));
+  const line = sub(end, root);
+  const along = dot(upper, line) / (dot(line, line) || 1);
+  const out = normalize([upper[0] - line[0] * along, upper[1] - line[1] * along, upper[2] - line[2] * along]);
+  const fallback = normalize(straight);
+  return [(1 - w) * fallback[0] + w * sign * out[0], (1 - w) * fallback[1] + w * sign * out[1], (1 - w) * fallback[2] + w * sign * out[2]];
 }
 
-/** The elbow's front: the chest's forward, plus (against) the elbow's offset behind the shoulder–wrist line when bent. */
+/** The knee's forward: where it points when bent, else where the foot points. */
+function kneeTwist(side: 'Left' | 'Right'): Twist {
+  const [hip, knee, ankle, toe] = ['UpLeg', 'Leg', 'Foot', 'ToeBase'].map((n) => at(`${side}${n}` as CanonicalJoint));
+  return (p) => bendTwist(p(hip), p(knee), p(ankle), sub(p(toe), p(ankle)), 1);
+}
+
+/** The elbow's front: against where it points when bent, else the chest's forward. */
 function elbowTwist(side: 'Left' | 'Right'): Twist {
   const [shoulder, elbow, wrist] = ['Arm', 'ForeArm', 'Hand'].map((n) => at(`${side}${n}` as CanonicalJoint));
-  return (p) => {
-    const s = p(shoulder), e = p(elbow), w = p(wrist);
-    const arm = length(sub(e, s)) + length(sub(w, e)) || 1;
-    const mid: Vec3 = [(s[0] + w[0]) / 2, (s[1] + w[1]) / 2, (s[2] + w[2]) / 2];
-    const fwd = chestForward(p);
-    const bend = sub(e, mid);
-    return [fwd[0] - (BEND_WEIGHT * bend[0]) / arm, fwd[1] - (BEND_WEIGHT * bend[1]) / arm, fwd[2] - (BEND_WEIGHT * bend[2]) / arm];
-  };
+  return (p) => bendTwist(p(shoulder), p(elbow), p(wrist), chestForward(p), -1);
 }
 
 function segmentRules(): SegmentRule[] {
@@ -289,6 +294,8 @@ interface LegBones {
   /** The toe bone and the toe-tip bone, -1 where the rig has none. */
   toe: number;
   tip: number;
+  /** The way the knee points (the body's forward in the rest pose) in the thigh bone's frame: where the IK bends a straight leg. */
+  kneeForward: Vec3;
   /** Foot points (ankle, toe, toe end) as offsets in the ankle bone's frame (rig units), and each one's rest height above the floor (m). */
   offsets: Vec3[];
   clearance: number[];
@@ -356,12 +363,15 @@ function prepared(rig: CharacterRig): PreparedRig {
 
   // The points a foot stands on: the ankle (heel), the toe base (ball) and the toe tip where the rig has a bone there
   // (skeletonMap.ts derives one along the foot where it has none: a guess the foot does not stand on).
+  const restForward = normalize(cross(sub(restAt(at('LeftUpLeg')), restAt(at('RightUpLeg'))), [0, 1, 0]));
   const legs: LegBones[] = (['Left', 'Right'] as const).map((side) => {
     const ankle = boneOf[at(`${side}Foot`)];
+    const thigh = boneOf[at(`${side}UpLeg`)];
     const inverseAnkle = quatConjugate(rest.rotations[ankle]);
     return {
-      thigh: boneOf[at(`${side}UpLeg`)],
+      thigh,
       knee: boneOf[at(`${side}Leg`)],
+      kneeForward: quatRotate(quatConjugate(rest.rotations[thigh]), restForward),
       ankle,
       toe: boneOf[at(`${side}ToeBase`)],
       tip: boneOf[at(`${side}ToeBase_end`)],
@@ -672,7 +682,8 @@ function plantFeet(
           target = lifted;
         }
       }
-      const [newKnee, newAnkle] = twoBoneIK(hip, knee, target, l1, l2, REACH, null, 0);
+      // The knee bends towards where it points (a leg the source holds straight bends forward, not sideways).
+      const [newKnee, newAnkle] = twoBoneIK(hip, knee, target, l1, l2, REACH, quatRotate(world[leg.thigh], leg.kneeForward), KNEE_POLE * (l1 + l2));
       const thighTurn = rotationFromTwoVectors(sub(knee, hip), sub(ankle, hip), sub(newKnee, hip), sub(newAnkle, hip)) ?? swingRotation(sub(knee, hip), sub(newKnee, hip));
       const shinTurn = quatMultiply(swingRotation(quatRotate(thighTurn, sub(ankle, knee)), sub(newAnkle, newKnee)), thighTurn);
       // Every bone from the thigh down to (not including) the foot turns: the thigh by thighTurn, the shin and the
