@@ -6,20 +6,25 @@
 //      rotation.
 //   3. Per frame, each mapped bone's world rotation = R × its rest world rotation, where R takes the bone's rest
 //      segment (its canonical point to the next one along the chain) and a twist reference to the source's current
-//      ones: the hip line for the hips, the shoulder line for the chest and neck, the limb's bend for thighs, shins,
-//      upper arms and forearms (the knee's or elbow's offset from the line through the limb's ends, with the feet's
-//      or the torso's forward where the limb is straight), the shin for the foot. Hands, toes and the head turn with
-//      their parent plus the least swing. Rest-pose differences (T or A pose, a rig facing −z, bone axes that do
-//      not follow the bones) cancel: R is measured from the rig's own rest directions.
-//      Unmapped bones (fingers, twist bones, clavicles, a root at the floor) keep their rest rotation relative to
-//      their parent. Local rotation = inverse(parent world) × world.
-//   4. The hips go where the source's hips go, scaled by leg length (character leg / source leg), with the height
-//      shifted by the difference in ankle heights so that planted feet land on the floor.
+//      ones: the hip line for the hips, the shoulder line for the chest and neck; for thighs, shins, upper arms and
+//      forearms the way the knee or elbow points out of the line through the limb's ends (its hinge plane), blended
+//      into the foot's or the chest's forward as the limb straightens; the shin for the foot. Hands, toes and the
+//      head turn with their parent plus the least swing. Rest-pose differences (T or A pose, a rig facing −z, bone
+//      axes that do not follow the bones) cancel: R is measured from the rig's own rest directions. The foot and the
+//      toes are also turned down by the difference between the rig's rest slope and the source's flat-foot slope,
+//      so that a flat foot stays flat. Unmapped bones (fingers, twist bones, clavicles, a root at the floor) keep
+//      their rest rotation under their parent. Local rotation = inverse(parent world) × world.
+//   4. The legs' hip joints go where the source's go, scaled by leg length (character leg / source leg), the height
+//      shifted by the difference in ankle heights so that planted feet land on the floor (y = 0).
 //   5. Where the source's feet are planted (its contacts, else labelled from height and speed, contactLabels.ts),
-//      the character's foot is held still on the floor: its lowest point (relative to where the point stands in the
-//      rest pose, so a mesh sole stands on the floor) is pinned horizontally where it was when the contact began and
-//      put at floor height; thigh and shin turn by two-bone IK (footLock.ts) to reach, the foot keeps its world
-//      rotation. The correction is blended in and out over RELEASE_SECONDS.
+//      the character's foot stands on its lowest point (heel, ball or a toe-tip bone, each against its height in
+//      the rest pose, so a mesh sole stands on the floor), held horizontally where it was when the contact began;
+//      thigh and shin turn by two-bone IK (footLock.ts) to reach, the foot keeps its world rotation. A push-off out
+//      of reach turns the foot about the pinned ball or tip; where even that does not reach, the hips come down.
+//      Swinging feet clear the floor at least as far as the source's. Corrections fade in and out over
+//      RELEASE_SECONDS.
+// The numbers measured on the source for 4 and 5 (RetargetCalibration) can be given, so that the windows of a live
+// stream are retargeted alike; the work on the rig is done once per rig object.
 import { labelContacts } from './contactLabels';
 import { twoBoneIK, smoothstep } from './footLock';
 import { CANONICAL_JOINTS, mapHumanoid, SkeletonMapError, type CanonicalJoint, type HumanoidMap } from './humanoid';
