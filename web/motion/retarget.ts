@@ -1,7 +1,8 @@
 // Retargeting a humanoid motion onto a character's own skeleton (issue 40, "Bring your own character"), by rotations.
 //
 //   1. The source (any humanoid Motion: a model's canonical output or an import) becomes the canonical points in
-//      metres (humanoid.ts maps it, skeletonMap.toCanonical places the points it lacks).
+//      metres (humanoid.ts maps it, skeletonMap.toCanonical places the points it lacks), stood on y = 0 if an import's
+//      floor is clearly elsewhere.
 //   2. The rig's rest pose is mapped the same way (mapRig): its rest canonical points and each bone's rest world
 //      rotation.
 //   3. Per frame, each mapped bone's world rotation = R × its rest world rotation, where R takes the bone's rest
@@ -96,6 +97,9 @@ const TYPICAL_HEIGHT = 1.7;
 const RELEASE_SECONDS = 0.15;
 /** A rig whose lowest rest foot point is within this height above y = 0 (m) stands on y = 0; else on that point. */
 const REST_FLOOR_SLACK = 0.15;
+/** A source whose feet's lowest point (this quantile over the frames) is more than OFF_FLOOR (m) off y = 0 is stood on y = 0. */
+const SOURCE_FLOOR_QUANTILE = 0.05;
+const OFF_FLOOR = 0.05;
 /** How far ahead of the knee (a share of the leg's length) the IK's bend is aimed: enough to bend a straight leg forward. */
 const KNEE_POLE = 0.05;
 /** The longest a leg may stretch in the foot IK, as a share of thigh + shin. */
@@ -251,8 +255,19 @@ export function mapRig(rig: CharacterRig): HumanoidMap {
 /** The source motion's canonical points (frames × 25 × 3, metres). */
 function sourceCanonical(source: Motion): Float32Array {
   const canonical = source.joints.length === K && source.joints.every((name, j) => name === CANONICAL_JOINTS[j]);
-  if (canonical) return source.positions;
-  return toCanonical(source, { ...mapSkeleton(source, 1), scale: 1 });
+  const points = canonical ? source.positions : toCanonical(source, { ...mapSkeleton(source, 1), scale: 1 });
+  // A motion is on the floor y = 0 (types.ts); an import that is not (a capture whose floor sits lower or higher) is
+  // stood on it: its feet's lowest point, 5th percentile over the frames, at y = 0.
+  const F = source.frames;
+  const lows = new Float64Array(F);
+  const feet = (['Left', 'Right'] as const).flatMap(footPointsOf);
+  for (let f = 0; f < F; f++) lows[f] = Math.min(...feet.map((k) => points[(f * K + k) * 3 + 1]));
+  lows.sort();
+  const floor = lows[Math.floor(F * SOURCE_FLOOR_QUANTILE)];
+  if (Math.abs(floor) <= OFF_FLOOR) return points;
+  const stood = Float32Array.from(points);
+  for (let i = 1; i < stood.length; i += 3) stood[i] -= floor;
+  return stood;
 }
 
 function legLength(points: ArrayLike<number>, frames: number): number {
