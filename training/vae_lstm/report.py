@@ -165,10 +165,16 @@ def target_rows(r: dict) -> list[tuple[str, str, str, bool]]:
     paths = [p for p in r.get("browser", {}).get("paths", []) if p["model"] == "vae-lstm"]
     walk = [p for p in paths if p["gait"] == "walk"]
     if walk:
-        ok = min(p["leastRealTime"] for p in walk) >= PATH_REAL_TIME and max(p["meanError"] for p in walk) <= PATH_MEAN_ERROR
+        fast = min(p["leastRealTime"] for p in walk) >= PATH_REAL_TIME
+        close = max(p["meanError"] for p in walk) <= PATH_MEAN_ERROR
+        b = r["browser"]
+        # Timed while the machine had more runnable jobs than cores, × real time measures the machine, not the model.
+        loaded = b.get("cores") and b.get("load_before", 0) > b["cores"]
+        met = (f"error {'yes' if close else 'no'}; × real time not judged (load {b['load_before']} on {b['cores']} cores)" if loaded and not fast
+               else "yes" if fast and close else "no")
         rows.append((f"{len(walk)} benchmark paths in Chromium (walk): ≥ {PATH_REAL_TIME}× real time, mean path error ≤ {PATH_MEAN_ERROR:.2f} m",
                      f"least {min(p['leastRealTime'] for p in walk):.0f}× real time, mean error {_span([p['meanError'] for p in walk], 3)} m",
-                     "yes" if ok else "no", ok))
+                     met, fast and close))
     back = [p for p in paths if p["path"] == DOUBLING_BACK and "leastCoverage" in p]
     if back:
         ok = {p["gait"]: p["leastCoverage"] >= FOLLOWED_SHARE for p in back}
