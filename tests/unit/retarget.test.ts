@@ -209,6 +209,21 @@ describe('retarget: the result drives the rig', () => {
     }
   });
 
+  it('a live stream retargeted a frame at a time over the last 31 frames, with the first calibration, follows the whole retargeting', () => {
+    // As the viewer does live: each new frame retargeted with 30 frames before it (planted feet carry over).
+    const stream = sources[3].motion;
+    const J = stream.joints.length, B = quaternius.bones.length;
+    const whole = retarget(stream, quaternius);
+    let worst = 0;
+    for (let end = 31; end <= stream.frames; end += 3) {
+      const from = end - 31;
+      const window = { ...stream, frames: 31, positions: stream.positions.slice(from * J * 3, end * J * 3), contacts: stream.contacts!.slice(from * 2, end * 2) };
+      const live = retarget(window, quaternius, { calibration: whole.calibration }).motion.positions;
+      for (let i = 0; i < B * 3; i++) worst = Math.max(worst, Math.abs(live[30 * B * 3 + i] - whole.motion.positions[(end - 1) * B * 3 + i]));
+    }
+    expect(worst).toBeLessThan(0.01);
+  });
+
   it('detects the rig units: centimetres for the Mixamo rig, metres for the others', () => {
     expect(rigs.map((_, r) => resultOf(r, 0).unitsPerMetre)).toEqual([1, 100, 1, 1, 1]);
     const mixamo = resultOf(1, 0), cmu = resultOf(0, 0);
