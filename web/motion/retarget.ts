@@ -536,7 +536,7 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
     const hips = sub(hipJoints, quatRotate(delta[at('Hips')], restHipJoints));
     const root = sub(hips.map((v) => v * unitsPerMetre) as Vec3, hipsFromRoot);
     rootTranslations.set(root, f * 3);
-    poseFrame(rig, world, rootBone, root, restLocal, rotations, positions, f);
+    poseFrame(rig, world, rootBone, root, rotations, positions, f);
   }
 
   if (footIK) plantFeet(rig, legs, worlds, mapped, contacts, swingClearance, source.fps, unitsPerMetre, rootBone, rootTranslations, restLocal, rotations, positions);
@@ -547,11 +547,11 @@ export function retarget(source: Motion, rig: CharacterRig, options: RetargetOpt
 }
 
 /**
- * One frame from world rotations: re-derives unmapped bones' world rotations (rest local under the parent's current
- * world), writes the local rotations and the positions (rig units; FK with three.js semantics: a bone's position is
- * its parent's plus the parent's world rotation applied to the bone's rest translation).
+ * One frame from its world rotations: writes the local rotations and the positions (rig units; FK with three.js
+ * semantics: a bone's position is its parent's plus the parent's world rotation applied to the bone's rest
+ * translation; `rootBone` stands at `root`, other roots at their rest).
  */
-function poseFrame(rig: CharacterRig, world: Quat[], rootBone: number, root: Vec3, restLocal: Quat[], rotations: Float32Array, positions: Float32Array, f: number): void {
+function poseFrame(rig: CharacterRig, world: Quat[], rootBone: number, root: Vec3, rotations: Float32Array, positions: Float32Array, f: number): void {
   const B = rig.bones.length;
   for (let b = 0; b < B; b++) {
     const parent = rig.parents[b];
@@ -714,7 +714,7 @@ function plantFeet(
     });
     if (!changed) continue;
     refreshUnmapped(rig, world, mapped, restLocal);
-    poseFrame(rig, world, rootBone, [rootTranslations[f * 3], rootTranslations[f * 3 + 1], rootTranslations[f * 3 + 2]], restLocal, rotations, positions, f);
+    poseFrame(rig, world, rootBone, [rootTranslations[f * 3], rootTranslations[f * 3 + 1], rootTranslations[f * 3 + 2]], rotations, positions, f);
   }
 }
 
