@@ -111,6 +111,7 @@ MAY_IMPORT = {
     "autoencoder": {"mocap", "data", "models"} | SHARED,
     "latent_erd": {"mocap", "data", "models", "autoencoder", "control", "generator"} | SHARED,
     "vae_lstm": {"mocap", "data", "models", "control", "latent_erd"} | SHARED,
+    "own": {"mocap", "data", "models", "generator", "aclstm"} | SHARED,
     "bench": {"models"} | SHARED,
     "fixtures": {"mocap", "data", "models", "generator", "refiner", "aclstm", "control", "autoencoder", "latent_erd"} | SHARED,
 }

@@ -1,0 +1,50 @@
+"""Train a model on your own motion: a folder of BVH or ASF/AMC files (plain or gzipped, any humanoid skeleton) in,
+a model pack out (ONNX + JSON as the shipped models, card.md and its pose-change plot, all from measurements).
+
+    python -m training.own --data DIR --kind locomotion --out DIR [--minutes 20] [--resume]
+
+The folder is read and checked before training starts (training/own/dataset.py); the run keeps its log and
+checkpoints in runs/own-<id>/ (--run), resumes with --resume and stops cleanly on Ctrl-C, keeping the last checkpoint.
+docs/training.md, "Train on your own motion", has the whole story.
+"""
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+from .dataset import OwnCorpus, RefusedFolder, load_folder
+from .options import add_own_arguments, min_clip_frames, pack_id, run_folder
+from .pack import export_pack, measure_pack, plot_pose_change, record_measures, write_card
+from .trainer import train_locomotion
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(prog="python -m training.own", description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_own_arguments(parser)
+    args = parser.parse_args(argv)
+    if args.kind == "dance":
+        raise SystemExit("error: --kind dance is not built yet; --kind locomotion trains the generator")
+    model_id = pack_id(args)
+    args.run = run_folder(args, model_id)
+    t0 = time.perf_counter()
+    try:
+        data = load_folder(args.data, min_clip_frames(args))
+    except RefusedFolder as err:
+        raise SystemExit(f"error: {err}") from None
+    print(f"data: {data.minutes:.2f} minutes in {len(data.clips)} clips ({len(data.held_out)} held out), "
+          f"read in {time.perf_counter() - t0:.0f} s")
+    result = train_locomotion(OwnCorpus(data), args)
+    print(f"trained {result.minutes:.1f} minutes, {result.iterations} iterations ({result.stopped}); "
+          f"held-out NLL {result.best_valid_nll:.3f} per frame; run in {args.run}")
+    onnx_path, json_path, info = export_pack(Path(args.run) / "best.pt", data, model_id, args.out, args.weights)
+    measures = measure_pack(onnx_path, info, data, args.stability_frames)
+    plot_pose_change(measures["stability"], measures["real"]["median_pose_change"], args.out / "pose_change.png")
+    write_card(args.out / "card.md", model_id, data, result, info, measures)
+    record_measures(json_path, info, result, measures)
+    print(f"wrote the pack {model_id} to {args.out}: {onnx_path.name}, {json_path.name}, card.md, pose_change.png")
+
+
+if __name__ == "__main__":
+    main()

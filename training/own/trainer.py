@@ -1,0 +1,97 @@
+"""Training on a user's folder: one function per model kind, each taking a dataset and a config, so that a
+distributed wrapper can run the same loop later. The generator's recipe is training/generator/training.py's (Wang,
+Chai, Xia §4.1.3): Gaussian input noise, RMSProp with the learning rate decayed each epoch, gradients clipped,
+windows of 50 frames; the run conventions are training/runs.py's TrainingLoop (progress bar, log, checkpoints every
+few minutes, --resume, the time budget). Ctrl-C stops cleanly: the last checkpoint and summary are written."""
+from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from ..generator.training import NOISE_SIGMA, validation_nll
+from ..models.generator import MixtureLSTM, mixture_nll
+from ..runs import TrainingLoop
+from .dataset import FPS, OwnCorpus
+
+
+@dataclass
+class TrainingResult:
+    best_valid_nll: float
+    iterations: int
+    epochs_done: int
+    minutes: float
+    stopped: str  # why the run stopped
+
+
+def train_locomotion(corpus: OwnCorpus, config: argparse.Namespace) -> TrainingResult:
+    """Trains the LSTM-GMM generator on `corpus`. `config` holds the flags of add_run_arguments (run, minutes,
+    checkpoint_minutes, resume, seed, threads) and hidden, dropout, lr, batch, window, epochs, iters_per_epoch and
+    iterations (a cap on all iterations, None for none). The best weights by held-out NLL go to best.pt in the run."""
+    loop = TrainingLoop(config)
+    run = loop.run
+    dim = corpus.mean.shape[0]
+    model = MixtureLSTM(dim, config.hidden, dropout=config.dropout)
+    optimiser = torch.optim.RMSprop(model.parameters(), lr=config.lr, alpha=0.9)
+    scheduler = torch.optim.lr_scheduler.ExponentialLR(optimiser, gamma=0.95)
+    rng = loop.seed()
+    per_epoch = config.iters_per_epoch
+    meta = {"dim": dim, "hidden": config.hidden, "mixtures": model.mixtures, "fps": FPS,
+            "mean": corpus.mean.tolist(), "std": corpus.std.tolist(),
+            "references": corpus.codec.references.tolist(), "valid_files": corpus.valid_files,
+            "train_frames": corpus.train_frames, "args": {k: str(v) if not isinstance(v, (int, float, str, bool, type(None))) else v
+                                                          for k, v in vars(config).items()}}
+    iteration = loop.start(meta, "epoch {epoch} iteration {iteration}", model=model, optimiser=optimiser, scheduler=scheduler)
+    epoch = loop.resumed["epoch"] if loop.resumed else 0
+    total_cap = config.iterations if config.iterations else config.epochs * per_epoch
+    run.log.info("start: %d features, %d parameters, %d training frames (with mirroring and speed changes), "
+                 "%d held-out clips, %d iterations per epoch", dim, loop.parameters, corpus.train_frames,
+                 len(corpus.valid), per_epoch)
+    bar = loop.progress_bar("own generator", total_cap, epoch * per_epoch + iteration)
+    losses: list[float] = []
+
+    def end_epoch() -> None:
+        nonlocal epoch, iteration
+        scheduler.step()
+        val = validation_nll(model, corpus)
+        epoch, iteration = epoch + 1, 0
+        if val < loop.best:
+            loop.best = val
+            run.save({"model": model.state_dict(), "epoch": epoch, "valid_nll": val, "meta": meta}, run.best_path)
+        loop.save(iteration, epoch=epoch)
+        run.log.info("epoch %d train_nll %.3f valid_nll %.3f best %.3f lr %.2e minutes %.1f", epoch,
+                     np.mean(losses) if losses else float("nan"), val, loop.best, scheduler.get_last_lr()[0],
+                     loop.elapsed() / 60)
+        losses.clear()
+
+    try:
+        while epoch * per_epoch + iteration < total_cap:
+            x, mask = corpus.batch(rng, config.batch, config.window)
+            inputs = x[:, :-1] + NOISE_SIGMA * torch.randn_like(x[:, :-1])
+            logits, mu, log_sigma, _ = model(inputs)
+            loss = (mixture_nll(logits, mu, log_sigma, x[:, 1:]) * mask).sum() / mask.sum()
+            optimiser.zero_grad()
+            loss.backward()
+            torch.nn.utils.clip_grad_value_(model.parameters(), 5.0)
+            optimiser.step()
+            iteration += 1
+            losses.append(loss.item())
+            bar.update(1)
+            bar.set_postfix(epoch=epoch + 1, nll=f"{np.mean(losses[-50:]):.2f}")
+            if iteration >= per_epoch:
+                end_epoch()
+            if loop.step_done(iteration, epoch=epoch):
+                break
+    except KeyboardInterrupt:
+        loop.stopped = "stopped by Ctrl-C"
+    done = epoch * per_epoch + iteration
+    if iteration > 0 or not run.best_path.exists():
+        # A part epoch (the budget, the cap or Ctrl-C cut it) is still measured, so a short run has weights to export.
+        val = validation_nll(model, corpus)
+        if val < loop.best or not run.best_path.exists():
+            loop.best = val
+            run.save({"model": model.state_dict(), "epoch": epoch, "valid_nll": val, "meta": meta}, run.best_path)
+    loop.finish(iteration, {"best_valid_nll": loop.best, "epochs_done": epoch, "iterations": done}, epoch=epoch)
+    return TrainingResult(loop.best, done, epoch, loop.elapsed() / 60, loop.stopped)
