@@ -495,3 +495,16 @@ describe('boneOwners', () => {
     expect(extra).toEqual([ci('Neck'), ci('Hips'), ci('Neck')]);
   });
 });
+
+describe('the acLSTM dance skeleton (Daz names, a buttock joint above each thigh)', () => {
+  it('maps the hip socket to the thigh the scheme names, not the buttock above it', async () => {
+    const { parseBVH } = await import('../../web/motion/bvh');
+    const { readCorpus } = await import('./corpus');
+    const m = parseBVH(readCorpus('aclstm/salsa/01.bvh.gz'));
+    expect(m.joints).toContain('lButtock');
+    const { source } = mapSkeleton(m, CANONICAL_LEG);
+    const at = (p: CanonicalJoint) => m.joints[source[ci(p)]];
+    expect([at('LeftUpLeg'), at('LeftLeg'), at('LeftFoot'), at('RightUpLeg')]).toEqual(['lThigh', 'lShin', 'lFoot', 'rThigh']);
+    expect([at('LeftArm'), at('LeftForeArm'), at('LeftHand'), at('Neck'), at('Head')]).toEqual(['lShldr', 'lForeArm', 'lHand', 'neck', 'head']);
+  });
+});

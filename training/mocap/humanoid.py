@@ -406,9 +406,12 @@ def _fit_leg(t: _Tree, pelvis: int, leg_root: int, hints: _Hints, side: str, nam
         return t.arc[b] - t.arc[a]
 
     hint = hints.hint
-    socket = pts[0]
+    # The hip socket: the first point below the legs' branch, or a later one the naming scheme names so (the Daz
+    # skeleton of the acLSTM set has a buttock joint above its thigh).
+    socket_at = next((i for i, j in enumerate(pts) if i < len(pts) - 2 and hints.named(j, f"{side}UpLeg")), 0)
+    socket = pts[socket_at]
     best: tuple[float, int, int] | None = None  # cost, knee, ankle
-    for i in range(1, len(pts) - 1):
+    for i in range(socket_at + 1, len(pts) - 1):
         for k in range(i + 1, len(pts)):
             thigh, shin = arc(socket, pts[i]), arc(pts[i], pts[k])
             foot = arc(pts[k], tip)

@@ -395,9 +395,12 @@ function fitLeg(t: Tree, pelvis: number, legRoot: number, { hint, named, namedAn
   const pts = limbPoints(t, pelvis, tip, names, namedAny);
   if (pts.length < 3) return undefined;
   const arc = (a: number, b: number) => t.arc[b] - t.arc[a];
-  const socket = pts[0];
+  // The hip socket: the first point below the legs' branch, or a later one the naming scheme names so (the Daz
+  // skeleton of the acLSTM set has a buttock joint above its thigh).
+  const socketAt = Math.max(0, pts.findIndex((j, i) => i < pts.length - 2 && named(j, `${side}UpLeg`)));
+  const socket = pts[socketAt];
   let best: { cost: number; knee: number; ankle: number } | undefined;
-  for (let i = 1; i < pts.length - 1; i++) {
+  for (let i = socketAt + 1; i < pts.length - 1; i++) {
     for (let k = i + 1; k < pts.length; k++) {
       const thigh = arc(socket, pts[i]), shin = arc(pts[i], pts[k]);
       const foot = arc(pts[k], tip);
