@@ -4,7 +4,7 @@
 // Most of the sliding was not on the turn but mid-swing: the swing foot's toe tip passing 2–3 cm over the floor
 // at 3 m/s, which the foot lock (planted feet only) leaves as it is; the live objective's low-foot term
 // (web/optimizer/objective.ts lowFootCost) now ranks particles that lift it higher. Before it, the seed states
-// below slid 0.158 (walk 02_01) and 0.388 m/s (walk 16_19).
+// below slid 0.158 (walk 02_01) and 0.388 m/s (walk 16_19); with it 0.126 and 0.124.
 import { afterAll, beforeAll, describe, expect, it } from 'vitest';
 import { parseGeneratorInfo } from '../../web/model/generatorInfo';
 import { footSkating, lowFootSliding } from '../../web/motion/footSkating';
