@@ -357,4 +357,43 @@ describe('your own character', { timeout: 600_000 }, () => {
       el.setAttribute('mode', 'clip');
     });
   });
+  test('live chunks are joined smoothly: steps at chunk boundaries no larger than elsewhere, close to one retargeting of the window', async () => {
+    const r = await suite.page.evaluate(async () => {
+      const { parseCharacter, UserCharacterDriver } = await import('/viewer/userCharacter.ts');
+      const asset = await parseCharacter(await (await fetch('characters/quaternius-human-male.glb')).arrayBuffer(), 'q.glb');
+      const out = {};
+      const sources = { walk: { model: 'generator', frames: 600, seed: 3, refine: true }, dance: { model: 'aclstm', style: 'salsa', seed: 10, frames: 600 } };
+      for (const [name, options] of Object.entries(sources)) {
+        const m = await window.playground.generate(options);
+        const J = m.joints.length;
+        const window_ = (start, end) => ({ ...m, frames: end - start, positions: m.positions.slice(start * J * 3, end * J * 3), contacts: m.contacts?.slice(start * 2, end * 2) });
+        // Windows as the live modes build them: chunks of 30 frames, at most 300 kept.
+        const live = new UserCharacterDriver(asset, { lit: false });
+        for (let end = 30; end <= 600; end += 30) live.setMotion(window_(Math.max(0, end - 300), end));
+        const whole = new UserCharacterDriver(asset, { lit: false });
+        whole.setMotion(window_(300, 600));
+        const a = live.retargeted.motion.positions, b = whole.retargeted.motion.positions, B = live.retargeted.motion.joints.length;
+        const step = (k, f) => Math.hypot(...[0, 1, 2].map((i) => a[(f * B + k) * 3 + i] - a[((f - 1) * B + k) * 3 + i]));
+        const result = {};
+        for (const bone of ['pelvis', 'foot_l', 'hand_r']) {
+          const k = live.retargeted.motion.joints.indexOf(bone);
+          const at = [], elsewhere = [];
+          for (let f = 1; f < 300; f++) (f % 30 === 0 ? at : elsewhere).push(step(k, f));
+          elsewhere.sort((x, y) => x - y);
+          result[bone] = { boundaryMax: Math.max(...at), elsewhereP95: elsewhere[Math.floor(elsewhere.length * 0.95)], elsewhereMax: elsewhere[elsewhere.length - 1] };
+        }
+        let sum = 0;
+        for (let f = 30; f < 300; f++) for (let k = 0; k < B; k++) sum += Math.hypot(...[0, 1, 2].map((i) => a[(f * B + k) * 3 + i] - b[(f * B + k) * 3 + i]));
+        out[name] = { ...result, meanFromWhole: sum / (270 * B) };
+      }
+      return out;
+    });
+    for (const [name, o] of Object.entries(r)) {
+      for (const bone of ['pelvis', 'foot_l', 'hand_r']) {
+        const { boundaryMax, elsewhereMax } = o[bone];
+        assert.ok(boundaryMax <= elsewhereMax, `${name}, ${bone}: largest step at a chunk boundary ${(boundaryMax * 100).toFixed(1)} cm, elsewhere at most ${(elsewhereMax * 100).toFixed(1)} cm`);
+      }
+      assert.ok(o.meanFromWhole < 0.1, `${name}: bones ${(o.meanFromWhole * 100).toFixed(1)} cm from one retargeting of the window on average`);
+    }
+  });
 });
