@@ -113,7 +113,7 @@ MAY_IMPORT = {
     "vae_lstm": {"mocap", "data", "models", "control", "latent_erd"} | SHARED,
     "own": {"mocap", "data", "models", "generator", "aclstm"} | SHARED,
     "bench": {"models"} | SHARED,
-    "fixtures": {"mocap", "data", "models", "generator", "refiner", "aclstm", "control", "autoencoder", "latent_erd"} | SHARED,
+    "fixtures": {"mocap", "data", "models", "generator", "refiner", "aclstm", "control", "autoencoder", "latent_erd", "own"} | SHARED,
 }
 
 

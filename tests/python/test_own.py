@@ -1,4 +1,4 @@
-"""python -m training.own: a folder of the user's motion in, a model pack out. The test folder is made here from a few
+"""python -m training.own: a folder of the user's motion in, a model pack out. The test folder is made here from two
 CMU clips renamed to Mixamo's joint names (one of them resampled to 30 fps and left unzipped), a Bandai Namco clip, a CMU
 ASF/AMC pair and a file broken at a known line; the refusals get folders of their own. The command runs as a
 subprocess (tests/python/test_layout.py). The training run is tiny (a small network, a capped number of iterations):
@@ -6,8 +6,10 @@ what is checked is that the pack is complete and readable as the page reads it, 
 import gzip
 import json
 import re
+import signal
 import subprocess
 import sys
+import time
 
 import numpy as np
 import onnxruntime
@@ -87,8 +89,7 @@ def folder(tmp_path_factory, mocap):
     (root / "mixamo" / "more").mkdir(parents=True)
     (root / "bandai").mkdir()
     (root / "asf").mkdir()
-    (root / "mixamo" / "07_04.bvh.gz").write_bytes(gzip.compress(as_mixamo(cmu_text("07_04")).encode()))
-    (root / "mixamo" / "more" / "08_05.bvh").write_text(as_mixamo(cmu_text("08_05")))
+    (root / "mixamo" / "more" / "07_04.bvh.gz").write_bytes(gzip.compress(as_mixamo(cmu_text("07_04")).encode()))
     (root / "mixamo" / "07_05_30fps.bvh").write_text(every_nth_frame(as_mixamo(cmu_text("07_05")), 4))
     bandai = "dataset-2_walk-turn-left_active_001.bvh.gz"
     (root / "bandai" / bandai).write_bytes((mocap / "bandai" / "bvh" / bandai).read_bytes())
@@ -115,7 +116,7 @@ def test_a_pack_is_written_from_a_mixed_folder(pack):
     assert sorted(p.name for p in out.iterdir()) == ["card.md", "my-walks.json", "my-walks.onnx", "pose_change.png"]
     # Mixed frame rates are resampled; the broken file is named with its line and the others go on.
     assert re.search(r"read mixamo/07_05_30fps\.bvh: [\d.]+ s at 30 fps", done.stdout)
-    assert re.search(r"read mixamo/07_04\.bvh\.gz: [\d.]+ s at 120 fps", done.stdout)
+    assert re.search(r"read mixamo/more/07_04\.bvh\.gz: [\d.]+ s at 120 fps", done.stdout)
     assert "read asf/02_01.amc.gz" in done.stdout and "read bandai/" in done.stdout
     line = broken_line(as_mixamo(cmu_text("08_07")).splitlines())
     assert f"skipped: mixamo/broken.bvh:{line}: expected a number, found 'oops'" in done.stdout
@@ -155,7 +156,7 @@ def test_the_card_is_written_from_measurements(pack):
     card = (out / "card.md").read_text()
     info = json.loads((out / "my-walks.json").read_text())
     measures = info["pack"]["measures"]
-    assert f"{info['pack']['data_minutes']:.2f} minutes of motion in 5 clips" in card
+    assert f"{info['pack']['data_minutes']:.2f} minutes of motion in 4 clips" in card
     assert "Mixamo" in card and "Bandai Namco" in card and "CMU ASF" in card
     assert "30 iterations" in card
     assert f"{measures['real']['sliding_low_foot']:.3f}" in card
@@ -174,6 +175,29 @@ def test_resume_continues_the_run(pack, folder, tmp_path):
     log = (run / "train.log").read_text()
     assert "resumed at epoch 1 iteration 10" in log
     assert json.loads((run / "summary.json").read_text())["iterations"] == 45
+
+
+def test_ctrl_c_stops_cleanly_keeping_the_checkpoint(tmp_path):
+    run, folder = tmp_path / "run", tmp_path / "two-clips"
+    folder.mkdir()
+    for name in ("07_04", "07_05"):
+        (folder / f"{name}.bvh").write_text(every_nth_frame(as_mixamo(cmu_text(name)), 4))
+    command = [sys.executable, "-m", "training.own", "--data", str(folder), "--kind", "locomotion", "--out",
+               str(tmp_path / "pack"), "--run", str(run), "--iterations", "1000000", *SMALL[:4], "--checkpoint-minutes", "0.005"]
+    process = subprocess.Popen(command, cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 90
+        while not (run / "checkpoint.pt").exists():  # training has started once the first timed checkpoint is written
+            assert process.poll() is None and time.monotonic() < deadline, "training did not start"
+            time.sleep(0.2)
+        process.send_signal(signal.SIGINT)
+        out, _ = process.communicate(timeout=60)
+    finally:
+        process.kill()
+    assert process.returncode == 130 and "stopped by Ctrl-C" in out and "--resume" in out
+    assert "stopped: stopped by Ctrl-C" in (run / "train.log").read_text()
+    assert json.loads((run / "summary.json").read_text())["iterations"] > 0
+    assert not (tmp_path / "pack").exists()
 
 
 def write_chain_bvh(path, joints: int = 5) -> None:
@@ -255,3 +279,11 @@ def test_derived_points_follow_the_page():
     assert np.allclose(at("LeftToeBase"), (0.2, 0.1 - 0.029, 0.114))
     assert np.allclose(at("LeftToeBase_end"), at("LeftFoot") + 1.5 * (at("LeftToeBase") - at("LeftFoot")))
     assert np.allclose(at("RightHand_end"), (-1.4 - 0.3 * 0.5, 2.9, 0))
+
+
+def test_own_canonical_fixture_is_current(mocap):
+    """tests/fixtures/own_canonical.json (the page's parity cases, tests/unit/ownCanonicalParity.test.ts) is what
+    python -m training.fixtures.own_canonical writes today."""
+    from training.fixtures.own_canonical_cases import OUT, build
+    from conftest import assert_same_json
+    assert_same_json(json.loads(json.dumps(build(mocap))), json.loads(OUT.read_text()))

@@ -32,10 +32,15 @@ def main(argv: list[str] | None = None) -> None:
     try:
         data = load_folder(args.data, min_clip_frames(args))
     except RefusedFolder as err:
-        raise SystemExit(f"error: {err}") from None
+        message = f"error: {err}"
+        raise SystemExit(message if len(message) <= 300 else message[:299] + "…") from None
     print(f"data: {data.minutes:.2f} minutes in {len(data.clips)} clips ({len(data.held_out)} held out), "
           f"read in {time.perf_counter() - t0:.0f} s")
     result = train_locomotion(OwnCorpus(data), args)
+    if result.interrupted:
+        print(f"stopped by Ctrl-C after {result.iterations} iterations; the checkpoint is in {args.run}: "
+              "run the same command with --resume to go on")
+        raise SystemExit(130)
     print(f"trained {result.minutes:.1f} minutes, {result.iterations} iterations ({result.stopped}); "
           f"held-out NLL {result.best_valid_nll:.3f} per frame; run in {args.run}")
     onnx_path, json_path, info = export_pack(Path(args.run) / "best.pt", data, model_id, args.out, args.weights)

@@ -30,7 +30,9 @@ class OwnData:
     clips: list[OwnClip]
     held_out: list[str]  # clip names
     skeletons: list[dict]  # per distinct skeleton: scheme, joints, files
-    skipped: list[str] = field(default_factory=list)  # files left out, each with why
+    skipped: list[str] = field(default_factory=list)  # files that could not be read, each with why (file:line)
+    too_short: list[str] = field(default_factory=list)  # clips shorter than the training window
+    min_seconds: float = 0.0  # the shortest clip the training window takes
 
     @property
     def minutes(self) -> float:
@@ -72,12 +74,12 @@ def load_folder(folder: Path, min_frames: int, log=print) -> OwnData:
         entry = skeletons.setdefault(key, {"scheme": mapping.scheme, "joints": len(raw.joints), "files": 0})
         entry["files"] += 1
     ik = make_ik(skel)
-    clips = []
+    clips, too_short = [], []
     for raw, mapping in zip(raws, mappings):
         clip = canonical_clip(raw, mapping, FPS, ik, skel)
         if clip.frames < min_frames:
-            skipped.append(f"{raw.name}: {raw.seconds:.2f} s, shorter than the {min_frames / FPS:.2f} s the training window needs")
-            log(f"skipped: {skipped[-1]}")
+            too_short.append(raw.name)
+            log(f"skipped: {raw.name}: {raw.seconds:.2f} s, shorter than the {min_frames / FPS:.2f} s the training window needs")
             continue
         clips.append(clip)
         log(f"read {raw.name}: {raw.seconds:.1f} s at {raw.fps:.4g} fps, skeleton {mapping.scheme}")
@@ -86,7 +88,8 @@ def load_folder(folder: Path, min_frames: int, log=print) -> OwnData:
         raise RefusedFolder(f"clips too short: training needs at least 2 clips of {min_frames / FPS:.2f} s or more "
                             f"(the window is {min_frames} frames at {FPS:g} fps); {len(clips)} here, the longest "
                             f"{longest:.2f} s")
-    return OwnData(folder, clips, held_out_names([c.name for c in clips]), list(skeletons.values()), skipped)
+    return OwnData(folder, clips, held_out_names([c.name for c in clips]), list(skeletons.values()), skipped, too_short,
+                   min_frames / FPS)
 
 
 class OwnCorpus(Corpus):

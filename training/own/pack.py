@@ -229,7 +229,9 @@ def write_card(path: Path, pack_id: str, data: OwnData, result: TrainingResult, 
         f"- {data.minutes:.2f} minutes of motion in {len(data.clips)} clips at {FPS:g} fps "
         f"({len(data.held_out)} held out: {', '.join(data.held_out)}).",
         f"- Skeleton: {skeletons}; mapped onto the canonical skeleton by the humanoid mapper.",
-        f"- Left out: {len(data.skipped)} file{'s' * (len(data.skipped) != 1)}" + (": " + "; ".join(data.skipped) if data.skipped else "."),
+        f"- Unreadable, left out: {len(data.skipped)} file{'s' * (len(data.skipped) != 1)}" + (": " + "; ".join(data.skipped) if data.skipped else "."),
+        f"- Shorter than the training window ({data.min_seconds:.2f} s), left out: {len(data.too_short)} clip{'s' * (len(data.too_short) != 1)}"
+        + (": " + ", ".join(data.too_short) if data.too_short else "."),
         "", "## Training", "",
         f"- {result.minutes:.1f} minutes, {result.iterations} iterations ({result.epochs_done} whole epoch{'s' * (result.epochs_done != 1)}); stopped: {result.stopped}.",
         f"- Held-out NLL per frame (normalised features, lower is better): {result.best_valid_nll:.3f}.",

@@ -24,6 +24,7 @@ class TrainingResult:
     epochs_done: int
     minutes: float
     stopped: str  # why the run stopped
+    interrupted: bool = False  # Ctrl-C: the checkpoint is saved, nothing is exported
 
 
 def train_locomotion(corpus: OwnCorpus, config: argparse.Namespace) -> TrainingResult:
@@ -51,6 +52,7 @@ def train_locomotion(corpus: OwnCorpus, config: argparse.Namespace) -> TrainingR
                  len(corpus.valid), per_epoch)
     bar = loop.progress_bar("own generator", total_cap, epoch * per_epoch + iteration)
     losses: list[float] = []
+    interrupted = False
 
     def end_epoch() -> None:
         nonlocal epoch, iteration
@@ -86,6 +88,7 @@ def train_locomotion(corpus: OwnCorpus, config: argparse.Namespace) -> TrainingR
                 break
     except KeyboardInterrupt:
         loop.stopped = "stopped by Ctrl-C"
+        interrupted = True
     done = epoch * per_epoch + iteration
     if iteration > 0 or not run.best_path.exists():
         # A part epoch (the budget, the cap or Ctrl-C cut it) is still measured, so a short run has weights to export.
@@ -94,4 +97,4 @@ def train_locomotion(corpus: OwnCorpus, config: argparse.Namespace) -> TrainingR
             loop.best = val
             run.save({"model": model.state_dict(), "epoch": epoch, "valid_nll": val, "meta": meta}, run.best_path)
     loop.finish(iteration, {"best_valid_nll": loop.best, "epochs_done": epoch, "iterations": done}, epoch=epoch)
-    return TrainingResult(loop.best, done, epoch, loop.elapsed() / 60, loop.stopped)
+    return TrainingResult(loop.best, done, epoch, loop.elapsed() / 60, loop.stopped, interrupted)
