@@ -175,6 +175,10 @@ def test_resume_continues_the_run(pack, folder, tmp_path):
     log = (run / "train.log").read_text()
     assert "resumed at epoch 1 iteration 10" in log
     assert json.loads((run / "summary.json").read_text())["iterations"] == 45
+    # A checkpoint of another network is not resumed.
+    other = run_own("--data", folder, "--kind", "locomotion", "--out", tmp_path / "other", "--run", run, "--resume",
+                    "--iterations", "60", "--hidden", "16", "--iters-per-epoch", "20")
+    assert other.returncode != 0 and "was trained on other data or another --hidden" in other.stderr
 
 
 def test_ctrl_c_stops_cleanly_keeping_the_checkpoint(tmp_path):

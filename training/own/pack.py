@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import json
 import time
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -42,14 +41,6 @@ STABILITY_FRAMES = 10_000
 SLIDING_STREAMS, SLIDING_FRAMES = 4, 600  # generated motion measured for sliding: streams × frames (20 s each)
 SEED_FRAMES = 6  # real frames each seed state is estimated from (eq. 26)
 MAX_SEEDS = 6
-
-
-@dataclass
-class PackFiles:
-    onnx: Path
-    json: Path
-    card: Path
-    thumbnail: Path
 
 
 def pick_seeds(data: OwnData, codec: FeatureCodec, mean: np.ndarray, std: np.ndarray) -> list[dict]:

@@ -27,6 +27,12 @@ class TrainingResult:
     interrupted: bool = False  # Ctrl-C: the checkpoint is saved, nothing is exported
 
 
+def _same_data(saved: dict, now: dict) -> bool:
+    """Whether a checkpoint was trained on the data now loaded: the same held-out clips and feature statistics."""
+    return (saved["valid_files"] == now["valid_files"] and saved["dim"] == now["dim"]
+            and np.allclose(saved["mean"], now["mean"], atol=1e-6) and np.allclose(saved["std"], now["std"], atol=1e-6))
+
+
 def train_locomotion(corpus: OwnCorpus, config: argparse.Namespace) -> TrainingResult:
     """Trains the LSTM-GMM generator on `corpus`. `config` holds the flags of add_run_arguments (run, minutes,
     checkpoint_minutes, resume, seed, threads) and hidden, dropout, lr, batch, window, epochs, iters_per_epoch and
@@ -44,6 +50,10 @@ def train_locomotion(corpus: OwnCorpus, config: argparse.Namespace) -> TrainingR
             "references": corpus.codec.references.tolist(), "valid_files": corpus.valid_files,
             "train_frames": corpus.train_frames, "args": {k: str(v) if not isinstance(v, (int, float, str, bool, type(None))) else v
                                                           for k, v in vars(config).items()}}
+    saved = run.load() if config.resume else None
+    if saved is not None and (saved["meta"]["hidden"] != config.hidden or not _same_data(saved["meta"], meta)):
+        raise SystemExit(f"error: --resume, but the checkpoint in {run.dir} was trained on other data or another "
+                         "--hidden: train without --resume, or into another --run")
     iteration = loop.start(meta, "epoch {epoch} iteration {iteration}", model=model, optimiser=optimiser, scheduler=scheduler)
     epoch = loop.resumed["epoch"] if loop.resumed else 0
     total_cap = config.iterations if config.iterations else config.epochs * per_epoch
