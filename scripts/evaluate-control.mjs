@@ -171,7 +171,7 @@ function markdown(r) {
   lines.push(...table(walk, true), '');
   const doubling = walk.filter((p) => p.path === DOUBLING_BACK);
   if (doubling.length) {
-    lines.push(`The back-and-forth path, walking: followed ${doubling.map((p) => fmt(p.coverage * 100, 1) + '%').join(', ')} of its length within ${T.coverageTolerance} m (target ≥ ${T.coverage * 100}% in every run): ${pass(doubling.every((p) => p.coverage >= T.coverage))}. The follower walks to each reversal's tip, turns round on a small loop and walks back (\`web/optimizer/pathFollower.ts\`: CUSP_REACH, TURNING_STEP).`, '');
+    lines.push(`The back-and-forth path, walking: followed ${doubling.map((p) => fmt(p.coverage * 100, 1) + '%').join(', ')} of its length within ${T.coverageTolerance} m (target ≥ ${T.coverage * 100}% in every run): ${pass(doubling.every((p) => p.coverage >= T.coverage))}. The follower walks to each reversal's tip, turns round on a small loop and walks back (\`web/optimizer/pathFollower.ts\`: CUSP_REACH, TURNING_STEP); with other seeds the generator at times shuffles on slowly after a turn and the walk runs out of time (its TURNING_STEP comment gives seeds 0–8).`, '');
   }
   const ok = (rows) => rows.every((p) => p.meanError <= T.meanError && p.maxError <= T.maxError && p.arcProgress >= T.arcProgress && p.realtime >= T.realtime);
   const skateRatio = mean(walk.map((p) => p.skatingBeforeLock)) / mean(walk.map((p) => p.freeSkating));

@@ -82,22 +82,30 @@ const LOW_FOOT_NONE = 0.06;
  * only) cannot do afterwards.
  */
 export function lowFootCost(info: GeneratorInfo, features: Float32Array, start: RootStart, sigma: number, previousPose: Float32Array | null = null): number {
-  const decoded = decodeFeatures(info, features, start);
+  const P = decodeFeatures(info, features, start).positions;
   const J = info.skeleton.joints.length;
   const frames = features.length / info.onnx.dim;
-  // The pose before the window (the last committed frame) links the window's first frame to what came before.
-  const pose = (f: number) => (f < 0 ? previousPose : decoded.positions.subarray(f * J * 3, (f + 1) * J * 3));
   let cost = 0;
-  for (const points of findLegs(info.skeleton.joints, 'the low-foot term').map(footPoints)) {
+  for (const points of lowFootPoints(info)) {
     for (let f = previousPose ? 0 : 1; f < frames; f++) {
-      const a = pose(f - 1)!, b = pose(f)!;
+      // Frame f − 1 from `previousPose` (the last committed frame) links the window to what came before.
+      const a = f > 0 ? P : previousPose!, aAt = f > 0 ? (f - 1) * J * 3 : 0, bAt = f * J * 3;
       let low = points[0];
-      for (const j of points) if (a[j * 3 + 1] < a[low * 3 + 1]) low = j;
-      const h = Math.max(a[low * 3 + 1], b[low * 3 + 1]);
+      for (const j of points) if (a[aAt + j * 3 + 1] < a[aAt + low * 3 + 1]) low = j;
+      const i = aAt + low * 3, k = bAt + low * 3;
+      const h = Math.max(a[i + 1], P[k + 1]);
       if (h >= LOW_FOOT_NONE) continue;
       const t = Math.min(Math.max((h - LOW_FOOT_FULL) / (LOW_FOOT_NONE - LOW_FOOT_FULL), 0), 1);
-      cost += (1 - t * t * (3 - 2 * t)) * ((b[low * 3] - a[low * 3]) ** 2 + (b[low * 3 + 2] - a[low * 3 + 2]) ** 2) / (sigma * sigma);
+      cost += ((1 - t * t * (3 - 2 * t)) * ((P[k] - a[i]) ** 2 + (P[k + 2] - a[i + 2]) ** 2)) / (sigma * sigma);
     }
   }
   return cost;
+}
+
+const footPointsOf = new WeakMap<GeneratorInfo, number[][]>();
+/** Each foot's points (ankle, toe, toe tip) of the generator's skeleton, found once per model. */
+function lowFootPoints(info: GeneratorInfo): number[][] {
+  let feet = footPointsOf.get(info);
+  if (!feet) footPointsOf.set(info, (feet = findLegs(info.skeleton.joints, 'the low-foot term').map(footPoints)));
+  return feet;
 }
