@@ -3,7 +3,9 @@
 // a row that scrolls, which lies inside it), none overlaps another control, a card or a readout, every control
 // scrolled into view is the one hit at its centre, and every mode button clicks. Touch works: a one-finger drag
 // orbits, a drag on the timeline scrubs, a drag on the ground draws a path, a drag on the stick steers. The
-// desktop layout (1280 × 800) passes the same checks. Screenshots go to test-results/layout-*.png.
+// desktop layout (1280 × 800) passes the same checks. On the phone the walking and the dancing figure stand
+// whole in the area the top bar, the cards and the panel leave free (the camera frames them there, issue 40).
+// Screenshots go to test-results/layout-*.png.
 import assert from 'node:assert/strict';
 import { mkdirSync } from 'node:fs';
 import path from 'node:path';
@@ -193,6 +195,67 @@ async function stillShot(page) {
   throw new assert.AssertionError({ message: 'paused, the picture never stood still' });
 }
 
+/**
+ * Where the paused figure stands on screen and where the overlays leave the stage free, in page pixels. The
+ * figure: the bounding box of the bright (mannequin) pixels of the stage drawn with the overlays hidden and
+ * the trail and footprints off. The free area: below the lowest top overlay (top bar, cards) over the figure's
+ * columns and above the control panel.
+ */
+async function figureAndFreeArea(page) {
+  await page.evaluate(() => {
+    window.playground.pause();
+    window.playground.setView({ trail: false, footprints: false });
+  });
+  const free = await page.evaluate(() => {
+    const boxes = (selector) => [...$uiAll(selector)].filter((el) => el.checkVisibility({ checkVisibilityCSS: true })).map((el) => el.getBoundingClientRect());
+    return { tops: boxes('.topbar *, .skate-card, .plot-card, .steer-card, .path-hint').map((r) => ({ left: r.left, right: r.right, bottom: r.bottom })), bottom: boxes('#controls')[0].top };
+  });
+  await page.evaluate(() => { $uiOne('.layout').style.visibility = 'hidden'; });
+  const png = await stillShot(page);
+  await page.evaluate(() => {
+    $uiOne('.layout').style.visibility = '';
+    window.playground.setView({ trail: true, footprints: true });
+  });
+  const stage = await page.locator('canvas.viewer-canvas').boundingBox();
+  const figure = await page.evaluate(async (b64) => {
+    const img = new Image();
+    img.src = `data:image/png;base64,${b64}`;
+    await img.decode();
+    const c = document.createElement('canvas');
+    c.width = img.width;
+    c.height = img.height;
+    const g = c.getContext('2d');
+    g.drawImage(img, 0, 0);
+    const { data } = g.getImageData(0, 0, c.width, c.height);
+    // The ground and sky are dark blue (channels under ~70); the mannequin's skin and grey parts are light.
+    let left = Infinity, right = -Infinity, top = Infinity, bottom = -Infinity, count = 0;
+    for (let y = 0; y < c.height; y++) {
+      for (let x = 0; x < c.width; x++) {
+        const i = (y * c.width + x) * 4;
+        if (0.3 * data[i] + 0.59 * data[i + 1] + 0.11 * data[i + 2] < 100) continue;
+        count++;
+        left = Math.min(left, x); right = Math.max(right, x); top = Math.min(top, y); bottom = Math.max(bottom, y);
+      }
+    }
+    return { left, right, top, bottom, count };
+  }, png.toString('base64'));
+  const box = { left: stage.x + figure.left, right: stage.x + figure.right, top: stage.y + figure.top, bottom: stage.y + figure.bottom, count: figure.count };
+  const over = free.tops.filter((r) => r.right > box.left && r.left < box.right);
+  return { figure: box, free: { top: Math.max(stage.y, ...over.map((r) => r.bottom)), bottom: free.bottom, left: stage.x, right: stage.x + stage.width } };
+}
+
+/** Asserts the figure stands whole inside the free area (head to feet clear of the cards and the panel). */
+async function checkFigureInFreeArea(page, what) {
+  const { figure, free } = await figureAndFreeArea(page);
+  const fmt = (r) => `x ${Math.round(r.left)}–${Math.round(r.right)}, y ${Math.round(r.top)}–${Math.round(r.bottom)}`;
+  assert.ok(figure.count > 500, `${what}: the figure is drawn (${figure.count} bright pixels)`);
+  assert.ok(
+    figure.top >= free.top && figure.bottom <= free.bottom && figure.left >= free.left && figure.right <= free.right,
+    `${what}: the figure (${fmt(figure)}) stands inside the area the overlays leave free (${fmt(free)})`,
+  );
+  assert.ok(figure.bottom - figure.top > 0.3 * (free.bottom - free.top), `${what}: the figure (${fmt(figure)}) is not lost in the distance (free ${fmt(free)})`);
+}
+
 describe('layout on a phone and in a small embed', { timeout: 900_000 }, () => {
   let server, url, browser;
   const problems = [];
@@ -271,10 +334,13 @@ describe('layout on a phone and in a small embed', { timeout: 900_000 }, () => {
       await waitUntil(page, () => Number($ui('walk-status').dataset.frame) > 10, null, { timeout: 60_000, message: 'the walk runs' });
       await shot(page, 'phone-walk');
       await checkLayout(page, 'phone, Random walk');
+      await checkFigureInFreeArea(page, 'phone, Random walk');
       await clickMode(page, 'dance');
       await waitUntil(page, () => Number($ui('dance-status').dataset.frame) > 10, null, { timeout: 60_000, message: 'the dance runs' });
       await shot(page, 'phone-dance');
       await checkLayout(page, 'phone, Dance');
+      await checkFigureInFreeArea(page, 'phone, Dance');
+      await page.evaluate(() => window.playground.play());
       assert.deepEqual(problems.splice(0), []);
     });
 

@@ -9,7 +9,7 @@ import type { RestPose } from '../motion/restPose';
 import { capMessage } from '../motion/text';
 import type { Motion } from '../motion/types';
 import type { PlaybackState } from '../viewer/playback';
-import { Viewer } from '../viewer/viewer';
+import { Viewer, type FreeArea } from '../viewer/viewer';
 import type { ModelInfo } from '../model/manifest';
 import type { ModelClientBase, ModelDescriptor } from '../runtime/descriptor';
 import { Registry } from '../runtime/registry';
@@ -97,6 +97,7 @@ export class App implements ModeHost {
     private readonly events: AppEvents,
   ) {
     this.viewer = new Viewer($('stage'));
+    this.viewer.setFreeAreaSource(freeAreaOf($('stage'), scope.root));
     this.panel = new Panel(this.viewer);
     this.toasts = new Toasts($('toasts'));
     this.characters = new CharacterInput(this.viewer);
@@ -476,4 +477,32 @@ export class App implements ModeHost {
       if (files.length) void this.handleFiles(files);
     });
   }
+}
+
+/** The overlays above the stage: those at its top (the top bar and what is in it, the cards) and the control panel below; not the Export menu, a popup. */
+const TOP_OVERLAYS = '.topbar *, .skate-card, .plot-card, .steer-card, .path-hint, .cleanup-card';
+const BOTTOM_OVERLAYS = '#controls';
+
+/**
+ * Where the overlays leave `stage` free, for the viewer's framings: below the lowest top overlay and above the
+ * highest bottom one among those over the stage's middle third (where a framed figure stands; a wide stage's
+ * cards sit beside it, a phone's span it).
+ */
+function freeAreaOf(stage: HTMLElement, root: ShadowRoot): () => FreeArea {
+  return () => {
+    const s = stage.getBoundingClientRect();
+    const midLeft = s.left + s.width / 3, midRight = s.right - s.width / 3;
+    const shown = (el: Element) => el.checkVisibility({ checkVisibilityCSS: true }) && el.getClientRects().length > 0;
+    const overMiddle = (r: DOMRect) => r.width > 0 && r.height > 0 && r.right > midLeft && r.left < midRight;
+    let top = 0, bottom = 0;
+    for (const el of root.querySelectorAll(TOP_OVERLAYS)) {
+      const r = el.getBoundingClientRect();
+      if (shown(el) && !el.closest('.export-menu') && overMiddle(r) && r.top < s.top + s.height / 2) top = Math.max(top, r.bottom - s.top);
+    }
+    for (const el of root.querySelectorAll(BOTTOM_OVERLAYS)) {
+      const r = el.getBoundingClientRect();
+      if (shown(el) && overMiddle(r) && r.bottom > s.top + s.height / 2) bottom = Math.max(bottom, s.bottom - r.top);
+    }
+    return { top, right: 0, bottom, left: 0 };
+  };
 }

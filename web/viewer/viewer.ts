@@ -18,6 +18,17 @@ import { chooseQuality, DynamicResolution, fixedResolution, probeGL, type GLInfo
 /** The ground, y = 0 (pointer picks land on it). */
 const GROUND_PLANE = new THREE.Plane(new THREE.Vector3(0, 1, 0), 0);
 
+/**
+ * The part of the stage the UI's overlays (top bar, cards, the control panel) leave free, as insets in CSS
+ * pixels from the stage's edges: framings keep the figure inside it.
+ */
+export interface FreeArea {
+  top: number;
+  right: number;
+  bottom: number;
+  left: number;
+}
+
 export interface ViewerLayers {
   follow: boolean;
   trail: boolean;
@@ -104,6 +115,10 @@ export class Viewer {
   private targetY = 0.9;
   private figureHeight = 1.7;
   private follow = true;
+  /** Where the UI's overlays leave the stage free (setFreeAreaSource), asked at each framing. */
+  private freeAreaSource: (() => FreeArea) | null = null;
+  /** The world points the last framing fitted into the free area (lowerView fits them again). */
+  private fitted: THREE.Vector3[] = [];
   /** Showing a live window of streamed frames (setLive) rather than a clip. */
   private live = false;
   private snap = true;
@@ -630,6 +645,7 @@ export class Viewer {
     this.camera.position.set(root.x + cx * dist, this.targetY + dist * 0.42, root.z + cz * dist);
     this.snap = true;
     this.controls.update();
+    this.fitFreeArea(this.figurePoints());
     this.dirty = true;
   }
 
@@ -666,6 +682,16 @@ export class Viewer {
     this.controls.target.copy(center).setY(this.targetY * 0.6);
     this.camera.position.copy(this.controls.target).addScaledVector(dir, dist);
     this.controls.update();
+    // The ground points and the root's track fitted (without the margin added above), a figure's height over each.
+    const track: THREE.Vector3[] = [];
+    const stride = Math.max(1, Math.floor(xz.length / 2 / 40));
+    for (let i = 0; i + 1 < xz.length; i += 2 * stride) track.push(new THREE.Vector3(xz[i], 0, xz[i + 1]));
+    if (m) {
+      const J = m.joints.length, every = Math.max(1, Math.floor(m.frames / 40));
+      for (let f = 0; f < m.frames; f += every) track.push(new THREE.Vector3(m.positions[(f * J + this.root) * 3], 0, m.positions[(f * J + this.root) * 3 + 2]));
+    }
+    for (const q of track.slice()) track.push(q.clone().setY(this.figureHeight));
+    this.fitFreeArea(track);
     this.dirty = true;
   }
 
@@ -712,7 +738,92 @@ export class Viewer {
     this.controls.target.y -= drop;
     this.camera.position.y -= drop;
     this.controls.update();
+    this.fitFreeArea(this.fitted);
     this.dirty = true;
+  }
+
+  /**
+   * Where the UI's overlays leave the stage free (null: all of it), asked at every framing: where the
+   * figure framed by `frameCharacter`, `frameGround` or `lowerView` would reach under an overlay (a
+   * phone's tall, narrow stage), the view backs off and its centre moves to the free area's centre.
+   */
+  setFreeAreaSource(source: (() => FreeArea) | null): void {
+    this.freeAreaSource = source;
+  }
+
+  /**
+   * After a framing: if `points` (world) do not all project inside the free area, moves the
+   * view's centre (the projection's principal point, kept while following and orbiting) to put their box at
+   * the free area's centre and backs the camera off from its target until the box fits with a margin. Points
+   * that already fit leave the framing as it is (a desktop's stage).
+   */
+  private fitFreeArea(points: THREE.Vector3[]): void {
+    this.fitted = points;
+    this.camera.clearViewOffset();
+    const w = this.container.clientWidth, h = this.container.clientHeight;
+    const area = this.freeAreaSource?.();
+    if (!area || !points.length || w < 2 || h < 2) return;
+    const free = { left: area.left, top: area.top, right: w - area.right, bottom: h - area.bottom };
+    const freeW = free.right - free.left, freeH = free.bottom - free.top;
+    if (freeW < 40 || freeH < 40) return; // no room worth fitting into: keep the plain framing
+    // Margins for what moves after the framing: a walk turning, a pair's spacing seen from another angle, a
+    // panel that grows a line once its stream runs.
+    const marginX = 0.1 * freeW, marginY = 0.08 * freeH;
+    const p = new THREE.Vector3();
+    const bounds = () => {
+      this.camera.updateMatrixWorld();
+      let x0 = Infinity, x1 = -Infinity, y0 = Infinity, y1 = -Infinity;
+      for (const q of points) {
+        p.copy(q).project(this.camera);
+        const x = ((p.x + 1) / 2) * w, y = ((1 - p.y) / 2) * h;
+        x0 = Math.min(x0, x); x1 = Math.max(x1, x); y0 = Math.min(y0, y); y1 = Math.max(y1, y);
+      }
+      return { x0, x1, y0, y1 };
+    };
+    const b = bounds();
+    // Inside the free area: left as framed. Otherwise fitted with a margin (so a small change doesn't refit).
+    if (b.x0 >= free.left && b.x1 <= free.right && b.y0 >= free.top && b.y1 <= free.bottom) return;
+    // Projected size goes nearly as 1 / distance and the view offset moves the picture by whole pixels:
+    // a few rounds settle both.
+    let offX = 0, offY = 0;
+    for (let round = 0; round < 6; round++) {
+      const { x0, x1, y0, y1 } = bounds();
+      if (!Number.isFinite(x0 + x1 + y0 + y1)) break;
+      const scale = Math.max((x1 - x0) / (freeW - 2 * marginX), (y1 - y0) / (freeH - 2 * marginY));
+      offX -= (free.left + free.right) / 2 - (x0 + x1) / 2;
+      offY -= (free.top + free.bottom) / 2 - (y0 + y1) / 2;
+      this.camera.setViewOffset(w, h, offX, offY, w, h);
+      if (scale > 1.001) {
+        const t = this.controls.target;
+        this.camera.position.sub(t).multiplyScalar(Math.min(scale, 4)).add(t);
+      } else if (Math.abs((free.top + free.bottom) / 2 - (y0 + y1) / 2) < 1) break;
+    }
+    this.controls.update();
+  }
+
+  /**
+   * Points that bound each shown figure from the playhead on: its joints, with its mesh's reach above and
+   * below them, and an upright cylinder around its root as tall as the figure stands, wide enough for its
+   * limbs as it turns and moves (a crouch in a dance rises again; the camera follows the root).
+   */
+  private figurePoints(): THREE.Vector3[] {
+    const out: THREE.Vector3[] = [];
+    if (!this.motion) return out;
+    const poses = this.companion ? [this.pose, this.companion.pose] : [this.pose];
+    const radius = 0.3 * this.figureHeight, top = this.figureHeight + 0.15;
+    for (const pose of poses) {
+      if (pose.length < 3) continue;
+      for (let k = 0; k + 2 < pose.length; k += 3) {
+        const [x, y, z] = [pose[k], pose[k + 1], pose[k + 2]];
+        out.push(new THREE.Vector3(x, y + 0.15, z), new THREE.Vector3(x, Math.max(0, y - 0.1), z));
+      }
+      const r = this.root * 3;
+      for (let i = 0; i < 8; i++) {
+        const x = pose[r] + radius * Math.cos((i * Math.PI) / 4), z = pose[r + 2] + radius * Math.sin((i * Math.PI) / 4);
+        out.push(new THREE.Vector3(x, 0, z), new THREE.Vector3(x, top, z));
+      }
+    }
+    return out;
   }
 
   /** Puts the camera `distance` metres behind a character facing `heading` (rad), turned `side` rad toward its side, `rise` up. */
