@@ -18,7 +18,7 @@ import { capMessage, quoteInput } from '../motion/text';
 import { prefetchRuntime } from '../runtime/worker/workerClient';
 import { DEFAULT_LOOK, type Look } from '../viewer/look';
 
-const OTHER_ATTRIBUTES = ['src', 'character', 'autoplay', 'camera-controls', 'controls', 'poster', 'loading', 'link'] as const;
+const OTHER_ATTRIBUTES = ['src', 'character', 'models', 'autoplay', 'camera-controls', 'controls', 'poster', 'loading', 'link'] as const;
 const CONTROLS = ['full', 'minimal', 'none'] as const;
 type Controls = (typeof CONTROLS)[number];
 const LOADING = ['eager', 'lazy'] as const;
@@ -142,6 +142,10 @@ export class MotionPlaygroundElement extends HTMLElement {
       else void this.loadCharacterAttribute();
       return;
     }
+    if (name === 'models') {
+      if (after !== null) void this.loadModelsAttribute();
+      return;
+    }
     if ((VIEW_KEYS as readonly string[]).includes(name) || name === 'dance-style') void this.api.ready.then(() => this.applyView(this.attributeView(), false));
   }
 
@@ -177,6 +181,7 @@ export class MotionPlaygroundElement extends HTMLElement {
     this.watchContext(app, signal);
     this.api = createPlayground(app);
     app.characters.allowedOrigins = () => allowedOrigins(this.getAttribute('allowed-origins'));
+    app.allowedOrigins = () => allowedOrigins(this.getAttribute('allowed-origins'));
     const version = this.shadow.getElementById('version');
     if (version) version.textContent = `v${this.api.version}`;
     app.viewer.controls.enabled = this.hasAttribute('camera-controls');
@@ -206,7 +211,7 @@ export class MotionPlaygroundElement extends HTMLElement {
         app.show(kept.motion, kept.name);
         if (!this.hasAttribute('autoplay')) app.viewer.pause();
       }
-      await Promise.all([this.hasAttribute('src') ? this.loadSource() : undefined, this.loadCharacterAttribute()]);
+      await Promise.all([this.hasAttribute('src') ? this.loadSource() : undefined, this.loadCharacterAttribute(), this.loadModelsAttribute()]);
       if (!signal.aborted) this.fire('load');
     });
   }
@@ -440,6 +445,24 @@ export class MotionPlaygroundElement extends HTMLElement {
       await app.loadCharacter(url);
     } catch (e) {
       if (this.app === app && !(e instanceof Error && e.name === 'SupersededError')) app.reportError(`${what}: ${errorMessage(e)}`);
+    }
+  }
+
+  /**
+   * Loads the model pack the `models` attribute names (the URL of its .json), else (with `link`) the URL's `models=`
+   * parameter, under the same rules as `src`. A refused pack fires `error`; the shipped models stay.
+   */
+  private async loadModelsAttribute(): Promise<void> {
+    const app = this.app;
+    if (!app) return;
+    const fromLink = this.hasAttribute('link') ? new URLSearchParams(location.search || location.hash.replace(/^#/, '')).get('models') : null;
+    const url = this.getAttribute('models') ?? fromLink;
+    if (!url) return;
+    try {
+      const id = await app.loadModels(url);
+      if (this.app === app) app.note(`Your model ${id} is loaded: choose it in Random walk, Path or Steer.`);
+    } catch (e) {
+      if (this.app === app) app.reportError(`${this.hasAttribute('models') ? 'models' : 'Link: models'}: ${errorMessage(e)}`);
     }
   }
 

@@ -193,6 +193,13 @@ export interface Playground {
    * (no skin, broken, over 32 MiB, not a humanoid), keeping the character and motion shown.
    */
   loadCharacter(source: CharacterSource, options?: LoadCharacterOptions): Promise<CharacterInfo>;
+  /**
+   * Loads a model pack written by `python -m training.own` (the URL of its .json under the `src` rules, its .onnx
+   * beside it; its files as File[], a folder's files or its .zip; or one .zip Blob) and lists it in the Random
+   * walk, Path and Steer pickers as the user's. Resolves to its model id (use it as `model` in generate,
+   * followPath, simulateControl); a broken or incompatible pack rejects with a short reason and changes nothing.
+   */
+  loadModels(source: string | readonly File[] | Blob): Promise<string>;
   /** The loaded character (as loadCharacter resolved), or null: the mannequin. */
   character(): CharacterInfo | null;
   /** Back to the project's mannequin. */
@@ -504,6 +511,9 @@ export function createPlayground(app: App): Playground {
         if (o.companion !== undefined && typeof o.companion !== 'boolean') throw new TypeError(`companion must be true or false, got ${describeValue(o.companion)}`);
         return app.loadCharacter(source, o.companion === true);
       });
+    },
+    loadModels(source) {
+      return guardedAsync('loadModels', () => app.loadModels(source));
     },
     character: () => app.characters.info,
     clearCharacter: () => app.clearCharacter(),

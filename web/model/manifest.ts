@@ -12,6 +12,10 @@ export interface ModelInfo {
   fps: number;
   styles?: string[];
   bytes: number;
+  /** A model not from the manifest (a user's pack, runtime/packs/): its files' URLs instead of models/<id>.*. */
+  files?: { model: string; info: string };
+  /** The pickers' label of such a model. */
+  label?: string;
 }
 
 export class ManifestError extends ModelInfoError {

@@ -144,8 +144,9 @@ export interface ModelDescriptor<C extends ModelClientBase = ModelClientBase> {
   };
 }
 
-/** A listed model's client options: its files, models/<id>.onnx and models/<id>.json beside the page, and its threads. */
+/** A listed model's client options: its files (models/<id>.onnx and models/<id>.json beside the page, or a pack's own), and its threads. */
 export function clientFiles(entry: ModelInfo, threads: number): ModelFileOptions {
+  if (entry.files) return { threads, modelUrl: entry.files.model, infoUrl: entry.files.info };
   return { threads, modelUrl: `models/${entry.id}.onnx`, infoUrl: `models/${entry.id}.json` };
 }
 

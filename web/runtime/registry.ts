@@ -44,6 +44,18 @@ export class Registry {
     });
   }
 
+  /** Adds a model not from the manifest (a user's pack), after the listed ones; false for a kind without a descriptor. */
+  add(info: ModelInfo, kinds: Map<string, ModelDescriptor> = shippedKinds()): boolean {
+    const descriptor = kinds.get(info.kind);
+    if (descriptor) this.models.push({ info, descriptor });
+    return descriptor !== undefined;
+  }
+
+  /** Every registered model's id. */
+  listedIds(): string[] {
+    return this.models.map((m) => m.info.id);
+  }
+
   /** The models that can do `capability`, in manifest order. */
   with(capability: Capability): RegisteredModel[] {
     return this.models.filter((m) => m.descriptor.capabilities.includes(capability));
@@ -77,6 +89,6 @@ export class Registry {
   /** The picker's label of model `id`. */
   label(id: string): string {
     const m = this.find(id);
-    return m?.descriptor.labels?.[id] ?? id;
+    return m?.info.label ?? m?.descriptor.labels?.[id] ?? id;
   }
 }

@@ -23,6 +23,8 @@ import { ExportMenu } from './exportMenu';
 import { BusyIndicator, ModelHost, pageThreads, withClient } from './modelHost';
 import { CleanupPanel } from './cleanupPanel';
 import { CHARACTER_FILE, CharacterInput } from './characterInput';
+import { droppedFolderFiles, loadPack, showCard, type PackSource } from './packInput';
+import { looksLikePack } from '../runtime/packs/pack';
 import { DanceMode } from './modes/danceMode';
 import type { ModeHost } from './modes/host';
 import type { LiveChunk, LiveMode } from './modes/liveMode';
@@ -85,6 +87,10 @@ export class App implements ModeHost {
   readonly cleanup: CleanupPanel;
   /** Called every rendered frame with the playback state (the element's play and pause events). */
   readonly frameListeners: ((s: PlaybackState) => void)[] = [];
+  /** The cards of the user's packs loaded so far, by model id. */
+  private readonly packCards = new Map<string, { text: string; thumbnail?: string }>();
+  /** Origins besides the page's own that URLs of packs may come from (the element's allowed-origins). */
+  allowedOrigins: () => readonly string[] = () => [];
   private mode: Mode = 'clip';
   /** The clip shown before another mode (Random walk, Dance, Path, Steer), restored when switching back. */
   private clip: { motion: Motion; name: string } | null = null;
@@ -150,9 +156,54 @@ export class App implements ModeHost {
   useModels(models: readonly ModelInfo[]): void {
     this.models = new Registry(models);
     this.controlModel.list(this.models);
+    this.walk.list(this.models);
     this.danceMode.list(this.models);
     this.pathMode.list(this.models);
     this.modelsArrived(this.models);
+  }
+
+  /**
+   * Loads a user's model pack (ui/packInput.ts) once the manifest is in, lists it in the pickers and resolves to its
+   * model id; a refused pack rejects with a short message and changes nothing.
+   */
+  async loadModels(source: PackSource): Promise<string> {
+    await this.modelsReady;
+    return loadPack(source, {
+      registryIds: () => this.models.listedIds(),
+      addModel: (info, card) => this.addModel(info, card),
+      pageHref: () => location.href,
+      allowedOrigins: () => this.allowedOrigins(),
+    });
+  }
+
+  private addModel(info: ModelInfo, card: { text: string; thumbnail?: string }): void {
+    this.models.add(info);
+    this.packCards.set(info.id, card);
+    const chosen = this.controlModel.value;
+    this.controlModel.list(this.models);
+    this.controlModel.set(chosen);
+    this.walk.list(this.models);
+    this.pathMode.list(this.models);
+    for (const select of [this.walk.model, $<HTMLSelectElement>('path-model'), $<HTMLSelectElement>('steer-model')]) this.cardButton(select);
+  }
+
+  /** A "card" button beside a picker, shown while it has a pack chosen: opens the pack's card. */
+  private cardButton(select: HTMLSelectElement): void {
+    if (select.nextElementSibling?.classList.contains('pack-card-btn')) return;
+    const button = document.createElement('button');
+    button.type = 'button';
+    button.className = 'pack-card-btn';
+    button.textContent = 'card';
+    button.title = "Your model's card: its data, training and measured numbers";
+    const show = () => (button.hidden = !this.packCards.has(select.value));
+    select.addEventListener('change', show);
+    this.controlModel.onChange(show);
+    button.addEventListener('click', () => {
+      const card = this.packCards.get(select.value);
+      if (card) showCard(this.scope.root, this.scope.frame, select.value, card);
+    });
+    select.after(button);
+    show();
   }
 
   /** Which models each mode shows (links and attributes are checked against it). */
@@ -446,6 +497,16 @@ export class App implements ModeHost {
     if (outcome.ignored.length) this.note(`Showing ${outcome.name}; ignored ${outcome.ignored.join(', ')}.`);
   }
 
+  /** A dropped pack: loaded and listed, or refused with its message. */
+  private async dropPack(files: File[]): Promise<void> {
+    try {
+      const id = await this.loadModels(files);
+      this.note(`Your model ${id} is loaded: choose it in Random walk, Path or Steer.`);
+    } catch (e) {
+      this.reportError(`Model pack: ${errorMessage(e)}`);
+    }
+  }
+
   private installDropZone(): void {
     // On the element's own area: several elements on a page each take the files dropped on them.
     const overlay = this.dropOverlay;
@@ -473,8 +534,13 @@ export class App implements ModeHost {
       e.preventDefault();
       depth = 0;
       overlay.classList.remove('visible');
+      const items = e.dataTransfer.items;
       const files = [...e.dataTransfer.files];
-      if (files.length) void this.handleFiles(files);
+      void droppedFolderFiles(items).then((walked) => {
+        const all = walked ?? files;
+        if (looksLikePack(all.map((f) => f.name))) void this.dropPack(all);
+        else if (files.length) void this.handleFiles(files);
+      });
     });
   }
 }

@@ -50,6 +50,7 @@ export class GeneratorClient extends ModelClient<StreamParams, InitResult, Gener
   /** Also the refiner's ONNX file (named in refiner.json beside the generator's JSON), for the first refined stream. */
   protected override prefetch(): void {
     super.prefetch();
+    if (!URL.canParse('refiner.json', this.urls.infoUrl)) return; // a pack's blob: URL has no refiner beside it
     const refinerInfo = new URL('refiner.json', this.urls.infoUrl).href;
     fetch(refinerInfo)
       .then((r) => (r.ok ? (r.json() as Promise<{ file?: unknown }>) : null))

@@ -7,7 +7,9 @@ import { lowFootSample } from '../../motion/footSkating';
 import type { Motion } from '../../motion/types';
 import { GeneratorClient, type GeneratedMotion } from '../../runtime/generator/generatorClient';
 import { CompanionAligner } from '../../viewer/sideBySide';
+import type { Registry } from '../../runtime/registry';
 import { $, changeTo, readSeed } from '../dom';
+import { fillSelect } from './modelChoice';
 import type { ModeHost } from './host';
 import { LiveMode, type LiveStream } from './liveMode';
 
@@ -37,6 +39,8 @@ export class RandomWalk extends LiveMode<WalkChunk> {
   private aligner: CompanionAligner | null = null;
   private walkSkeleton: { fps: number; joints: string[]; parents: number[] } | null = null;
 
+  /** The model that walks (the first listed that can, unless another is chosen). */
+  readonly model = $<HTMLSelectElement>('walk-model');
   private readonly temperature = $<HTMLInputElement>('walk-temperature');
   private readonly temperatureOut = $('walk-temperature-out');
   private readonly seedState = $<HTMLSelectElement>('walk-seed-state');
@@ -55,6 +59,12 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     this.temperature.addEventListener('input', () => this.showTemperature());
     this.temperature.addEventListener('change', () => this.restartIfActive());
     this.seedState.addEventListener('change', () => this.restartIfActive());
+    this.model.addEventListener('change', () => {
+      // Another model has other seed states.
+      this.seedState.replaceChildren(this.seedState.options[0]);
+      this.seedsListed = false;
+      this.restartIfActive();
+    });
     this.seed.addEventListener('change', () => this.restartIfActive());
     $('walk-restart').addEventListener('click', () => this.restartIfActive());
     this.refine.addEventListener('change', () => {
@@ -99,9 +109,15 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     return { seed, temperature, ...(idx === undefined ? {} : { seedIndex: idx }), refine: this.refine.checked };
   }
 
+  /** Lists the registry's walking models in the model picker. */
+  list(registry: Registry): void {
+    fillSelect(this.model, registry, registry.ids('walk'));
+  }
+
   protected async open(signal: AbortSignal): Promise<LiveStream<WalkChunk>> {
     // The first listed model that walks (the generator: a stream with the refiner behind it on request).
-    const walker = (await this.app.whenModels()).defaultFor('walk');
+    const registry = await this.app.whenModels();
+    const walker = (this.model.value && registry.can(this.model.value, 'walk') ? registry.find(this.model.value) : undefined) ?? registry.defaultFor('walk');
     if (!walker) throw new Error('no model for Random walk is listed in models/index.json');
     const id = walker.info.id;
     const { client } = await this.app.host(id).load();
