@@ -393,7 +393,9 @@ describe('your own character', { timeout: 600_000 }, () => {
         const { boundaryMax, elsewhereMax } = o[bone];
         assert.ok(boundaryMax <= elsewhereMax, `${name}, ${bone}: largest step at a chunk boundary ${(boundaryMax * 100).toFixed(1)} cm, elsewhere at most ${(elsewhereMax * 100).toFixed(1)} cm`);
       }
-      assert.ok(o.meanFromWhole < 0.1, `${name}: bones ${(o.meanFromWhole * 100).toFixed(1)} cm from one retargeting of the window on average`);
+      // The whole window's retargeting measures the source on its own 300 frames, the stream once on its first 5 s
+      // (measured: 4.6 cm on the walk, 9.3 cm on the salsa); a chunk retargeted alone ran off by metres.
+      assert.ok(o.meanFromWhole < 0.15, `${name}: bones ${(o.meanFromWhole * 100).toFixed(1)} cm from one retargeting of the window on average`);
     }
   });
 });

@@ -13,7 +13,7 @@ import { clone as cloneSkinned } from 'three/examples/jsm/utils/SkeletonUtils.js
 import { CANONICAL_JOINTS, CANONICAL_PARENTS, SkeletonMapError, type CanonicalJoint, type HumanoidMap } from '../motion/humanoid';
 import { mapSkeleton, toCanonical, type SkeletonMapping } from '../motion/skeletonMap';
 import type { Quat, Vec3 } from '../motion/math';
-import { mapRig, restPositions, retarget, type CharacterRig, type RetargetResult } from '../motion/retarget';
+import { mapRig, restPositions, retarget, type CharacterRig, type RetargetCalibration, type RetargetResult } from '../motion/retarget';
 import { quoteInput } from '../motion/text';
 import type { Motion } from '../motion/types';
 import { matcap } from './mannequin';
@@ -263,6 +263,8 @@ export class UserCharacterDriver implements CharacterView {
    * for the next ones: a second of a dance (arms over the head) may not map on its own.
    */
   private sourceMapping: SkeletonMapping | null = null;
+  /** The stream's calibration, once measured on CALIBRATION_FRAMES (undefined before: each chunk measures its own). */
+  private calibration: RetargetCalibration | undefined;
   private readonly point = new THREE.Vector3();
 
   /**
@@ -356,7 +358,11 @@ export class UserCharacterDriver implements CharacterView {
     try {
       if (dropped < 0) this.sourceMapping = isCanonical(motion) ? null : mapSkeleton(motion, 1);
       const canonical = (m: Motion) => this.canonicalOf(m);
-      this.result = dropped >= 0 ? extendLive(this.result!, old!, motion, dropped, this.asset.rig, canonical) : retarget(canonical(motion), this.asset.rig);
+      // A stream's chunks are retargeted with the numbers (retarget's calibration: scale, ankle and sole heights, foot
+      // slopes) measured once on CALIBRATION_FRAMES of it, so that they do not change from chunk to chunk.
+      const calibration = dropped >= 0 && this.result!.motion.frames >= CALIBRATION_FRAMES ? (this.calibration ??= this.result!.calibration) : undefined;
+      if (dropped < 0) this.calibration = undefined;
+      this.result = dropped >= 0 ? extendLive(this.result!, old!, motion, dropped, this.asset.rig, canonical, calibration) : retarget(canonical(motion), this.asset.rig);
     } catch {
       this.result = null;
       this.source = null;
@@ -450,6 +456,9 @@ function isCanonical(m: Motion): boolean {
   return m.joints.length === CANONICAL_JOINTS.length && m.joints.every((name, k) => name === CANONICAL_JOINTS[k]);
 }
 
+/** Frames of a live stream its calibration is measured on (the window's, when it first holds this many: 5 s). */
+const CALIBRATION_FRAMES = 150;
+
 /**
  * Frames before a live window's new ones that are retargeted with them (planted feet and their lock carry over, and
  * the part's own measures of the source settle). Measured on 600 frames of a generated walk and a salsa in chunks of
@@ -495,7 +504,7 @@ function liveOverlap(previous: Motion, next: Motion): number {
  * out over the new frames (time constant SHIFT_FADE_SECONDS), so that it does not add up chunk after chunk (the first
  * frames of a part carry their own offsets: aligned there, a dance sank 7 cm a chunk).
  */
-function extendLive(old: RetargetResult, previous: Motion, next: Motion, dropped: number, rig: CharacterRig, canonical: (m: Motion) => Motion): RetargetResult {
+function extendLive(old: RetargetResult, previous: Motion, next: Motion, dropped: number, rig: CharacterRig, canonical: (m: Motion) => Motion, calibration?: RetargetCalibration): RetargetResult {
   const kept = previous.frames - dropped;
   const fresh = next.frames - kept;
   const B = rig.bones.length;
@@ -521,7 +530,7 @@ function extendLive(old: RetargetResult, previous: Motion, next: Motion, dropped
     positions: next.positions.subarray(from * stride, next.frames * stride),
     contacts: next.contacts?.subarray(from * 2, next.frames * 2),
   };
-  const r = retarget(canonical(part), rig);
+  const r = retarget(canonical(part), rig, calibration ? { calibration } : {});
   // The shift (rig units) that puts the part's root on the earlier one at the context's last frame.
   const shift = [0, 0, 0];
   if (context > 0) for (let i = 0; i < 3; i++) shift[i] = out.rootTranslations[(kept - 1) * 3 + i] - r.rootTranslations[(context - 1) * 3 + i];
