@@ -240,9 +240,14 @@ function pathCost(r: RolloutResult, b: number, path: GroundPath, startArc: numbe
   return cost + (shortfall / PROGRESS_SIGMA) ** 2;
 }
 
-/** Seed states of a gait: those whose names start with it ("walk 02_01"). */
+/**
+ * Seed states of a gait: those whose names start with it ("walk 02_01"). A model whose seeds name no gait at all
+ * (a user's pack: its seeds are its own clips, named by file) starts every gait from any of them.
+ */
 export function gaitSeeds(info: GeneratorInfo, gait: Gait): number[] {
   const found = info.seeds.flatMap((s, i) => (s.name.startsWith(gait) ? [i] : []));
+  const namesGaits = info.seeds.some((s) => (Object.keys(GAITS) as string[]).some((g) => s.name.startsWith(g)));
+  if (!found.length && !namesGaits) return info.seeds.map((_, i) => i);
   if (!found.length) throw new Error(`the generator has no "${gait}" seed states (it has ${info.seeds.map((s) => s.name).join(', ')})`);
   return found;
 }
