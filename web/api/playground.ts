@@ -473,7 +473,7 @@ export function createPlayground(app: App): Playground {
   const api: Playground = {
     version: __APP_VERSION__,
     ready,
-    models: () => models.map((m) => ({ ...m, ...(m.styles ? { styles: [...m.styles] } : {}) })),
+    models: () => [...models, ...app.packModels().map(({ files: _blobs, ...pack }) => pack)].map((m) => ({ ...m, ...(m.styles ? { styles: [...m.styles] } : {}) })),
 
     importMotion(text, format, asfText, options) {
       return cancellable('importMotion', options, async (signal) => {
@@ -568,7 +568,7 @@ export function createPlayground(app: App): Playground {
     generate(options) {
       return cancellable('generate', options, async (signal) => {
         await ready;
-        const call = checkGenerate(options, models);
+        const call = checkGenerate(options, [...models, ...app.packModels()]);
         return app.withModel(call.model, (client, descriptor) => descriptor.generate!.run(client, call, { signal }));
       });
     },

@@ -176,6 +176,11 @@ export class App implements ModeHost {
     });
   }
 
+  /** The users' packs loaded so far, as manifest entries (after the manifest's own). */
+  packModels(): ModelInfo[] {
+    return [...this.packCards.keys()].flatMap((id) => this.models.find(id)?.info ?? []);
+  }
+
   private addModel(info: ModelInfo, card: { text: string; thumbnail?: string }): void {
     this.models.add(info);
     this.packCards.set(info.id, card);
@@ -184,7 +189,7 @@ export class App implements ModeHost {
     this.controlModel.set(chosen);
     this.walk.list(this.models);
     this.pathMode.list(this.models);
-    for (const select of [this.walk.model, $<HTMLSelectElement>('path-model'), $<HTMLSelectElement>('steer-model')]) this.cardButton(select);
+    for (const id of ['walk-model', 'path-model', 'steer-model']) this.cardButton(this.scope.root.getElementById(id) as HTMLSelectElement);
   }
 
   /** A "card" button beside a picker, shown while it has a pack chosen: opens the pack's card. */

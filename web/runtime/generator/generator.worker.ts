@@ -30,8 +30,10 @@ serveModel({
     return loadGeneratorInfo(url);
   },
   makeCore: (session, info, threads) => {
-    const refinerInfoUrl = new URL('refiner.json', generatorInfoUrl).href;
-    return new GeneratorCore(session, info, ort.Tensor, threads, { loadRefiner: (core) => loadRefiner(refinerInfoUrl, core.info, threads) });
+    // A user's pack (blob: URLs) has no refiner beside it: refine is refused when asked.
+    const refinerInfoUrl = URL.canParse('refiner.json', generatorInfoUrl) ? new URL('refiner.json', generatorInfoUrl).href : null;
+    const loadPackRefiner = () => Promise.reject(new Error("refine is not available for your own model (a pack has no refiner)"));
+    return new GeneratorCore(session, info, ort.Tensor, threads, { loadRefiner: (core) => (refinerInfoUrl ? loadRefiner(refinerInfoUrl, core.info, threads) : loadPackRefiner()) });
   },
   streamParams: (r: StreamParams): StreamParams => ({ seed: r.seed, temperature: r.temperature, seedIndex: r.seedIndex, ...(r.refine === undefined ? {} : { refine: r.refine }) }),
   requests: {
