@@ -124,10 +124,10 @@ class TrainingLoop:
     A checkpoint holds each part's state_dict under its name, the random generators, `iteration`, `best`,
     `elapsed` (seconds trained in all sessions), `meta` and what the recipe adds to it (`extra`)."""
 
-    def __init__(self, args: argparse.Namespace):
+    def __init__(self, args: argparse.Namespace, run: Run | None = None):
         self.args = args
         torch.set_num_threads(args.threads)
-        self.run = Run(args.run, args.checkpoint_minutes)
+        self.run = run or Run(args.run, args.checkpoint_minutes)  # `run`: another Run (own/distributed.py's followers)
         self.log = self.run.log
         self.best = float("inf")
         self.stopped = "iterations done"

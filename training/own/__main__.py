@@ -5,6 +5,8 @@ a model pack out (ONNX + JSON as the shipped models, card.md and its pose-change
 
 The folder is read and checked before training starts (training/own/dataset.py); the run keeps its log and
 checkpoints in runs/own-<id>/ (--run), resumes with --resume and stops cleanly on Ctrl-C, keeping the last checkpoint.
+The same command runs on several processes or machines under torchrun (python -m torch.distributed.run … -m
+training.own …); process 0 writes the run and the pack.
 docs/training.md, "Train on your own motion", has the whole story.
 """
 from __future__ import annotations
@@ -14,6 +16,7 @@ import time
 from pathlib import Path
 
 from .dataset import OwnCorpus, RefusedFolder, load_folder
+from .distributed import launched_rank
 from .options import add_own_arguments, min_clip_frames, pack_id, run_folder
 from .pack import export_pack, measure_pack, plot_pose_change, record_measures, write_card
 from .trainer import train_locomotion
@@ -28,19 +31,23 @@ def main(argv: list[str] | None = None) -> None:
         raise SystemExit("error: --kind dance is not built yet; --kind locomotion trains the generator")
     model_id = pack_id(args)
     args.run = run_folder(args, model_id)
+    lead = launched_rank() == 0  # under torchrun, only process 0 prints, writes and exports
+    say = print if lead else (lambda *_: None)
     t0 = time.perf_counter()
     try:
-        data = load_folder(args.data, min_clip_frames(args))
+        data = load_folder(args.data, min_clip_frames(args), log=say)
     except RefusedFolder as err:
         message = f"error: {err}"
         raise SystemExit(message if len(message) <= 300 else message[:299] + "…") from None
-    print(f"data: {data.minutes:.2f} minutes in {len(data.clips)} clips ({len(data.held_out)} held out), "
+    say(f"data: {data.minutes:.2f} minutes in {len(data.clips)} clips ({len(data.held_out)} held out), "
           f"read in {time.perf_counter() - t0:.0f} s")
     result = train_locomotion(OwnCorpus(data), args)
     if result.interrupted:
-        print(f"stopped by Ctrl-C after {result.iterations} iterations; the checkpoint is in {args.run}: "
+        say(f"stopped by Ctrl-C after {result.iterations} iterations; the checkpoint is in {args.run}: "
               "run the same command with --resume to go on")
         raise SystemExit(130)
+    if not lead:
+        return
     print(f"trained {result.minutes:.1f} minutes, {result.iterations} iterations ({result.stopped}); "
           f"held-out NLL {result.best_valid_nll:.3f} per frame; run in {args.run}")
     onnx_path, json_path, info = export_pack(Path(args.run) / "best.pt", data, model_id, args.out, args.weights)
