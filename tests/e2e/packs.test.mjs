@@ -13,6 +13,7 @@ import { installUiLookups, ROOT, sitePage, usePlayground, waitUntil } from './ha
 const PACK = path.join(ROOT, 'tests', 'fixtures', 'packs');
 const CORP = { 'Cross-Origin-Resource-Policy': 'same-origin' };
 const PACK_FILES = ['my-walks.json', 'my-walks.onnx', 'card.md', 'pose_change.png'];
+const CORNER = JSON.parse(readFileSync(path.join(ROOT, 'tests', 'fixtures', 'benchmark_paths.json'), 'utf8')).paths.corner.points;
 const packJson = () => JSON.parse(readFileSync(path.join(PACK, 'my-walks', 'my-walks.json'), 'utf8'));
 
 /** Files served under packs/: the fixture, and broken variants of it. */
@@ -70,7 +71,7 @@ describe('model packs', { timeout: 900_000 }, () => {
   const listed = (page, id) =>
     page.evaluate((id) => ['walk-model', 'path-model', 'steer-model'].map((s) => [...$ui(s).options].find((o) => o.value === id)?.textContent ?? null), id);
 
-  test('a dropped pack is listed in Random walk, Path and Steer, walks and follows a path; its card opens', async () => {
+  test('a dropped pack is listed in Random walk, Path and Steer, walks, follows a path and is steered; its card opens', async (t) => {
     const { page, problems } = await freshPage();
     try {
       await dropFetched(page, PACK_FILES.map((f) => `my-walks/${f}`));
@@ -114,13 +115,21 @@ describe('model packs', { timeout: 900_000 }, () => {
       assert.ok(card.plot > 100, 'the pose-change plot is shown');
       await page.evaluate(() => $uiOne('dialog.pack-card').close());
 
-      // A path followed by the MAP optimiser with the pack's model: finite, non-empty, along the path.
-      const r = await page.evaluate(async () => {
-        const m = await window.playground.followPath({ model: 'my-walks', points: [[0, 0], [0, 3], [2, 5]], gait: 'walk', seed: 1 });
+      // The benchmark 'corner' path followed by the MAP optimiser (Path mode's worker call) with the pack's model:
+      // finite, non-empty. A 30-iteration model need not follow it well: only that it runs is asserted.
+      const r = await page.evaluate(async (points) => {
+        const m = await window.playground.followPath({ model: 'my-walks', points, gait: 'walk', seed: 1 });
         return { frames: m.frames, finite: m.positions.every(Number.isFinite), stats: m.stats };
-      });
+      }, CORNER);
+      t.diagnostic(`corner path with the pack: ${r.frames} frames, mean error ${r.stats.meanError.toFixed(2)} m, ${(r.stats.arcProgress * 100).toFixed(0)} % of the path`);
       assert.ok(r.frames > 30 && r.finite, `frames ${r.frames}`);
       assert.ok(Number.isFinite(r.stats.meanError) && r.stats.arcProgress > 0, JSON.stringify(r.stats));
+      // Steer's live control (simulateControl runs the same controller) with the pack's model.
+      const steer = await page.evaluate(async () => {
+        const m = await window.playground.simulateControl({ model: 'my-walks', seconds: 2, schedule: [{ t: 0, speed: 1.2, heading: 0 }], seed: 1 });
+        return { frames: m.frames, finite: m.positions.every(Number.isFinite) };
+      });
+      assert.ok(steer.frames >= 50 && steer.finite, JSON.stringify(steer));
       assert.deepEqual(problems, []);
     } finally {
       await page.close();

@@ -83,7 +83,8 @@ export class Registry {
 
   /** How titles name model `id` (its descriptor's short name; the id itself if it is not registered). */
   shortName(id: string): string {
-    return this.find(id)?.descriptor.shortName ?? id;
+    const m = this.find(id);
+    return m?.info.label ? id : (m?.descriptor.shortName ?? id); // a user's pack by its own name
   }
 
   /** The picker's label of model `id`. */

@@ -475,6 +475,7 @@ export class App implements ModeHost {
    * together or the .asf first). Large ones show their progress; a failure leaves the scene as it was.
    */
   async handleFiles(files: File[]): Promise<void> {
+    if (looksLikePack(files.map((f) => f.name))) return this.dropPack(files); // a model pack (.zip, or .onnx with .json)
     const character = files.find((f) => CHARACTER_FILE.test(f.name));
     if (character) {
       try {
