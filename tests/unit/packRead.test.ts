@@ -1,0 +1,57 @@
+// Reading a model pack's files (web/runtime/packs/pack.ts) on the fixture pack (tests/fixtures/packs: a 30-iteration
+// `python -m training.own` run): the registry entry it makes, and its refusals (short, naming the problem).
+import { readFileSync, readdirSync } from 'node:fs';
+import path from 'node:path';
+import { describe, expect, it } from 'vitest';
+import { looksLikePack, packFiles, readPack, type PackFile } from '../../web/runtime/packs/pack';
+import { Registry } from '../../web/runtime/registry';
+
+const DIR = path.join(__dirname, '..', 'fixtures', 'packs');
+const folder = (): PackFile[] => readdirSync(path.join(DIR, 'my-walks')).map((name) => ({ name, bytes: new Uint8Array(readFileSync(path.join(DIR, 'my-walks', name))) }));
+const json = () => JSON.parse(new TextDecoder().decode(folder().find((f) => f.name === 'my-walks.json')!.bytes));
+const withJson = (raw: unknown): PackFile[] => folder().map((f) => (f.name === 'my-walks.json' ? { name: f.name, bytes: new TextEncoder().encode(JSON.stringify(raw)) } : f));
+
+describe('readPack', () => {
+  it("makes a registry entry of the generator's kind, labelled as the user's, that can walk and follow paths", async () => {
+    const fromFolder = readPack(folder(), ['generator']);
+    const fromZip = readPack(await packFiles([{ name: 'my-walks.zip', bytes: new Uint8Array(readFileSync(path.join(DIR, 'my-walks.zip'))) }]), []);
+    for (const pack of [fromFolder, fromZip]) {
+      expect(pack.info).toMatchObject({ id: 'my-walks', fps: 30, label: 'my-walks (your model)' });
+      expect(pack.info.files?.model).toMatch(/^blob:/);
+      expect(pack.card.text).toMatch(/^# my-walks/);
+      expect(pack.card.thumbnail).toMatch(/^blob:/);
+    }
+    const registry = new Registry([]);
+    expect(registry.add(fromFolder.info)).toBe(true);
+    expect(registry.ids('walk')).toEqual(['my-walks']);
+    expect(registry.can('my-walks', 'followPath') && registry.can('my-walks', 'liveControl')).toBe(true);
+    expect(registry.label('my-walks')).toBe('my-walks (your model)');
+    expect(registry.shortName('my-walks')).toBe('my-walks');
+    expect(looksLikePack(['my-walks.onnx', 'my-walks.json'])).toBe(true);
+    expect(looksLikePack(['walk.bvh'])).toBe(false);
+  });
+
+  it('refuses a broken or incompatible pack with a short message', () => {
+    const refusal = (files: PackFile[], taken: string[] = []) => {
+      try {
+        readPack(files, taken);
+        return null;
+      } catch (e) {
+        return (e as Error).message;
+      }
+    };
+    const messages = [
+      [refusal(folder(), ['my-walks']), /a model "my-walks" is already listed/],
+      [refusal(folder().filter((f) => !f.name.endsWith('.onnx'))), /the pack has no my-walks\.onnx/],
+      [refusal(folder().filter((f) => !f.name.endsWith('.json'))), /no model JSON in the pack/],
+      [refusal(withJson({ ...json(), kind: 'aclstm' })), /kind must be "lstm-gmm"/],
+      [refusal(withJson({ ...json(), seeds: [] })), /seeds must be a non-empty array/],
+      [refusal(withJson({ ...json(), id: '../../etc' })), /id must be a short name/],
+      [refusal([{ name: 'my-walks.json', bytes: new TextEncoder().encode('{ "id": ') }]), /my-walks\.json is not valid JSON/],
+    ] as const;
+    for (const [message, expected] of messages) {
+      expect(message).toMatch(expected);
+      expect(message!.length).toBeLessThanOrEqual(300);
+    }
+  });
+});
