@@ -36,8 +36,12 @@ def train(command: list[str]) -> subprocess.CompletedProcess:
     return done
 
 
-def final_weights(run):
-    return torch.load(run / "checkpoint.pt", weights_only=False)["model"]
+def final_weights(run) -> dict:
+    """The model's weights at the end, and RMSProp's running mean of squared gradients: RMSProp's steps hardly change
+    when every gradient is scaled alike, so the weights alone would not show gradients averaged with a wrong factor."""
+    state = torch.load(run / "checkpoint.pt", weights_only=False)
+    squares = {f"square_avg {i}": s["square_avg"] for i, s in state["optimiser"]["state"].items()}
+    return {**state["model"], **squares}
 
 
 def assert_same_weights(a, b):
