@@ -124,6 +124,18 @@ describe('model packs', { timeout: 900_000 }, () => {
       t.diagnostic(`corner path with the pack: ${r.frames} frames, mean error ${r.stats.meanError.toFixed(2)} m, ${(r.stats.arcProgress * 100).toFixed(0)} % of the path`);
       assert.ok(r.frames > 30 && r.finite, `frames ${r.frames}`);
       assert.ok(Number.isFinite(r.stats.meanError) && r.stats.arcProgress > 0, JSON.stringify(r.stats));
+      // Path mode itself walks the same path with the pack's model (the page's element given model, path and mode).
+      await page.evaluate((points) => {
+        const el = document.querySelector('motion-playground');
+        el.setAttribute('model', 'my-walks');
+        el.setAttribute('path', points.map((p) => p.join(',')).join(';'));
+        el.setAttribute('mode', 'path');
+      }, CORNER);
+      const line = await waitUntil(page, () => $uiOne('.path-stats')?.textContent, null, { timeout: 90_000, message: 'Path mode walks the path with the pack' });
+      t.diagnostic(`Path mode: ${line}`);
+      assert.match(line, /^my-walks: error mean [\d.]+ cm/);
+      const shown = await page.evaluate(() => ({ frames: window.playground.current()?.frames ?? 0, finite: window.playground.current()?.positions.every(Number.isFinite) }));
+      assert.ok(shown.frames > 30 && shown.finite, JSON.stringify(shown));
       // Steer's live control (simulateControl runs the same controller) with the pack's model.
       const steer = await page.evaluate(async () => {
         const m = await window.playground.simulateControl({ model: 'my-walks', seconds: 2, schedule: [{ t: 0, speed: 1.2, heading: 0 }], seed: 1 });
