@@ -56,9 +56,11 @@ describe('followPath on the back-and-forth path', () => {
   });
   afterAll(() => core?.release());
 
-  it('walks ≥ 95% of its length within 0.15 m of it', async () => {
+  // Seed 3 fell into a shuffle at 0.1–0.2 m/s after the second tip and ran out of time at 62% followed, until
+  // the follower learnt to escape shuffles (pathFollower.ts STALL_WINDOWS).
+  it.each([0, 3])('walks ≥ 95% of its length within 0.15 m of it (seed %i)', async (seed) => {
     const step = (b: number, x: Float32Array, h: Float32Array, c: Float32Array) => core.step(b, x, h, c);
-    const r = await followPath({ step, info, mean: core.mean, std: core.std, path: GroundPath.fromPoints(BACK_AND_FORTH), gait: 'walk', seed: 0 });
+    const r = await followPath({ step, info, mean: core.mean, std: core.std, path: GroundPath.fromPoints(BACK_AND_FORTH), gait: 'walk', seed });
     const coverage = pathCoverage(BACK_AND_FORTH, rootGroundTrack(r.positions, info.skeleton.joints.length, r.frames));
     expect(coverage).toBeGreaterThanOrEqual(0.95);
     expect(r.stats.arcProgress).toBeGreaterThan(0.95);

@@ -40,12 +40,28 @@ const BACK_COST = 0.1;
  * backwards. From 90° to 150° off (smoothly) the step shrinks to TURNING_STEP of the pace and turns from toward
  * the target to 45° off the facing, on the side of the turn: the walker turns round on a small loop while still
  * stepping. Asked to stop and turn on the spot (no step), the generator often kept shuffling at 0.1–0.15 m/s for
- * many seconds after. It still does at times: on the back-and-forth path, seeds 0–8 (Node), 6 of 9 walks follow
- * ≥ 95% of it (96.8–100%); 3 (seeds 3, 4, 6) shuffle at 0.1–0.2 m/s after a turn and run out of time at 62–74%.
+ * many seconds after. With this loop alone it still did at times (back-and-forth path, seeds 3, 4, 6 in Node
+ * shuffled at 0.1–0.2 m/s after a turn and ran out of time at 62–74% followed); see STALL_WINDOWS for the rest.
+ * A faster loop (0.9 of the pace) did not cure it: 58.8, 61.9, 80.6% for those seeds.
  */
 const TURN_FROM = Math.PI / 2;
 const TURN_FULL_AT = (5 * Math.PI) / 6;
 const TURNING_STEP = 0.6;
+/**
+ * Escaping a shuffle. After turning round the generator at times falls into a shuffle at 0.1–0.2 m/s that the
+ * search cannot leave: the model is so sure of a shuffle's small steps that its prior NLL is ~1000 lower over a
+ * window than a walk's, more than the progress term's whole range, and with full-size input noise no particle
+ * walks off (more particles or rounds made it worse: 52–58% followed; a higher temperature did not help). After
+ * STALL_WINDOWS committed windows each under STALL_SHARE of the pace, the next windows (until one is not slow)
+ * draw input noise STALL_NOISE_SCALE× the size, which moves the network's input off the shuffle, and weigh the
+ * prior by STALL_PRIOR_WEIGHT. Back-and-forth path, seeds 0–8 in Node: 96.9–100% followed (seeds 3, 4, 6 were
+ * at 62.1, 73.7, 69.0%). Turning round at a tip is slow too: from the first slow window on, the extra noise threw
+ * the walker off the way back (seeds 5 and 8: 91.8, 93.2%), hence two windows.
+ */
+const STALL_SHARE = 0.5;
+const STALL_WINDOWS = 2;
+const STALL_NOISE_SCALE = 3;
+const STALL_PRIOR_WEIGHT = 0.5;
 /** Progress shortfall of 10 cm over a window costs 1. */
 const PROGRESS_SIGMA = 0.05;
 /**
@@ -273,9 +289,13 @@ export async function followPath(o: FollowPathOptions): Promise<FollowPathResult
   let frames = 0, arc = 0, windows = 0, particleSteps = 0;
   let toes: ToeState | null = null;
 
+  // Committed windows in a row that fell under STALL_SHARE of the pace.
+  let slowWindows = 0;
   while (frames < maxFrames) {
+    const stalled = slowWindows >= STALL_WINDOWS;
+    const priorWeight = stalled ? STALL_PRIOR_WEIGHT : 1;
     const best = await crossEntropySearch({
-      rollout: { step: o.step, info, mean: o.mean, std: o.std, start: state, temperature, commit: COMMIT_FRAMES, noiseCorrelation: noiseCorrelation(info) },
+      rollout: { step: o.step, info, mean: o.mean, std: o.std, start: state, temperature, noiseScale: stalled ? STALL_NOISE_SCALE : 1, commit: COMMIT_FRAMES, noiseCorrelation: noiseCorrelation(info) },
       particles: P,
       frames: WINDOW_FRAMES,
       rounds,
@@ -286,13 +306,14 @@ export async function followPath(o: FollowPathOptions): Promise<FollowPathResult
       jitterKnobs: (k, round, r) => jitterKnobs(k, pathJitterScale(round), r, gait),
       steering: (knobs) => new PathSteering(path, knobs, arc, fps),
       cost: (result, b) =>
-        result.priorCost[b] + result.noiseCost[b] + pathCost(result, b, path, arc, fitSigma, GAITS[gait].pace, fps) + contactCost(info, particleFeatures(result, b), state.root, toes),
+        priorWeight * result.priorCost[b] + result.noiseCost[b] + pathCost(result, b, path, arc, fitSigma, GAITS[gait].pace, fps) + contactCost(info, particleFeatures(result, b), state.root, toes),
     });
     particleSteps += best.particleSteps;
     windows++;
 
     const { result, particle: b } = best;
     const end = framesToKeep(path, result, b, arc);
+    slowWindows = end.arc - arc < (STALL_SHARE * GAITS[gait].pace * COMMIT_FRAMES) / fps ? slowWindows + 1 : 0;
     arc = end.arc;
     const chunk = particleFeatures(result, b, end.keep);
     kept.push(chunk.slice());
