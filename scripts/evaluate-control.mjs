@@ -171,7 +171,7 @@ function markdown(r) {
   lines.push(...table(walk, true), '');
   const doubling = walk.filter((p) => p.path === DOUBLING_BACK);
   if (doubling.length) {
-    lines.push(`The back-and-forth path, walking: followed ${doubling.map((p) => fmt(p.coverage * 100, 1) + '%').join(', ')} of its length within ${T.coverageTolerance} m (target ≥ ${T.coverage * 100}% in every run): ${pass(doubling.every((p) => p.coverage >= T.coverage))}. The follower walks to each reversal's tip, turns round on a small loop and walks back (\`web/optimizer/pathFollower.ts\`: CUSP_REACH, TURNING_STEP); with other seeds the generator at times shuffles on slowly after a turn and the walk runs out of time (its TURNING_STEP comment gives seeds 0–8).`, '');
+    lines.push(`The back-and-forth path, walking: followed ${doubling.map((p) => fmt(p.coverage * 100, 1) + '%').join(', ')} of its length within ${T.coverageTolerance} m (target ≥ ${T.coverage * 100}% in every run): ${pass(doubling.every((p) => p.coverage >= T.coverage))}. The follower walks to each reversal's tip, turns round on a small loop and walks back (\`web/optimizer/pathFollower.ts\`: CUSP_REACH, TURNING_STEP); when a walk falls into a slow shuffle after a turn (two windows in a row under half the pace) its next windows search with more noise and half the prior's weight until it walks on (STALL_WINDOWS; measured in Node over seeds 0–8: 96.9–100% followed, the TURNING_STEP comment).`, '');
   }
   const ok = (rows) => rows.every((p) => p.meanError <= T.meanError && p.maxError <= T.maxError && p.arcProgress >= T.arcProgress && p.realtime >= T.realtime);
   const skateRatio = mean(walk.map((p) => p.skatingBeforeLock)) / mean(walk.map((p) => p.freeSkating));
@@ -205,7 +205,7 @@ function markdown(r) {
   lines.push('');
   const steerTurn = r.control.filter((c) => c.scenario === STEER_TURN);
   if (steerTurn.length) {
-    lines.push(`- Sliding on \`${STEER_TURN}\` (1.2 m/s, 90° at 3 s) by the lowest foot point: ${steerTurn.map((c) => fmt(c.sliding, 3)).join(', ')} m/s (target ≤ ${T.turnSliding} in every run): ${pass(steerTurn.every((c) => c.sliding <= T.turnSliding))}. Most of what remains is mid-swing, a swing foot's toe tip passing under 4 cm at 2–4 m/s, not planted feet; the live objective ranks particles by it (\`web/optimizer/objective.ts\` lowFootCost).`);
+    lines.push(`- Sliding on \`${STEER_TURN}\` (1.2 m/s, 90° at 3 s) by the lowest foot point: ${steerTurn.map((c) => fmt(c.sliding, 3)).join(', ')} m/s (target ≤ ${T.turnSliding} in every run): ${pass(steerTurn.every((c) => c.sliding <= T.turnSliding))}. Most of what remains is mid-swing, a swing foot's toe tip passing under 4 cm at 2–4 m/s, not planted feet; the live objective ranks particles by it (\`web/optimizer/objective.ts\` lowFootCost). Beyond the report's seeds, in Node: seeds 3–5 slide 0.124, 0.240, 0.068 m/s (six seeds 0.112 on average); seed 4's seed state slides 0.17–0.37 m/s in every second under live control, before the turn too.`);
   }
   const heads = r.control.filter((c) => c.kind === 'heading');
   const walkSpeeds = r.control.filter((c) => c.kind === 'speed' && !c.scenario.startsWith('run'));
