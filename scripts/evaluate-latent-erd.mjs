@@ -171,7 +171,8 @@ function summarise(r) {
     skating: mean(g.map((p) => p.skating)),
     freeSkating: mean(g.map((p) => p.freeSkating)),
   }));
-  const walk = r.paths.filter((p) => p.gait === 'walk');
+  // The five benchmark paths of the targets (arc progress does not measure the back-and-forth path, which doubles back).
+  const walk = r.paths.filter((p) => p.gait === 'walk' && p.path !== 'back-and-forth');
   const scenarios = Object.keys(SCENARIOS).map((name) => {
     const g = r.control.filter((c) => c.scenario === name);
     return {

@@ -179,7 +179,9 @@ def target_rows(r: dict) -> list[tuple[str, str, bool]]:
     out = []
     b = r.get("browser")
     if b:
-        walk = [p for p in b["paths"] if p["gait"] == "walk"]
+        # The five benchmark paths of the target; the back-and-forth path (issue 43) came later, and arc progress
+        # does not measure a path that doubles back (the VAE-LSTM report measures it by coverage).
+        walk = [p for p in b["paths"] if p["gait"] == "walk" and p["path"] != "back-and-forth"]
         worst_mean = max(_mean([q["meanError"] for q in walk if q["path"] == name]) for name in {p["path"] for p in walk})
         least_progress, least_rt = min(p["arcProgress"] for p in walk), min(p["realtime"] for p in walk)
         out.append(("five benchmark paths (walk) in Chromium: mean error ≤ 0.15 m, progress ≥ 95%, ≥ 20× real time",
