@@ -584,7 +584,7 @@ def map_humanoid(joints: Sequence[str], parents: Sequence[int], positions: np.nd
         raise _refuse("its joints all lie at one height, so no legs can be told")
     names = joints
     hints = _Hints(names)
-    hint, named = hints.hint, hints.named
+    named = hints.named
     # Extremities are leaves of the main tree (the one with the most bone length: a prop beside the figure is not a
     # foot), neither helpers themselves (a twist bone's end) nor below an IK bone (an IK hand sits where the hand is;
     # a helper inside a limb, such as an inline twist bone, leaves the limb's end an extremity).

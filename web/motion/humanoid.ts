@@ -549,7 +549,7 @@ export function mapHumanoid(sk: PosedSkeleton): HumanoidMap {
   if (!(t.height > 0)) refuse('its joints all lie at one height, so no legs can be told');
   const names = sk.joints;
   const hints = hintsFor(names);
-  const { hint, named, scheme } = hints;
+  const { named, scheme } = hints;
   // Extremities are leaves of the main tree (the one with the most bone length: a prop beside the figure is not a
   // foot), neither helpers themselves (a twist bone's end) nor below an IK bone (an IK hand sits where the hand is;
   // a helper inside a limb, such as an inline twist bone, leaves the limb's end an extremity).

@@ -49,7 +49,7 @@ export interface RetargetOptions {
   /** keep planted feet planted with two-bone IK on the character's legs (default true) */
   footIK?: boolean;
   /**
-   * Added: the numbers a retarget measured on a source (RetargetResult.calibration), to use instead of measuring them
+   * The numbers a retarget measured on a source (RetargetResult.calibration), to use instead of measuring them
    * on this motion: for a live stream retargeted window by window, so that the scale, the hips' height and the feet's
    * slope do not change from one window to the next.
    */
@@ -75,7 +75,7 @@ export interface RetargetResult {
   rotations: Float32Array;
   /** frames × 3: the root bone's local translation per frame (in the rig's units). */
   rootTranslations: Float32Array;
-  /** Added: the bone `rootTranslations` moves: the root the hips hang from (bone 0 in most rigs); other roots keep their rest. */
+  /** The bone `rootTranslations` moves: the root the hips hang from (bone 0 in most rigs); other roots keep their rest. */
   rootBone: number;
   /** The rig's humanoid map used (canonical point -> bone), and what canonical points the rig lacks (derived). */
   mapping: HumanoidMap;
@@ -83,11 +83,11 @@ export interface RetargetResult {
   scale: number;
   /** Units of the rig per metre (e.g. 100 for a centimetre rig, 1 for metres), as detected from its height. */
   unitsPerMetre: number;
-  /** Added: the rig's rest pose as canonical points (25 × 3, metres, CANONICAL_JOINTS order; derived points placed). */
+  /** The rig's rest pose as canonical points (25 × 3, metres, CANONICAL_JOINTS order; derived points placed). */
   restCanonical: Float32Array;
-  /** Added: the source's foot contacts used for the foot IK (frames × 2, left, right; 1 = planted). */
+  /** The source's foot contacts used for the foot IK (frames × 2, left, right; 1 = planted). */
   contacts: Uint8Array;
-  /** Added: the numbers measured on the source (or given in options.calibration) that set this retargeting. */
+  /** The numbers measured on the source (or given in options.calibration) that set this retargeting. */
   calibration: RetargetCalibration;
 }
 
