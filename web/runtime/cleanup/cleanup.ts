@@ -294,6 +294,48 @@ export async function cleanUpOnCanonical(
   clean: (input: CanonicalInput) => Promise<CanonicalCleaned>,
   signal?: AbortSignal,
 ): Promise<CleanupResult> {
+  // Reference frames before the capture (CMU BVH 07_12 and 09_10 start with the rest pose at the origin, metres
+  // from where the capture begins) are kept as they are: cleaning smoothed the jump into the capture's first seconds.
+  const start = referenceFramesBefore(motion);
+  if (start === 0) return cleanCapture(info, motion, method, clean, signal);
+  const J = motion.joints.length;
+  const rest = { ...motion, frames: motion.frames - start, positions: motion.positions.slice(start * J * 3), contacts: undefined };
+  const cleaned = await cleanCapture(info, rest, method, clean, signal);
+  const positions = new Float32Array(motion.positions.length);
+  positions.set(motion.positions.subarray(0, start * J * 3));
+  positions.set(cleaned.motion.positions, start * J * 3);
+  const contacts = new Uint8Array(motion.frames * 2);
+  contacts.set(cleaned.motion.contacts, start * 2);
+  return { motion: { ...cleaned.motion, frames: motion.frames, positions, contacts }, stats: cleaned.stats };
+}
+
+/** A root jump this long (m) between two frames is not motion: a reference frame before the capture. */
+const REFERENCE_JUMP = 0.5;
+/** Reference frames are looked for among the first this many frames. */
+const MAX_REFERENCE_FRAMES = 10;
+
+/**
+ * How many frames at the start of `motion` are reference frames: the frame the root jumps into by more than
+ * REFERENCE_JUMP within the first MAX_REFERENCE_FRAMES (and the first half of the motion); else 0.
+ */
+export function referenceFramesBefore(motion: Motion): number {
+  const J = motion.joints.length;
+  const P = motion.positions;
+  const last = Math.min(MAX_REFERENCE_FRAMES, Math.floor(motion.frames / 2));
+  for (let f = 1; f <= last; f++) {
+    const a = (f - 1) * J * 3, b = f * J * 3;
+    if (Math.hypot(P[b] - P[a], P[b + 1] - P[a + 1], P[b + 2] - P[a + 2]) > REFERENCE_JUMP) return f;
+  }
+  return 0;
+}
+
+async function cleanCapture(
+  info: GeneratorInfo,
+  motion: Motion,
+  method: CleanupMethod,
+  clean: (input: CanonicalInput) => Promise<CanonicalCleaned>,
+  signal?: AbortSignal,
+): Promise<CleanupResult> {
   const began = performance.now();
   await pause(signal);
   const mapping = mapSkeleton(motion, legLength(info));
