@@ -1,7 +1,8 @@
 // A user's model pack (python -m training.own … --out OUT; tests/fixtures/packs/my-walks is a 30-iteration run on
-// three CMU clips) loaded by the page: dropped as its files, as a folder (the drop's entries walked) and as its
+// three CMU clips, my-dance a 30-iteration --kind dance run on three acLSTM salsa files) loaded by the page: dropped as its files, as a folder (the drop's entries walked) and as its
 // .zip, from the element's `models` attribute, from the page's `?models=` parameter and playground.loadModels. Its
-// model is listed in the Random walk, Path and Steer pickers as the user's, streams a random walk and follows a path;
+// model is listed in the Random walk, Path and Steer pickers as the user's, streams a random walk and follows a path
+// (a dance pack: in the Dance picker, dancing its style);
 // broken packs (bad JSON, an ONNX of another shape, a missing file, too large) are refused with a short message
 // and the shipped models keep working. Run with `node --test tests/e2e/packs.test.mjs`.
 import assert from 'node:assert/strict';
@@ -13,6 +14,7 @@ import { installUiLookups, ROOT, sitePage, usePlayground, waitUntil } from './ha
 const PACK = path.join(ROOT, 'tests', 'fixtures', 'packs');
 const CORP = { 'Cross-Origin-Resource-Policy': 'same-origin' };
 const PACK_FILES = ['my-walks.json', 'my-walks.onnx', 'card.md', 'pose_change.png'];
+const DANCE_FILES = ['my-dance.json', 'my-dance.onnx', 'card.md', 'pose_change.png'];
 const CORNER = JSON.parse(readFileSync(path.join(ROOT, 'tests', 'fixtures', 'benchmark_paths.json'), 'utf8')).paths.corner.points;
 const packJson = () => JSON.parse(readFileSync(path.join(PACK, 'my-walks', 'my-walks.json'), 'utf8'));
 
@@ -20,6 +22,7 @@ const packJson = () => JSON.parse(readFileSync(path.join(PACK, 'my-walks', 'my-w
 function servedFiles() {
   const files = new Map(PACK_FILES.map((f) => [`my-walks/${f}`, readFileSync(path.join(PACK, 'my-walks', f))]));
   files.set('my-walks.zip', readFileSync(path.join(PACK, 'my-walks.zip')));
+  for (const f of DANCE_FILES) files.set(`my-dance/${f}`, readFileSync(path.join(PACK, 'my-dance', f)));
   // An ONNX of another shape: the shipped generator's network under the pack's JSON (other hidden size).
   const wrong = { ...packJson(), id: 'wrong-shape' };
   files.set('wrong/wrong-shape.json', Buffer.from(JSON.stringify(wrong)));
@@ -142,6 +145,46 @@ describe('model packs', { timeout: 900_000 }, () => {
         return { frames: m.frames, finite: m.positions.every(Number.isFinite) };
       });
       assert.ok(steer.frames >= 50 && steer.finite, JSON.stringify(steer));
+      assert.deepEqual(problems, []);
+    } finally {
+      await page.close();
+    }
+  });
+
+  test('a dropped dance pack is listed in Dance only, dances its style in Dance mode and in generate; its card opens', async () => {
+    const { page, problems } = await freshPage();
+    try {
+      await dropFetched(page, DANCE_FILES.map((f) => `my-dance/${f}`));
+      await waitUntil(page, () => [...$ui('dance-model').options].some((o) => o.value === 'my-dance'), null, { timeout: 60_000, message: 'the dropped dance pack is listed' });
+      assert.deepEqual(await listed(page, 'my-dance'), [null, null, null], 'not in Random walk, Path or Steer');
+      assert.match(await page.evaluate(() => [...$uiAll('.toast')].map((t) => t.textContent).join(' | ')), /Your model my-dance is loaded: choose it in Dance\./);
+      await page.evaluate(() => {
+        $ui('dance-model').value = 'my-dance';
+        $ui('dance-model').dispatchEvent(new Event('change'));
+        $ui('mode-dance').click();
+      });
+      const dance = await waitUntil(page, () => {
+        const m = window.playground.current();
+        return m && m.frames >= 60 && $ui('dance-style').value === 'salsa' ? { frames: m.frames, joints: m.joints.length, finite: m.positions.every(Number.isFinite), styles: [...$ui('dance-style').options].map((o) => o.value) } : null;
+      }, null, { timeout: 120_000, message: 'the dance pack dances in Dance mode' });
+      assert.deepEqual(dance.styles, ['salsa']);
+      assert.ok(dance.finite && dance.joints === 25, JSON.stringify(dance));
+      const card = await page.evaluate(() => {
+        const button = $ui('dance-model').nextElementSibling;
+        if (!button || button.hidden) return null;
+        button.click();
+        return $uiOne('dialog.pack-card')?.querySelector('pre')?.textContent ?? '';
+      });
+      assert.match(card ?? '', /^# my-dance/);
+      await page.evaluate(() => $uiOne('dialog.pack-card').close());
+      const m = await page.evaluate(async () => {
+        const m = await window.playground.generate({ model: 'my-dance', style: 'salsa', frames: 90, seed: 1 });
+        const models = window.playground.models();
+        return { frames: m.frames, finite: m.positions.every(Number.isFinite), entry: models.find((x) => x.id === 'my-dance') };
+      });
+      assert.equal(m.frames, 90);
+      assert.ok(m.finite);
+      assert.deepEqual(m.entry?.styles, ['salsa']);
       assert.deepEqual(problems, []);
     } finally {
       await page.close();

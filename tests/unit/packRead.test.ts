@@ -1,5 +1,6 @@
-// Reading a model pack's files (web/runtime/packs/pack.ts) on the fixture pack (tests/fixtures/packs: a 30-iteration
-// `python -m training.own` run): the registry entry it makes, and its refusals (short, naming the problem).
+// Reading a model pack's files (web/runtime/packs/pack.ts) on the fixture packs (tests/fixtures/packs: 30-iteration
+// `python -m training.own` runs, my-walks of --kind locomotion, my-dance of --kind dance on three acLSTM salsa files):
+// the registry entry each makes, and the refusals (short, naming the problem).
 import { readFileSync, readdirSync } from 'node:fs';
 import path from 'node:path';
 import { describe, expect, it } from 'vitest';
@@ -7,7 +8,7 @@ import { looksLikePack, packFiles, readPack, type PackFile } from '../../web/run
 import { Registry } from '../../web/runtime/registry';
 
 const DIR = path.join(__dirname, '..', 'fixtures', 'packs');
-const folder = (): PackFile[] => readdirSync(path.join(DIR, 'my-walks')).map((name) => ({ name, bytes: new Uint8Array(readFileSync(path.join(DIR, 'my-walks', name))) }));
+const folder = (pack = 'my-walks'): PackFile[] => readdirSync(path.join(DIR, pack)).map((name) => ({ name, bytes: new Uint8Array(readFileSync(path.join(DIR, pack, name))) }));
 const json = () => JSON.parse(new TextDecoder().decode(folder().find((f) => f.name === 'my-walks.json')!.bytes));
 const withJson = (raw: unknown): PackFile[] => folder().map((f) => (f.name === 'my-walks.json' ? { name: f.name, bytes: new TextEncoder().encode(JSON.stringify(raw)) } : f));
 
@@ -44,7 +45,9 @@ describe('readPack', () => {
       [refusal(folder(), ['my-walks']), /a model "my-walks" is already listed/],
       [refusal(folder().filter((f) => !f.name.endsWith('.onnx'))), /the pack has no my-walks\.onnx/],
       [refusal(folder().filter((f) => !f.name.endsWith('.json'))), /no model JSON in the pack/],
-      [refusal(withJson({ ...json(), kind: 'aclstm' })), /kind must be "lstm-gmm"/],
+      [refusal(withJson({ ...json(), kind: 'latent-erd' })), /kind must be "lstm-gmm" \(a locomotion pack\) or "aclstm" \(a dance pack\), got "latent-erd"/],
+      // A generator's JSON that calls itself a dance model is checked as one.
+      [refusal(withJson({ ...json(), kind: 'aclstm' })), /styles/],
       [refusal(withJson({ ...json(), seeds: [] })), /seeds must be a non-empty array/],
       [refusal(withJson({ ...json(), id: '../../etc' })), /id must be a short name/],
       [refusal([{ name: 'my-walks.json', bytes: new TextEncoder().encode('{ "id": ') }]), /my-walks\.json is not valid JSON/],
@@ -53,5 +56,21 @@ describe('readPack', () => {
       expect(message).toMatch(expected);
       expect(message!.length).toBeLessThanOrEqual(300);
     }
+  });
+
+  it('makes a dance entry of a dance pack, listed for Dance only, with its style', async () => {
+    const fromFolder = readPack(folder('my-dance'), ['aclstm', 'my-walks']);
+    const fromZip = readPack(await packFiles([{ name: 'my-dance.zip', bytes: new Uint8Array(readFileSync(path.join(DIR, 'my-dance.zip'))) }]), []);
+    for (const pack of [fromFolder, fromZip]) {
+      expect(pack.info).toMatchObject({ id: 'my-dance', kind: 'aclstm', fps: 30, styles: ['salsa'], label: 'my-dance (your model)' });
+      expect(pack.card.text).toMatch(/^# my-dance/);
+    }
+    const registry = new Registry([]);
+    expect(registry.add(fromFolder.info)).toBe(true);
+    expect(registry.ids('dance')).toEqual(['my-dance']);
+    expect(registry.ids('walk')).toEqual([]);
+    const raw = JSON.parse(new TextDecoder().decode(folder('my-dance').find((f) => f.name === 'my-dance.json')!.bytes));
+    const broken = folder('my-dance').map((f) => (f.name === 'my-dance.json' ? { name: f.name, bytes: new TextEncoder().encode(JSON.stringify({ ...raw, seeds: raw.seeds.map((s: { frames: number[][] }) => ({ ...s, frames: s.frames.slice(1) })) })) } : f));
+    expect(() => readPack(broken, [])).toThrow(/seeds\[0\]\.frames must hold 10 frames/);
   });
 });

@@ -42,10 +42,10 @@ def export_onnx(model: DanceLSTM, path: Path, weights: str = "float32") -> Dance
     return dance_model_from_onnx(path, model.dim, model.styles, model.hidden, model.layers)
 
 
-def pick_seeds(clips: list[DanceClip]) -> list[dict]:
+def pick_seeds(clips: list[DanceClip], styles: tuple[str, ...] | list[str] = STYLES) -> list[dict]:
     """SEEDS_PER_STYLE windows of SEED_FRAMES real feature frames per style, spread over the held-out clips."""
     seeds = []
-    for style in STYLES:
+    for style in styles:
         held = [c for c in clips if c.style == style and c.held_out]
         for k in range(SEEDS_PER_STYLE):
             c = held[k % len(held)]
@@ -105,7 +105,7 @@ def training_minutes(checkpoint: Path, iteration: int | None) -> float | None:
     return None if minutes is None else round(minutes, 1)
 
 
-def _write_graph(model: DanceLSTM, onnx_path: Path, weights: str) -> tuple[dict, dict]:
+def write_dance_graph(model: DanceLSTM, onnx_path: Path, weights: str) -> tuple[dict, dict]:
     """Writes and parity-checks the graph; returns the JSON's `onnx` and `parity` fields."""
     stored = export_onnx(model, onnx_path, weights)
     parity = {**check_parity(stored, onnx_path), "reference": f"torch with the weights as stored ({weights})"}
@@ -141,7 +141,7 @@ def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | 
     model, meta, state = load_dance_model(checkpoint)
     out.mkdir(parents=True, exist_ok=True)
     onnx_path = out / f"{model_id}.onnx"
-    onnx_fields, parity = _write_graph(model, onnx_path, weights)
+    onnx_fields, parity = write_dance_graph(model, onnx_path, weights)
     _, clips = load_clips(mocap)
     vanilla = meta["args"]["condition"] == 0
     info = {
@@ -179,7 +179,7 @@ def rewrite_dance_model(source: Path, model_id: str, out: Path, weights: str) ->
     model = dance_model_from_onnx(source / info["file"], o["dim"], o["styles"], o["hidden"], o["layers"])
     out.mkdir(parents=True, exist_ok=True)
     onnx_path = out / f"{model_id}.onnx"
-    info["onnx"], info["parity"] = _write_graph(model, onnx_path, weights)
+    info["onnx"], info["parity"] = write_dance_graph(model, onnx_path, weights)
     info["file"] = onnx_path.name
     _publish(info, onnx_path, model_id, out)
     return onnx_path

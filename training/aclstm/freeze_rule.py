@@ -29,11 +29,11 @@ def longest_run(mask: np.ndarray) -> int:
     return best
 
 
-def real_reference(clips: list[DanceClip]) -> dict:
+def real_reference(clips: list[DanceClip], styles: tuple[str, ...] | list[str] = STYLES) -> dict:
     """Per style, over the held-out clips at the model's rate: the median per-second pose change (m/s), the share
     of low seconds and the longest low stretch (s) of any clip (clips are measured one by one, never joined)."""
     out = {}
-    for style in STYLES:
+    for style in styles:
         curves = held_out_pose_change(clips, style)
         median = float(np.median(np.concatenate(curves)))
         low = [curve < LOW_FRACTION * median for curve in curves]
@@ -51,10 +51,10 @@ def judge(curve: np.ndarray, ref: dict) -> dict:
             "passes": all(verdict.values())}
 
 
-def real_jitter_cm(clips) -> dict:
+def real_jitter_cm(clips, styles: tuple[str, ...] | list[str] = STYLES) -> dict:
     """Each style's mean jitter_cm over its held-out clips, each clip alone, at the model's rate."""
     return {s: float(np.mean([jitter_cm(resample_positions(c.positions, c.fps, 0.0, int(c.seconds * MODEL_FPS) - 1))
-                              for c in clips if c.style == s and c.held_out])) for s in STYLES}
+                              for c in clips if c.style == s and c.held_out])) for s in styles}
 
 
 def jitter_cm(pos: np.ndarray) -> float:

@@ -37,8 +37,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--iters-per-epoch", type=int, default=250)
     parser.add_argument("--no-mirror", action="store_true", help="no left/right mirroring of training windows")
     args = parser.parse_args(argv)
-    stopped, best, run_dir = train_dance_model(args)
-    print(f"done: {stopped}; best validation loss {best:.4f}; checkpoints in {run_dir}")
+    result = train_dance_model(args)
+    print(f"done: {result.stopped}; best validation loss {result.best:.4f}; checkpoints in {result.run_dir}")
 
 
 if __name__ == "__main__":

@@ -14,12 +14,13 @@ Styles are drawn equally often. Losses are in normalised units (per-feature mean
 from __future__ import annotations
 
 import argparse
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import torch
 
-from ..data.dance import MODEL_FPS, STYLES, DanceClip, encode, load_clips, mirror, mirror_pairs, resample_positions, rotate_y
+from ..data.dance import MODEL_FPS, STYLES, DanceClip, DanceSkeleton, encode, load_clips, mirror, mirror_pairs, resample_positions, rotate_y
 from ..models.aclstm import DanceLSTM
 from ..models.losses import energy_loss
 from ..runs import TrainingLoop
@@ -30,17 +31,19 @@ SPEEDS = (0.8, 1.2)
 class DanceCorpus:
     """Training windows drawn on the fly (rotation and speed augmentation) and fixed validation windows."""
 
-    def __init__(self, clips: list[DanceClip], window: int, rng: np.random.Generator, names: list[str], use_mirror: bool):
+    def __init__(self, clips: list[DanceClip], window: int, rng: np.random.Generator, names: list[str], use_mirror: bool,
+                 styles: tuple[str, ...] = STYLES):
         self.window = window
+        self.styles = tuple(styles)
         self.pairs = mirror_pairs(names) if use_mirror else None
-        self.train = {s: [c for c in clips if c.style == s and not c.held_out] for s in STYLES}
+        self.train = {s: [c for c in clips if c.style == s and not c.held_out] for s in self.styles}
         # Clips of a style are drawn in proportion to their duration.
         self.clip_p = {}
         for s, mine in self.train.items():
             secs = np.array([c.seconds for c in mine])
             self.clip_p[s] = secs / secs.sum()
         self.valid_files = [c.file for c in clips if c.held_out]
-        sample = np.concatenate([self._features(rng, s)[0] for s in STYLES for _ in range(200)])
+        sample = np.concatenate([self._features(rng, s)[0] for s in self.styles for _ in range(200)])
         self.mean = sample.mean(axis=0)
         self.std = np.maximum(sample.std(axis=0), 1e-3)
         # Rotation makes x and z statistically alike: give them one spread, and zero mean.
@@ -66,16 +69,16 @@ class DanceCorpus:
         return ((x - self.mean) / self.std).astype(np.float32)
 
     def one_hot(self, styles):
-        return torch.eye(len(STYLES))[[STYLES.index(s) for s in styles]]
+        return torch.eye(len(self.styles))[[self.styles.index(s) for s in styles]]
 
     def batch(self, rng, size):
-        styles = [STYLES[i] for i in rng.integers(0, len(STYLES), size)]
+        styles = [self.styles[i] for i in rng.integers(0, len(self.styles), size)]
         x = np.stack([self.normalise(self._features(rng, s)[0]) for s in styles])
         return torch.from_numpy(x), self.one_hot(styles)
 
     def _validation_windows(self, clips, per_style=48):
         out = {}
-        for s in STYLES:
+        for s in self.styles:
             held = [c for c in clips if c.style == s and c.held_out]
             wins = []
             for k in range(per_style):
@@ -102,80 +105,104 @@ def validation_losses(model: DanceLSTM, corpus: DanceCorpus, condition: int) -> 
             out[s] = {"teacher_forced": float(tf), "auto_conditioned": float(ac)}
     model.train()
     key = "auto_conditioned" if condition else "teacher_forced"
-    out["objective"] = float(np.mean([out[s][key] for s in STYLES]))
+    out["objective"] = float(np.mean([out[s][key] for s in corpus.styles]))
     return out
 
 
-def train_dance_model(args: argparse.Namespace) -> tuple[str, float, Path]:
-    """One training run with the options of python -m training.aclstm.train (kept in the checkpoint's meta);
-    returns why it stopped, the best validation loss and the run directory."""
+@dataclass
+class DanceRun:
+    stopped: str  # why the run stopped
+    best: float  # the best validation objective
+    run_dir: Path
+    iterations: int
+    minutes: float  # trained, over all sessions of the run
+    interrupted: bool = False  # Ctrl-C: the checkpoint is saved
+
+
+def train_dance_model(args: argparse.Namespace,
+                      data: tuple[DanceSkeleton, list[DanceClip], tuple[str, ...]] | None = None) -> DanceRun:
+    """One training run with the options of python -m training.aclstm.train (kept in the checkpoint's meta).
+    `data`: the skeleton, clips and styles to train on (python -m training.own --kind dance); default the acLSTM
+    corpus. Ctrl-C stops after the current step with the checkpoint saved."""
     loop = TrainingLoop(args)
     run = loop.run
     rng = loop.seed()
-    skel, clips = load_clips(args.mocap)
-    corpus = DanceCorpus(clips, args.window, np.random.default_rng(12345), skel.names, not args.no_mirror)
+    skel, clips = load_clips(args.mocap) if data is None else data[:2]
+    styles = STYLES if data is None else data[2]
+    corpus = DanceCorpus(clips, args.window, np.random.default_rng(12345), skel.names, not args.no_mirror, styles)
     dim = corpus.mean.shape[0]
-    model = DanceLSTM(dim, len(STYLES), args.hidden, args.layers, args.head)
+    model = DanceLSTM(dim, len(styles), args.hidden, args.layers, args.head)
     optimiser = torch.optim.Adam(model.parameters(), lr=args.lr)
     scheduler = torch.optim.lr_scheduler.ExponentialLR(optimiser, gamma=args.decay)
-    meta = {"dim": dim, "styles": list(STYLES), "hidden": args.hidden, "layers": args.layers, "head": args.head, "fps": MODEL_FPS,
+    meta = {"dim": dim, "styles": list(styles), "hidden": args.hidden, "layers": args.layers, "head": args.head, "fps": MODEL_FPS,
             "mean": corpus.mean.tolist(), "std": corpus.std.tolist(), "skeleton": skel.to_json(),
             "valid_files": corpus.valid_files, "args": vars(args)}
     iteration = loop.start(meta, model=model, optimiser=optimiser, scheduler=scheduler)
+    if loop.resumed and (loop.resumed["meta"]["valid_files"] != meta["valid_files"] or loop.resumed["meta"]["dim"] != dim):
+        raise SystemExit(f"error: --resume, but the checkpoint in {run.dir} was trained on other data: train without "
+                         "--resume, or into another --run")
     history = loop.resumed["history"] if loop.resumed else []  # validation results, kept in every checkpoint
     run.log.info("start: %s, u=%d v=%d, %d features, %d parameters, batch %d x %d frames", args.run,
                  args.ground_truth, args.condition, dim, loop.parameters, args.batch, args.window)
     noise_rng = torch.Generator().manual_seed(args.seed + iteration)
     bar = loop.progress_bar(args.run, args.iterations, iteration)
     losses = []
-    while iteration < args.iterations:
-        x, style = corpus.batch(rng, args.batch)
-        # Schedules over the time budget (so a resumed run continues them): the self-fed stretch grows from
-        # v = condition to condition_max, and noise on the real input frames from noise[0] to noise[1]
-        # (normalised units; the targets stay clean).
-        progress = min(1.0, loop.elapsed() / (args.minutes * 60))
-        condition = args.condition
-        if args.condition and args.condition_max:
-            condition = int(round(args.condition + (args.condition_max - args.condition) * progress))
-        inputs = x[:, :-1]
-        sigma = args.input_noise[0] + (args.input_noise[1] - args.input_noise[0]) * progress
-        if sigma > 0:
-            inputs = inputs + sigma * torch.randn(inputs.shape, generator=noise_rng)
-        pred, log_sigma = model.auto_conditioned_distribution(inputs, style, args.ground_truth, condition, args.feedback_noise)
-        if log_sigma is None:
-            loss = ((pred - x[:, 1:]) ** 2).mean()
-        else:  # Gaussian negative log-likelihood per channel (constant dropped)
-            loss = (0.5 * ((x[:, 1:] - pred) * torch.exp(-log_sigma)) ** 2 + log_sigma).mean()
-        if args.energy:
-            # Motion energy: each channel's RMS change between frames over the window should match the real
-            # window's. A frozen pose is the mean regression's cheapest answer; this term prices it.
-            loss = loss + args.energy * energy_loss(pred, x[:, 1:])
-        optimiser.zero_grad()
-        loss.backward()
-        torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
-        optimiser.step()
-        iteration += 1
-        losses.append(loss.item())
-        bar.update(1)
-        bar.set_postfix(loss=f"{np.mean(losses[-50:]):.4f}", v=condition, noise=f"{sigma:.2f}")
-        if iteration % args.iters_per_epoch == 0:
-            scheduler.step()
-            val = validation_losses(model, corpus, args.condition)
-            history.append({"iteration": iteration, "minutes": round(loop.elapsed() / 60, 2), "train": float(np.mean(losses)),
-                            "valid": val})
-            if val["objective"] < loop.best:
-                loop.best = val["objective"]
-                run.save({"model": model.state_dict(), "iteration": iteration, "valid": val, "meta": meta}, run.best_path)
-            run.log.info("iteration %d train %.4f valid %.4f (tf %s, ac %s) best %.4f lr %.2e minutes %.1f", iteration,
-                         np.mean(losses), val["objective"],
-                         "/".join(f"{val[s]['teacher_forced']:.3f}" for s in STYLES),
-                         "/".join(f"{val[s]['auto_conditioned']:.3f}" for s in STYLES),
-                         loop.best, scheduler.get_last_lr()[0], loop.elapsed() / 60)
-            losses = []
-            loop.save(iteration, history=history)
-        if loop.step_done(iteration, history=history):
-            break
+    interrupted = False
+    try:
+        while iteration < args.iterations:
+            x, style = corpus.batch(rng, args.batch)
+            # Schedules over the time budget (so a resumed run continues them): the self-fed stretch grows from
+            # v = condition to condition_max, and noise on the real input frames from noise[0] to noise[1]
+            # (normalised units; the targets stay clean).
+            progress = min(1.0, loop.elapsed() / (args.minutes * 60))
+            condition = args.condition
+            if args.condition and args.condition_max:
+                condition = int(round(args.condition + (args.condition_max - args.condition) * progress))
+            inputs = x[:, :-1]
+            sigma = args.input_noise[0] + (args.input_noise[1] - args.input_noise[0]) * progress
+            if sigma > 0:
+                inputs = inputs + sigma * torch.randn(inputs.shape, generator=noise_rng)
+            pred, log_sigma = model.auto_conditioned_distribution(inputs, style, args.ground_truth, condition, args.feedback_noise)
+            if log_sigma is None:
+                loss = ((pred - x[:, 1:]) ** 2).mean()
+            else:  # Gaussian negative log-likelihood per channel (constant dropped)
+                loss = (0.5 * ((x[:, 1:] - pred) * torch.exp(-log_sigma)) ** 2 + log_sigma).mean()
+            if args.energy:
+                # Motion energy: each channel's RMS change between frames over the window should match the real
+                # window's. A frozen pose is the mean regression's cheapest answer; this term prices it.
+                loss = loss + args.energy * energy_loss(pred, x[:, 1:])
+            optimiser.zero_grad()
+            loss.backward()
+            torch.nn.utils.clip_grad_norm_(model.parameters(), 1.0)
+            optimiser.step()
+            iteration += 1
+            losses.append(loss.item())
+            bar.update(1)
+            bar.set_postfix(loss=f"{np.mean(losses[-50:]):.4f}", v=condition, noise=f"{sigma:.2f}")
+            if iteration % args.iters_per_epoch == 0:
+                scheduler.step()
+                val = validation_losses(model, corpus, args.condition)
+                history.append({"iteration": iteration, "minutes": round(loop.elapsed() / 60, 2), "train": float(np.mean(losses)),
+                                "valid": val})
+                if val["objective"] < loop.best:
+                    loop.best = val["objective"]
+                    run.save({"model": model.state_dict(), "iteration": iteration, "valid": val, "meta": meta}, run.best_path)
+                run.log.info("iteration %d train %.4f valid %.4f (tf %s, ac %s) best %.4f lr %.2e minutes %.1f", iteration,
+                             np.mean(losses), val["objective"],
+                             "/".join(f"{val[s]['teacher_forced']:.3f}" for s in styles),
+                             "/".join(f"{val[s]['auto_conditioned']:.3f}" for s in styles),
+                             loop.best, scheduler.get_last_lr()[0], loop.elapsed() / 60)
+                losses = []
+                loop.save(iteration, history=history)
+            if loop.step_done(iteration, history=history):
+                break
+    except KeyboardInterrupt:
+        loop.stopped, interrupted = "stopped by Ctrl-C", True
+    if not run.best_path.exists():  # no validation yet (a short or interrupted run): the weights as they are
+        val = validation_losses(model, corpus, args.condition)
+        loop.best = val["objective"]
+        run.save({"model": model.state_dict(), "iteration": iteration, "valid": val, "meta": meta}, run.best_path)
     # The last weights also count as a candidate: last.pt, for the evaluation to compare.
     loop.finish(iteration, {"best_valid": loop.best, "iterations": iteration, "stopped": loop.stopped},
                 save_last=True, history=history)
-    return loop.stopped, loop.best, run.dir
+    return DanceRun(loop.stopped, loop.best, run.dir, iteration, loop.elapsed() / 60, interrupted)

@@ -138,8 +138,12 @@ def rotate_y(pos: np.ndarray, angle: float) -> np.ndarray:
 
 
 def mirror_pairs(names: list[str]) -> np.ndarray:
-    """Index of each point's left/right counterpart (itself on the midline): rShin <-> lShin, rightEye <-> leftEye."""
+    """Index of each point's left/right counterpart (itself on the midline): rShin <-> lShin, rightEye <-> leftEye,
+    LeftUpLeg <-> RightUpLeg (the canonical skeleton's names)."""
     def other(n: str) -> str:
+        for a, b in (("Left", "Right"), ("Right", "Left")):
+            if n.startswith(a):
+                return b + n[len(a):]
         if n.startswith("left"):
             return "right" + n[4:]
         if n.startswith("right"):
@@ -200,6 +204,6 @@ def held_out_pose_change(clips: list[DanceClip], style: str) -> list[np.ndarray]
     return curves
 
 
-def real_pose_change(clips: list[DanceClip]) -> dict:
+def real_pose_change(clips: list[DanceClip], styles: tuple[str, ...] | list[str] = STYLES) -> dict:
     """Median per-second pose change (m/s) of the real held-out clips, per style."""
-    return {style: round(float(np.median(np.concatenate(held_out_pose_change(clips, style)))), 4) for style in STYLES}
+    return {style: round(float(np.median(np.concatenate(held_out_pose_change(clips, style)))), 4) for style in styles}

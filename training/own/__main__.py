@@ -1,23 +1,27 @@
 """Train a model on your own motion: a folder of BVH or ASF/AMC files (plain or gzipped, any humanoid skeleton) in,
 a model pack out (ONNX + JSON as the shipped models, card.md and its pose-change plot, all from measurements).
 
-    python -m training.own --data DIR --kind locomotion --out DIR [--minutes 20] [--resume]
+    python -m training.own --data DIR --kind locomotion|dance --out DIR [--minutes 20] [--resume]
+
+locomotion trains the LSTM-GMM generator (Random walk, Path and Steer); dance the acLSTM (Dance), one style.
 
 The folder is read and checked before training starts (training/own/dataset.py); the run keeps its log and
 checkpoints in runs/own-<id>/ (--run), resumes with --resume and stops cleanly on Ctrl-C, keeping the last checkpoint.
-The same command runs on several processes or machines under torchrun (python -m torch.distributed.run … -m
+The same command (--kind locomotion) runs on several processes or machines under torchrun (python -m torch.distributed.run … -m
 training.own …); process 0 writes the run and the pack.
 docs/training.md, "Train on your own motion", has the whole story.
 """
 from __future__ import annotations
 
 import argparse
+import os
 import time
 from pathlib import Path
 
 from .dataset import OwnCorpus, RefusedFolder, load_folder
 from .distributed import launched_rank
-from .options import add_own_arguments, min_clip_frames, pack_id, run_folder
+from .dance_pack import train_and_pack_dance
+from .options import add_own_arguments, apply_kind_defaults, min_clip_frames, pack_id, run_folder
 from .pack import export_pack, measure_pack, plot_pose_change, record_measures, write_card
 from .trainer import train_locomotion
 
@@ -27,20 +31,23 @@ def main(argv: list[str] | None = None) -> None:
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     add_own_arguments(parser)
     args = parser.parse_args(argv)
-    if args.kind == "dance":
-        raise SystemExit("error: --kind dance is not built yet; --kind locomotion trains the generator")
+    apply_kind_defaults(args)
+    if args.kind == "dance" and int(os.environ.get("WORLD_SIZE", "1")) > 1:
+        raise SystemExit("error: --kind dance trains on one process; run it without torchrun (torchrun is for --kind locomotion)")
     model_id = pack_id(args)
     args.run = run_folder(args, model_id)
     lead = launched_rank() == 0  # under torchrun, only process 0 prints, writes and exports
     say = print if lead else (lambda *_: None)
     t0 = time.perf_counter()
     try:
-        data = load_folder(args.data, min_clip_frames(args), log=say)
+        data = load_folder(args.data, min_clip_frames(args), log=say, source_fps=args.source_fps)
     except RefusedFolder as err:
         message = f"error: {err}"
         raise SystemExit(message if len(message) <= 300 else message[:299] + "…") from None
     say(f"data: {data.minutes:.2f} minutes in {len(data.clips)} clips ({len(data.held_out)} held out), "
           f"read in {time.perf_counter() - t0:.0f} s")
+    if args.kind == "dance":
+        return train_and_pack_dance(args, data, model_id)
     result = train_locomotion(OwnCorpus(data), args)
     if result.interrupted:
         say(f"stopped by Ctrl-C after {result.iterations} iterations; the checkpoint is in {args.run}: "

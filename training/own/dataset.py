@@ -51,12 +51,18 @@ def held_out_names(names: list[str]) -> list[str]:
     return chosen or [ordered[len(ordered) // 2]]
 
 
-def load_folder(folder: Path, min_frames: int, log=print) -> OwnData:
+def load_folder(folder: Path, min_frames: int, log=print, source_fps: float | None = None) -> OwnData:
     """Reads and maps every clip under `folder`; raises RefusedFolder for a folder with no motion, a skeleton the mapper
-    cannot map (naming the file), or fewer than two clips of at least `min_frames` frames at FPS."""
+    cannot map (naming the file), or fewer than two clips of at least `min_frames` frames at FPS. `source_fps`: the
+    files' true frame rate, instead of their headers'."""
     if not folder.is_dir():
         raise RefusedFolder(f"{folder} is not a folder")
     raws, skipped = read_folder(folder)
+    if source_fps is not None:
+        if not source_fps > 0:
+            raise RefusedFolder(f"--source-fps must be a positive frame rate, got {source_fps:g}")
+        for raw in raws:
+            raw.fps = source_fps
     for problem in skipped:
         log(f"skipped: {problem}")
     if not raws:

@@ -201,7 +201,7 @@ def plot_pose_change(stability: dict, real_median: float, path: Path) -> None:
     plt.close(fig)
 
 
-def _m(v: float) -> str:
+def number_or_na(v: float) -> str:
     return "n/a" if v != v else f"{v:.3f}"
 
 
@@ -230,10 +230,10 @@ def write_card(path: Path, pack_id: str, data: OwnData, result: TrainingResult, 
         f"On the {real['clips']} held-out clip{'s' * (real['clips'] != 1)} ({real['seconds']:.1f} s) against "
         f"{gen['streams']} generated streams of {gen['frames']} frames.", "",
         "| measure | held-out clips | generated | generated, feet locked |", "|---|---|---|---|",
-        f"| toe speed while the contact bit is on | {_m(real['sliding_contact_bits'])} | {_m(gen['sliding_contact_bits'])} | |",
-        f"| lowest foot point within 4 cm of the floor | {_m(real['sliding_low_foot'])} | {_m(gen['sliding_low_foot'])} | "
-        f"{_m(gen['sliding_low_foot_locked'])} |",
-        "", f"Locked generated sliding is {_m(ratio)}× the held-out clips' (lowest foot point).",
+        f"| toe speed while the contact bit is on | {number_or_na(real['sliding_contact_bits'])} | {number_or_na(gen['sliding_contact_bits'])} | |",
+        f"| lowest foot point within 4 cm of the floor | {number_or_na(real['sliding_low_foot'])} | {number_or_na(gen['sliding_low_foot'])} | "
+        f"{number_or_na(gen['sliding_low_foot_locked'])} |",
+        "", f"Locked generated sliding is {number_or_na(ratio)}× the held-out clips' (lowest foot point).",
         "", "## Stability", "",
         f"{stab['frames']:,} frames from seed {stab['seed']}: "
         + (f"all finite; pose change per second median {stab['median_pose_change']:.3f} m/s, lowest "

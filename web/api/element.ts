@@ -460,7 +460,7 @@ export class MotionPlaygroundElement extends HTMLElement {
     if (!url) return;
     try {
       const id = await app.loadModels(url);
-      if (this.app === app) app.note(`Your model ${id} is loaded: choose it in Random walk, Path or Steer.`);
+      if (this.app === app) app.note(app.packLoadedNote(id));
     } catch (e) {
       if (this.app === app) app.reportError(`${this.hasAttribute('models') ? 'models' : 'Link: models'}: ${errorMessage(e)}`);
     }

@@ -188,8 +188,22 @@ export class App implements ModeHost {
     this.controlModel.list(this.models);
     this.controlModel.set(chosen);
     this.walk.list(this.models);
+    this.danceMode.list(this.models);
     this.pathMode.list(this.models);
-    for (const id of ['walk-model', 'path-model', 'steer-model']) this.cardButton(this.scope.root.getElementById(id) as HTMLSelectElement);
+    for (const id of ['walk-model', 'dance-model', 'path-model', 'steer-model']) this.cardButton(this.scope.root.getElementById(id) as HTMLSelectElement);
+  }
+
+  /** What to tell the user once pack `id` is loaded: where to find it. */
+  packLoadedNote(id: string): string {
+    const modes = modeModels(this.models);
+    const where = [
+      ['Random walk', modes.walk],
+      ['Dance', modes.dance],
+      ['Path', modes.path],
+      ['Steer', modes.steer],
+    ].flatMap(([name, ids]) => ((ids as string[]).includes(id) ? [name as string] : []));
+    const list = where.length > 1 ? `${where.slice(0, -1).join(', ')} or ${where[where.length - 1]}` : where[0] ?? 'the model pickers';
+    return `Your model ${id} is loaded: choose it in ${list}.`;
   }
 
   /** A "card" button beside a picker, shown while it has a pack chosen: opens the pack's card. */
@@ -507,7 +521,7 @@ export class App implements ModeHost {
   private async dropPack(files: File[]): Promise<void> {
     try {
       const id = await this.loadModels(files);
-      this.note(`Your model ${id} is loaded: choose it in Random walk, Path or Steer.`);
+      this.note(this.packLoadedNote(id));
     } catch (e) {
       this.reportError(`Model pack: ${errorMessage(e)}`);
     }

@@ -3,7 +3,7 @@
 // the seed motion.
 
 import { describeValue } from '../../motion/describe';
-import { motionOf, type ModelDescriptor } from '../descriptor';
+import { clientFiles, motionOf, type ModelDescriptor } from '../descriptor';
 import { DanceClient } from './danceClient';
 
 export const descriptor: ModelDescriptor<DanceClient> = {
@@ -11,7 +11,7 @@ export const descriptor: ModelDescriptor<DanceClient> = {
   shortName: 'acLSTM',
   labels: { aclstm: 'acLSTM', 'aclstm-vanilla': 'vanilla LSTM (baseline)' },
   capabilities: ['generate', 'dance'],
-  createClient: (entry, threads) => new DanceClient({ model: entry.id, threads }),
+  createClient: (entry, threads) => new DanceClient({ ...clientFiles(entry, threads), model: entry.id }),
 
   generate: {
     options: ['model', 'style', 'frames', 'seed'],

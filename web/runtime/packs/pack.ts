@@ -1,11 +1,14 @@
-// A model pack (training/own/pack.py: `python -m training.own … --out OUT`) as the page takes it: <id>.onnx,
-// <id>.json (the shipped generator JSON's fields plus `pack`), card.md and pose_change.png, from dropped files, a
-// folder, a .zip or a URL. `readPack` checks the JSON with the generator's own parser and makes the manifest entry
-// (blob URLs for its files); the model itself is checked by loading it in its worker (ui/packInput.ts), so an ONNX
-// whose inputs and outputs disagree with the JSON is refused before the pickers list it.
+// A model pack (`python -m training.own … --out OUT`: training/own/pack.py for --kind locomotion, dance_pack.py for
+// --kind dance) as the page takes it: <id>.onnx, <id>.json (the shipped generator's or acLSTM's JSON fields plus
+// `pack`), card.md and pose_change.png, from dropped files, a folder, a .zip or a URL. `readPack` checks the JSON with
+// its kind's own parser and makes the manifest entry (blob URLs for its files); the model itself is checked by
+// loading it in its worker (ui/packInput.ts), so an ONNX whose inputs and outputs disagree with the JSON is refused
+// before the pickers list it.
 
 import type { ModelInfo } from '../../model/manifest';
 import { parseGeneratorInfo } from '../../model/generatorInfo';
+import { parseDanceInfo } from '../aclstm/danceModel';
+import { descriptor as dance } from '../aclstm/descriptor';
 import { descriptor as generator } from '../generator/descriptor';
 import { MAX_SOURCE_BYTES } from '../import/motionSource';
 import { readZip } from './zip';
@@ -30,6 +33,12 @@ export interface Pack {
 }
 
 const baseName = (path: string): string => path.split('/').pop() ?? path;
+
+/** The kinds a pack may hold, each with its JSON's parser: a locomotion generator or a dance model. */
+const PACK_KINDS: Record<string, { parse: (raw: unknown, name: string) => unknown; what: string }> = {
+  [generator.kind]: { parse: parseGeneratorInfo, what: 'a locomotion pack' },
+  [dance.kind]: { parse: parseDanceInfo, what: 'a dance pack' },
+};
 
 /** The files of a pack from dropped or picked files: a .zip is opened, anything else taken as it is. */
 export async function packFiles(files: readonly { name: string; bytes: Uint8Array }[]): Promise<PackFile[]> {
@@ -74,9 +83,13 @@ export function readPack(files: readonly PackFile[], taken: readonly string[]): 
   const chosen = withPack[0] ?? (parsed.length === 1 ? parsed[0] : undefined);
   if (!chosen) throw new PackError(`none of ${jsons.map((j) => j.name).join(', ')} is a pack's JSON (no "pack" field)`);
   const raw = chosen.raw as Record<string, unknown>;
-  if (raw.kind !== generator.kind) throw new PackError(`${chosen.f.name}: kind must be "${generator.kind}" (a locomotion pack), got ${JSON.stringify(raw.kind)?.slice(0, 40)}`);
+  const kind = typeof raw.kind === 'string' && Object.hasOwn(PACK_KINDS, raw.kind) ? PACK_KINDS[raw.kind] : undefined;
+  if (!kind) {
+    const kinds = Object.entries(PACK_KINDS).map(([k, v]) => `"${k}" (${v.what})`).join(' or ');
+    throw new PackError(`${chosen.f.name}: kind must be ${kinds}, got ${JSON.stringify(raw.kind)?.slice(0, 40)}`);
+  }
   try {
-    parseGeneratorInfo(raw, chosen.f.name);
+    kind.parse(raw, chosen.f.name);
   } catch (err) {
     throw new PackError(short(err instanceof Error ? err.message : String(err)));
   }
@@ -94,9 +107,10 @@ export function readPack(files: readonly PackFile[], taken: readonly string[]): 
   const urls: string[] = [];
   const info: ModelInfo = {
     id,
-    kind: generator.kind,
+    kind: raw.kind as string,
     skeleton: 'cmu-canonical',
     fps: raw.fps as number,
+    ...(Array.isArray(raw.styles) ? { styles: raw.styles as string[] } : {}),
     bytes: onnx.bytes.length,
     files: { model: blobUrl(onnx.bytes, 'application/octet-stream', urls), info: blobUrl(chosen.f.bytes, 'application/json', urls) },
     label: `${id} (your model)`,
