@@ -282,8 +282,13 @@ function restPositions(nodes: ReadonlyArray<{ offset: Vec3; parent: number }>): 
   return rest;
 }
 
-/** Metres per file unit: the candidate unit that makes the rest figure closest to 1.7 m tall. */
-export function detectBVHUnitScale(nodes: ReadonlyArray<{ offset: Vec3; parent: number }>): number {
+/**
+ * Metres per file unit: the candidate unit that makes the figure closest to 1.7 m tall. The figure's height is the
+ * taller of its rest pose's and its posed height (`posedHeight`, file units: the median vertical extent of a few
+ * frames, bvhPosedHeight), so a rest pose lying flat does not shrink it: the Bandai Namco files (centimetres) rest
+ * with spine and legs along x, the hips 93 cm above a root joint on the floor, a 1 m rest figure that read as inches.
+ */
+export function detectBVHUnitScale(nodes: ReadonlyArray<{ offset: Vec3; parent: number }>, posedHeight = 0): number {
   const rest = restPositions(nodes);
   const extent = (axis: number) => {
     let lo = Infinity;
@@ -300,11 +305,51 @@ export function detectBVHUnitScale(nodes: ReadonlyArray<{ offset: Vec3; parent: 
   // A rest figure of (almost) no size (every bone of zero length, as exportBVH writes a skeleton whose joints all
   // coincide: 0.001 cm bones) says nothing of its unit; no candidate makes it a figure, so the exporter's centimetres.
   if (!(height >= MIN_DETECTABLE_HEIGHT)) return 0.01;
+  if (posedHeight > height) height = posedHeight;
   let best = BVH_UNIT_CANDIDATES[0].scale;
   for (const { scale } of BVH_UNIT_CANDIDATES) {
     if (Math.abs(Math.log((height * scale) / TYPICAL_HEIGHT)) < Math.abs(Math.log((height * best) / TYPICAL_HEIGHT))) best = scale;
   }
   return best;
+}
+
+/** Frames sampled (evenly over the file) for the posed height of unit detection. */
+const POSED_HEIGHT_SAMPLES = 15;
+
+/**
+ * The figure's posed height in file units: the median, over up to POSED_HEIGHT_SAMPLES frame lines spread over the
+ * file, of the kept joints' vertical extent. Lines that do not read are skipped here (the frame loop reports them).
+ */
+function bvhPosedHeight(lines: string[], firstFrameLine: number, nodes: BvhNode[], keptNodes: number[], channelCount: number): number {
+  const frameLines: number[] = [];
+  for (let k = firstFrameLine; k < lines.length; k++) if (lines[k].trim() !== '') frameLines.push(k);
+  const count = Math.min(POSED_HEIGHT_SAMPLES, frameLines.length);
+  const posed = posedNodes(nodes);
+  const globals: Quat[] = new Array(nodes.length);
+  const world: Vec3[] = new Array(nodes.length);
+  const values = new Float64Array(channelCount);
+  const heights: number[] = [];
+  for (let s = 0; s < count; s++) {
+    const parts = tokens(lines[frameLines[Math.floor(((s + 0.5) * frameLines.length) / count)]]);
+    if (parts.length !== channelCount) continue;
+    let ok = true;
+    for (let c = 0; c < channelCount && ok; c++) {
+      values[c] = Number(parts[c]);
+      ok = Number.isFinite(values[c]) && Math.abs(values[c]) <= MAX_BVH_LENGTH;
+    }
+    if (!ok) continue;
+    poseNodes(nodes, posed, values, globals, world);
+    let lo = Infinity;
+    let hi = -Infinity;
+    for (const k of keptNodes) {
+      lo = Math.min(lo, world[k][1]);
+      hi = Math.max(hi, world[k][1]);
+    }
+    heights.push(hi - lo);
+  }
+  if (heights.length === 0) return 0;
+  heights.sort((a, b) => a - b);
+  return heights[heights.length >> 1];
 }
 
 /** Reads "Frames: N" / "Frame Time: t" style header lines; returns the value token or throws. */
@@ -344,7 +389,7 @@ export function parseBVH(text: string, options: BVHOptions = {}): Motion {
   }
 
   let unitScale = options.unitScale;
-  if (unitScale === undefined) unitScale = detectBVHUnitScale(nodes);
+  if (unitScale === undefined) unitScale = detectBVHUnitScale(nodes, bvhPosedHeight(lines, firstFrameLine, nodes, keptNodes, channelCount));
   if (!(unitScale > 0 && Number.isFinite(unitScale))) throw new Error(`parseBVH: unitScale must be a positive number, got ${unitScale}`);
 
   // Allocate for the frame lines actually present, so a bogus "Frames:" cannot reserve memory.
