@@ -17,8 +17,8 @@ import pytest
 
 from conftest import MOCAP, REPO
 from training.mocap.skeleton import canonical_skeleton
-from training.own.ik import CanonicalIK
-from training.own.canonical import ik_prior, to_canonical
+from training.mocap.canonical_ik import CanonicalIK
+from training.mocap.canonical_points import ik_prior, to_canonical
 from training.mocap.humanoid import CANONICAL_JOINTS
 
 CMU_TO_MIXAMO = {"LHipJoint": "LeftHipJoint", "RHipJoint": "RightHipJoint", "LowerBack": "Spine", "Spine": "Spine1",

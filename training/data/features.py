@@ -14,11 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..mocap.rotations import axis_rotation, matrix_to_quat, quat_to_matrix
-from ..mocap.skeleton import Skeleton, canonical_skeleton, forward_kinematics_matrices
-
-# Segments that retargeting keeps rigid (see retarget.RIGID_BONES): nothing to model.
-FIXED_JOINTS = ("LeftUpLeg", "RightUpLeg", "LeftHand_end", "RightHand_end")
+from ..mocap.rotations import axis_rotation, matrix_to_rotvec, quat_to_matrix
+from ..mocap.skeleton import FIXED_JOINTS, Skeleton, canonical_skeleton, forward_kinematics_matrices
 
 
 def feature_joints(skel: Skeleton) -> list[int]:
@@ -33,14 +30,6 @@ def feature_names(skel: Skeleton) -> list[str]:
 
 
 # ---- rotation vectors -------------------------------------------------------------------------
-
-def matrix_to_rotvec(m: np.ndarray) -> np.ndarray:
-    q = matrix_to_quat(m)  # w >= 0, so the angle is in [0, pi]
-    s = np.linalg.norm(q[..., :3], axis=-1, keepdims=True)
-    angle = 2 * np.arctan2(s, q[..., 3:4])
-    scale = np.where(s > 1e-9, angle / np.maximum(s, 1e-12), 2.0)
-    return q[..., :3] * scale
-
 
 def rotvec_to_matrix(v: np.ndarray) -> np.ndarray:
     angle = np.linalg.norm(v, axis=-1, keepdims=True)

@@ -108,3 +108,12 @@ def rotation_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
         return 2 * np.outer(perp, perp) - np.eye(3)
     vx = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
     return np.eye(3) + vx + vx @ vx / (1 + c)
+
+
+def matrix_to_rotvec(m: np.ndarray) -> np.ndarray:
+    """Rotation vectors (axis × angle, angle in [0, π]) of rotation matrices (..., 3, 3)."""
+    q = matrix_to_quat(m)  # w >= 0, so the angle is in [0, pi]
+    s = np.linalg.norm(q[..., :3], axis=-1, keepdims=True)
+    angle = 2 * np.arctan2(s, q[..., 3:4])
+    scale = np.where(s > 1e-9, angle / np.maximum(s, 1e-12), 2.0)
+    return q[..., :3] * scale

@@ -52,6 +52,9 @@ CANONICAL_LAYOUT: list[tuple[str, str | None, tuple[str, ...]]] = [
 
 # Points whose heights and speeds decide foot contact: (ankle, toe) per side.
 FOOT_POINTS = {"left": ("LeftFoot", "LeftToeBase"), "right": ("RightFoot", "RightToeBase")}
+# Segments that retargeting keeps rigid (retarget.RIGID_BONES): nothing to model (data/features.py), held at their
+# reference by the canonical IK (canonical_ik.py).
+FIXED_JOINTS = ("LeftUpLeg", "RightUpLeg", "LeftHand_end", "RightHand_end")
 # Points that can touch the ground: used to put the feet on the floor.
 GROUND_POINTS = ("LeftFoot", "LeftToeBase", "LeftToeBase_end", "RightFoot", "RightToeBase", "RightToeBase_end")
 

@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 from ..data.features import FeatureCodec, mirror_clip
 from ..data.locomotion import SPEED_FACTORS, Corpus, LocomotionClip, change_speed
+from ..mocap.canonical_points import MappedClip, canonical_clip, make_ik, map_skeleton
 from ..mocap.humanoid import SkeletonMapError
 from ..mocap.skeleton import canonical_skeleton
-from .canonical import OwnClip, canonical_clip, make_ik, map_skeleton
 from .reading import read_folder
 
 FPS = 30.0  # the generator's rate
@@ -27,7 +27,7 @@ class RefusedFolder(ValueError):
 class OwnData:
     """The user's clips on the canonical skeleton, and what was found reading them."""
     folder: Path
-    clips: list[OwnClip]
+    clips: list[MappedClip]
     held_out: list[str]  # clip names
     skeletons: list[dict]  # per distinct skeleton: scheme, joints, files
     skipped: list[str] = field(default_factory=list)  # files that could not be read, each with why (file:line)
@@ -38,10 +38,10 @@ class OwnData:
     def minutes(self) -> float:
         return sum(c.frames for c in self.clips) / FPS / 60
 
-    def train_clips(self) -> list[OwnClip]:
+    def train_clips(self) -> list[MappedClip]:
         return [c for c in self.clips if c.name not in self.held_out]
 
-    def held_out_clips(self) -> list[OwnClip]:
+    def held_out_clips(self) -> list[MappedClip]:
         return [c for c in self.clips if c.name in self.held_out]
 
 

@@ -1,14 +1,12 @@
 """Reading a user's folder of motion: every BVH and ASF/AMC pair under it (plain or gzipped), through the corpus
-readers (training/mocap/bvh.py, asf_amc.py), as joint names, parents and world positions. A file that cannot be read
-is set aside with its reader's message (file and line) and the others go on."""
+readers (training/mocap/canonical_points.py read_bvh, asf_amc.py), as joint names, parents and world positions (RawClip).
+A file that cannot be read is set aside with its reader's message (file and line) and the others go on."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
-from ..mocap import asf_amc, bvh
+from ..mocap import asf_amc
+from ..mocap.canonical_points import RawClip, read_bvh
 from ..mocap.files import MotionFormatError
 
 BVH_SUFFIXES = (".bvh", ".bvh.gz")
@@ -16,19 +14,6 @@ AMC_SUFFIXES = (".amc", ".amc.gz")
 ASF_SUFFIXES = (".asf", ".asf.gz")
 # AMC files carry no frame rate; CMU's (the format's main source) are captured at 120 fps.
 AMC_FPS = 120.0
-
-
-@dataclass
-class RawClip:
-    name: str  # the file, relative to the data folder
-    fps: float
-    joints: list[str]
-    parents: list[int]
-    positions: np.ndarray  # (frames, joints, 3) world, the file's units, y up
-
-    @property
-    def seconds(self) -> float:
-        return len(self.positions) / self.fps
 
 
 def _has_suffix(path: Path, suffixes: tuple[str, ...]) -> bool:
@@ -60,14 +45,6 @@ def skeleton_for(amc: Path, folder: Path) -> Path | None:
     if len(beside) == 1:
         return beside[0]
     return asfs[0] if len(asfs) == 1 else None
-
-
-def read_bvh(path: Path, name: str) -> RawClip:
-    clip = bvh.load_bvh(path)
-    _, positions = bvh.global_transforms(clip)
-    # End sites are points too (a toe or head tip), named after their joint.
-    joints = [f"{clip.joints[j.parent].name}_end" if j.end_site else j.name for j in clip.joints]
-    return RawClip(name, clip.fps, joints, [j.parent for j in clip.joints], positions)
 
 
 def read_amc(path: Path, asf: Path, name: str) -> RawClip:

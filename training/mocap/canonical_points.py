@@ -1,6 +1,7 @@
-"""A user's clip on the canonical skeleton: the humanoid mapper's points (training/mocap/humanoid.py), the points a
-skeleton lacks derived from the others, scaled by leg length, resampled to the model's rate, turned into rotations by
-inverse kinematics (ik.py), put on the floor, with foot contacts.
+"""Any humanoid clip on the canonical skeleton: the humanoid mapper's points (humanoid.py), the points a skeleton lacks
+derived from the others, scaled by leg length, resampled to the model's rate, turned into rotations by inverse
+kinematics (canonical_ik.py), put on the floor, with foot contacts. Used for a user's folder (training.own) and for
+the Bandai Namco set (training/data/bandai.py).
 
 The derived points are the page's rule (web/motion/skeletonMap.ts toCanonical, the Python twin here; the fixture
 tests/fixtures/own_canonical.json, python -m training.fixtures.own_canonical, holds this module's answers for the
@@ -15,15 +16,38 @@ from pathlib import Path
 
 import numpy as np
 
-from ..data.cmu import clip_contacts
-from ..mocap.humanoid import CANONICAL_JOINTS, HumanoidMap, map_humanoid
-from ..mocap.resample import resample_times
-from ..mocap.retarget import CanonicalClip, put_on_floor
-from ..mocap.rotations import matrix_to_quat, quat_to_matrix
-from ..mocap.skeleton import Skeleton, canonical_skeleton, forward_kinematics_matrices
 from ..paths import MODELS_DIR
-from .ik import CanonicalIK, local_rotations
-from .reading import RawClip
+from . import bvh
+from .canonical_ik import CanonicalIK, local_rotations
+from .contacts import contacts_for
+from .humanoid import CANONICAL_JOINTS, HumanoidMap, map_humanoid
+from .resample import resample_times
+from .retarget import CanonicalClip, put_on_floor
+from .rotations import matrix_to_quat, quat_to_matrix
+from .skeleton import FOOT_POINTS, Skeleton, canonical_skeleton, forward_kinematics_matrices
+
+
+@dataclass
+class RawClip:
+    """A clip as a reader gives it: joint names, parents and world positions."""
+    name: str  # the file, relative to the data folder
+    fps: float
+    joints: list[str]
+    parents: list[int]
+    positions: np.ndarray  # (frames, joints, 3) world, the file's units, y up
+
+    @property
+    def seconds(self) -> float:
+        return len(self.positions) / self.fps
+
+
+def read_bvh(path: Path, name: str) -> RawClip:
+    """A BVH file (plain or gzipped) as a RawClip; End Sites are points too (a toe or head tip), named <joint>_end."""
+    clip = bvh.load_bvh(path)
+    _, positions = bvh.global_transforms(clip)
+    joints = [f"{clip.joints[j.parent].name}_end" if j.end_site else j.name for j in clip.joints]
+    return RawClip(name, clip.fps, joints, [j.parent for j in clip.joints], positions)
+
 
 # Points placed from others when a skeleton lacks them: at t along from → to (t > 1 beyond `to`); skeletonMap.ts DERIVED.
 DERIVED = {
@@ -111,8 +135,8 @@ def ik_prior(models_dir: Path = MODELS_DIR) -> tuple[np.ndarray, np.ndarray]:
 
 
 @dataclass
-class OwnClip:
-    """One of the user's clips on the canonical skeleton at the model's rate."""
+class MappedClip:
+    """A clip on the canonical skeleton at the model's rate."""
     name: str  # the file, relative to the data folder
     source_fps: float
     root: np.ndarray       # (frames, 3) metres
@@ -125,13 +149,14 @@ class OwnClip:
         return len(self.root)
 
 
-def canonical_clip(raw: RawClip, mapping: Mapping, fps: float, ik: CanonicalIK, skel: Skeleton) -> OwnClip:
+def canonical_clip(raw: RawClip, mapping: Mapping, fps: float, ik: CanonicalIK, skel: Skeleton) -> MappedClip:
     points = resample_points(to_canonical(raw.positions, mapping.humanoid.source, mapping.scale), raw.fps, fps)
     local = local_rotations(ik.solve(points), skel.parents)
     root = points[:, 0].copy()
     clip = CanonicalClip(raw.name, fps, root, matrix_to_quat(local), forward_kinematics_matrices(skel, root, local))
     clip = put_on_floor(clip, skel)
-    return OwnClip(raw.name, raw.fps, clip.root, clip.rotations, clip.positions, clip_contacts(clip))
+    contacts = contacts_for(clip.positions, skel.joints, fps, FOOT_POINTS)
+    return MappedClip(raw.name, raw.fps, clip.root, clip.rotations, clip.positions, contacts)
 
 
 def make_ik(skel: Skeleton | None = None) -> CanonicalIK:

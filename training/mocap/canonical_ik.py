@@ -10,15 +10,16 @@ hand segments) stay at their reference, as in training.
 
 One difference from the page: the page scans the whole turn on a stream's first frame only and then searches near the
 last frame's twist; here every frame gets the whole scan (frames are solved together), then the same golden-section
-refinement. tests/python/test_own.py checks the rows it gives against tests/fixtures/feature_encoding.json within the
+refinement. Used by training.own (a user's folder) and training/data/bandai.py (the Bandai Namco set).
+tests/python/test_own.py checks the rows it gives against tests/fixtures/feature_encoding.json within the
 tolerances the page's IK is held to.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ..data.features import FIXED_JOINTS, matrix_to_rotvec
-from ..mocap.skeleton import Skeleton
+from .rotations import matrix_to_rotvec
+from .skeleton import FIXED_JOINTS, Skeleton
 
 TWIST_SCAN = np.pi / 12  # coarse scan step (rad), as on the page
 GOLDEN_STEPS = 16
