@@ -25,6 +25,7 @@ interface Fixture {
   };
   amc: ClipParity & { asf: string; amc: string };
   bvh: ClipParity & { file: string };
+  bvh_bandai: ClipParity & { file: string };
 }
 
 /** Largest distance between our positions and the fixture's, over its frames and joints (by name). */
@@ -66,5 +67,11 @@ describe.skipIf(!repoFileExists(FIXTURE))('parity with the Python loader', () =>
     const m = parseBVH(readCorpus(fixture.bvh.file));
     expect(m.joints).toEqual(expect.arrayContaining(fixture.bvh.joints));
     expect(maxError(m, fixture.bvh)).toBeLessThan(TOLERANCE);
+  });
+
+  it('parseBVH matches on a Bandai Namco file (position channels on every joint, centimetres detected)', () => {
+    const m = parseBVH(readCorpus(fixture.bvh_bandai.file));
+    expect(m.joints).toEqual(expect.arrayContaining(fixture.bvh_bandai.joints));
+    expect(maxError(m, fixture.bvh_bandai)).toBeLessThan(TOLERANCE);
   });
 });

@@ -2,7 +2,9 @@
 
 Local rotation of a joint is the product of its rotation channels in the listed order
 (e.g. "Zrotation Yrotation Xrotation" gives Rz @ Ry @ Rx); G_j = G_parent @ R_j and
-p_j = p_parent + G_parent @ OFFSET_j. Positions stay in the file's units.
+p_j = p_parent + G_parent @ OFFSET_j. Position channels move the root from its OFFSET; on any other joint they take
+the OFFSET's place (the Bandai Namco files give every joint position channels equal to its OFFSET, the hips' carrying
+the translation), as the page's reader does (web/motion/bvh.ts poseNodes). Positions stay in the file's units.
 """
 from __future__ import annotations
 
@@ -175,9 +177,11 @@ def global_transforms(clip: BvhClip) -> tuple[np.ndarray, np.ndarray]:
         rot_axes = "".join(c[0] for c in joint.channels if c.endswith("rotation"))
         rot_vals = np.radians(vals[:, [i for i, c in enumerate(joint.channels) if c.endswith("rotation")]])
         local_r = euler_matrix(rot_vals, rot_axes, intrinsic=True) if rot_axes else np.broadcast_to(np.eye(3), (frames, 3, 3))
-        for i, c in enumerate(joint.channels):
-            if c.endswith("position"):
-                local_t[:, "xyz".index(c[0])] += vals[:, i]
+        moves = [(i, "xyz".index(c[0])) for i, c in enumerate(joint.channels) if c.endswith("position")]
+        if moves and joint.parent >= 0:
+            local_t[:] = 0.0  # a non-root joint's position channels replace its offset
+        for i, axis in moves:
+            local_t[:, axis] += vals[:, i]
         if joint.parent < 0:
             rots[:, j] = local_r
             pos[:, j] = local_t
