@@ -1,4 +1,5 @@
-"""Measure the corpus on the canonical skeleton and write docs/data.md (training/data/statistics.py).
+"""Measure the corpus on the canonical skeleton and write docs/data.md (training/data/statistics.py): every CMU clip,
+then the combined locomotion corpus from the CMU and Bandai Namco caches (built first when missing).
 
     python -m training.data.report [--mocap DIR]
 """
@@ -7,7 +8,9 @@ from __future__ import annotations
 import argparse
 
 from ..paths import REPO_ROOT, add_mocap_argument, resolve_mocap_dir
-from .statistics import corpus_statistics, data_report
+from .bandai import load_clips as load_bandai_clips
+from .locomotion import load_clips as load_cmu_clips
+from .statistics import corpus_statistics, data_report, locomotion_report
 
 OUT = REPO_ROOT / "docs" / "data.md"
 
@@ -15,8 +18,10 @@ OUT = REPO_ROOT / "docs" / "data.md"
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_mocap_argument(parser)
-    mocap = resolve_mocap_dir(parser.parse_args(argv).mocap)
-    OUT.write_text(data_report(corpus_statistics(mocap)))
+    flag = parser.parse_args(argv).mocap
+    mocap = resolve_mocap_dir(flag)
+    combined = locomotion_report(load_cmu_clips(flag), load_bandai_clips(flag))
+    OUT.write_text(data_report(corpus_statistics(mocap)) + "\n" + combined)
     print(f"wrote {OUT}")
 
 
