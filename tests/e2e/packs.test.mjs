@@ -96,6 +96,11 @@ describe('model packs', { timeout: 900_000 }, () => {
       assert.ok(walk.finite, 'finite frames');
       const seedNames = packJson().seeds.map((s) => s.name);
       assert.deepEqual(walk.seeds.slice(1), seedNames, "the seed states are the pack's own");
+      // The header names the pack's model, and the sliding readout compares with the pack's own held-out clips.
+      const labels = await page.evaluate(() => ({ reference: $ui('walk-skating-reference').textContent, header: document.querySelector('motion-playground').shadowRoot.textContent }));
+      assert.equal(labels.reference, `your held-out clips: ${packJson().pack.measures.real.sliding_low_foot.toFixed(2)} m/s`);
+      assert.match(labels.header, /my-walks · 30 fps · live/);
+      assert.deepEqual(await page.evaluate(() => [$ui('walk-refine').disabled, $ui('walk-refine').title]), [true, 'Your model has no refiner']);
 
       // Its card, from the Path picker.
       await page.evaluate(() => {

@@ -9,6 +9,8 @@ export interface GeneratorInfo {
   id: string;
   kind: string;
   fps: number;
+  /** A user's pack (python -m training.own): its card's measurements; `real.sliding_low_foot` is its held-out clips' sliding, m/s. */
+  pack?: { measures?: { real?: { sliding_low_foot?: number } } };
   /** ONNX file name, relative to the JSON. */
   file: string;
   description?: string;

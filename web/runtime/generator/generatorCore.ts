@@ -85,6 +85,7 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
       parents: info.skeleton.parents,
       dim: info.onnx.dim,
       seeds: info.seeds.map((s) => s.name),
+      ...(typeof info.pack?.measures?.real?.sliding_low_foot === 'number' ? { heldOutSliding: info.pack.measures.real.sliding_low_foot } : {}),
     };
   }
 

@@ -20,6 +20,8 @@ export type StreamParams = Omit<GenerateParams, 'frames'>;
 export interface InitResult extends ModelInit {
   dim: number;
   seeds: string[];
+  /** The real held-out clips' foot sliding (lowest foot point, m/s) a user's pack measured on its card; absent for shipped models. */
+  heldOutSliding?: number;
 }
 
 /** A decoded run of generated frames. */

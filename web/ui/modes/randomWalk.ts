@@ -17,6 +17,8 @@ const DEFAULT_TEMPERATURE = 0.5;
 /** Seconds of motion up to the playhead the skating readout averages over. */
 export const SKATING_SECONDS = 5;
 const LABELS = { main: 'refined + foot lock', companion: 'raw' };
+/** The sliding readout's reference for the shipped models (docs/models/refiner.md, held-out CMU walks). */
+const CMU_HELD_OUT_SLIDING = 'real held-out walks: 0.26 m/s';
 
 /** A pulled chunk as the window shows it: with refine, positions and contacts are the refined ones and `raw` the generator's. */
 type WalkChunk = GeneratedMotion & { raw?: { positions: Float32Array; contacts: Uint8Array; rootHeading: Float32Array } };
@@ -50,6 +52,7 @@ export class RandomWalk extends LiveMode<WalkChunk> {
   private readonly skating = $('walk-skating');
   private readonly skatingRaw = $('walk-skating-raw');
   private readonly skatingRefined = $('walk-skating-refined');
+  private readonly skatingReference = $('walk-skating-reference');
 
   constructor(app: ModeHost) {
     // 1 s chunks at 30 fps, at least 1.5 s ahead, 20 s kept.
@@ -120,6 +123,14 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     const walker = (this.model.value && registry.can(this.model.value, 'walk') ? registry.find(this.model.value) : undefined) ?? registry.defaultFor('walk');
     if (!walker) throw new Error('no model for Random walk is listed in models/index.json');
     const id = walker.info.id;
+    // A user's pack (its files are its own) has no refiner trained for it: refine and side by side are off for it.
+    const noRefiner = walker.info.files !== undefined;
+    this.refine.disabled = this.sideBySide.disabled = noRefiner;
+    this.refine.title = this.sideBySide.title = noRefiner ? 'Your model has no refiner' : '';
+    if (noRefiner && this.refine.checked) {
+      this.refine.checked = this.sideBySide.checked = false;
+      this.showCompanion();
+    }
     const { client } = await this.app.host(id).load();
     if (!(client instanceof GeneratorClient)) throw new Error(`model "${id}" cannot stream a random walk`);
     const info = client.initResult;
@@ -135,7 +146,9 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     this.walkSkeleton = info;
     this.raw = null;
     this.aligner = params.refine ? new CompanionAligner(info.joints.length, info.fps) : null;
-    const name = walker.descriptor.shortName;
+    const name = registry.shortName(id);
+    // The readout's reference: the CMU held-out walks for the shipped models, a pack's own held-out clips (its card).
+    this.skatingReference.textContent = info.heldOutSliding === undefined ? CMU_HELD_OUT_SLIDING : `your held-out clips: ${info.heldOutSliding.toFixed(2)} m/s`;
     this.app.setLiveLabel('Random walk', params.refine ? `${name} + refiner · 30 fps · live` : `${name} · 30 fps · live`);
     const pull = async (frames: number): Promise<WalkChunk> => {
       const m = await client.pull(frames, { signal });
