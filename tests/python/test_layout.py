@@ -112,6 +112,7 @@ MAY_IMPORT = {
     "latent_erd": {"mocap", "data", "models", "autoencoder", "control", "generator"} | SHARED,
     "vae_lstm": {"mocap", "data", "models", "control", "latent_erd"} | SHARED,
     "own": {"mocap", "data", "models", "generator", "aclstm"} | SHARED,
+    "style_generator": {"mocap", "data", "models", "generator", "refiner"} | SHARED,
     "bench": {"models"} | SHARED,
     "fixtures": {"mocap", "data", "models", "generator", "refiner", "aclstm", "control", "autoencoder", "latent_erd", "own"} | SHARED,
 }

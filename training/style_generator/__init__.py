@@ -1,0 +1,1 @@
+"""The style-conditioned locomotion generator (issue 39): train, pilot measures."""
