@@ -21,8 +21,9 @@ FIGURES = {"generator": "generator.png", "refiner": "refiner.png", "aclstm": "ac
 # refiner-notes.md and refiner-browser.md are parts of refiner.md, which its writer copies in; aclstm-pilots.md is the
 # acLSTM's pilot runs (history, linked from aclstm.md, written by training/aclstm/pilots.py); weights.md measures how
 # every model's weights are stored (linked from the generator and acLSTM reports); retarget.md measures retargeting onto
-# characters' own rigs (web/motion/retarget.ts, no model; written by npm run evaluate:retarget).
-NOT_REPORTS = ["refiner-notes", "refiner-browser", "aclstm-pilots", "weights", "retarget"]
+# characters' own rigs (web/motion/retarget.ts, no model; written by npm run evaluate:retarget); style-generator.md is
+# the style-conditioned generator's pilots (issue 39, not shipped; from python -m training.style_generator.pilot's JSON).
+NOT_REPORTS = ["refiner-notes", "refiner-browser", "aclstm-pilots", "weights", "retarget", "style-generator"]
 SUMMARY_LABELS = ["What it does", "In the page", None, None, "Not met"]
 LONGEST_CELL = 200
 

@@ -25,6 +25,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--checkpoint", type=Path, default=None, help="a style-generator checkpoint (none: the shipped generator only)")
     parser.add_argument("--frames", type=int, default=PILOT_FRAMES, help="frames per seed and stream set")
     parser.add_argument("--steps", type=int, default=None, help="classifier training steps (default 1,500, the report's)")
+    parser.add_argument("--classifier-seeds", type=int, default=1, help="classifiers per test (the report uses 3)")
     parser.add_argument("--styles", default=",".join(STYLES), help="styles the style generator is sampled in")
     parser.add_argument("--out", type=Path, default=REPORTS_DIR / "style-generator-pilot.json")
     parser.add_argument("--mocap", default=None)
@@ -38,7 +39,8 @@ def main(argv: list[str] | None = None) -> None:
             raise SystemExit(f"error: no checkpoint at {args.checkpoint}")
         cands.append(style_candidate(args.checkpoint))
         styles[cands[1].name] = [s for s in args.styles.split(",") if s]
-    result = measure(cands, styles, args.frames, steps=args.steps, mocap=args.mocap)
+    result = measure(cands, styles, args.frames, steps=args.steps, mocap=args.mocap,
+                     classifier_seeds=args.classifier_seeds)
     result["checkpoint"] = str(args.checkpoint) if args.checkpoint else None
     args.out.write_text(json.dumps(result, indent=1) + "\n")
     print(f"wrote {args.out} ({result['minutes']:.1f} min)")

@@ -10,7 +10,7 @@ refiner, no foot lock), both models sampled the same way:
   normalise differently; both encode with the shipped rotation references, so the features are the same);
 - the refiner report's two-sample test (refiner/measures.py: window and single-frame classifiers trained on real
   training windows of the style against stream set B, scored on its held-out clips against stream set A), cut down as
-  refiner/pilots.py cuts it: one classifier seed, PILOT_FRAMES per seed;
+  refiner/pilots.py cuts it: one classifier seed (or the mean of --classifier-seeds), PILOT_FRAMES per seed;
 - the hip-bob probe (docs/models/refiner.md, "What gives generated walking away"): the amplitude spectrum of the hips'
   vertical velocity in the classifier's 32-frame windows (mean removed per window; bins of 0.94 Hz), at 0.94 Hz (slow
   change) and 2.81 Hz (the step's bob), and the mean above 5 Hz (noise); and the hips' height spread (sd within each
@@ -213,7 +213,7 @@ def physical_nll(cand: Candidate, clips: list[StyledClip], style: str) -> float:
 
 
 def measure(cands: list[Candidate], styles_by_cand: dict[str, list[str]], frames: int = PILOT_FRAMES,
-            classifier_seed: int = 0, steps: int | None = None, mocap: str | None = None,
+            classifier_seed: int = 0, steps: int | None = None, mocap: str | None = None, classifier_seeds: int = 1,
             log=lambda line: print(line, flush=True)) -> dict:
     """Every measure above, for each candidate on each of its styles (the shipped one: CMU only, since it has no
     style input; its NLL on every style all the same)."""
@@ -221,7 +221,7 @@ def measure(cands: list[Candidate], styles_by_cand: dict[str, list[str]], frames
     clips = load_styled_clips(mocap)
     fps = 30.0
     out = {"frames_per_seed": frames, "temperature": TEMPERATURE, "noise_correlation": 0.8,
-           "classifier_seed": classifier_seed, "classifier_steps": steps or 1500, "real": {}, "models": {}}
+           "classifier_seed": classifier_seed, "classifier_seeds": classifier_seeds, "classifier_steps": steps or 1500, "real": {}, "models": {}}
     codec = cands[0].codec  # both candidates encode with the shipped references: the real motion is the same
     real_cache = {}
     for style in STYLES:
@@ -249,10 +249,13 @@ def measure(cands: list[Candidate], styles_by_cand: dict[str, list[str]], frames
             real_test, real_summ = real_cache[style]
             real_train = windows(training_frames(codec, clips, style, fps))
             test_w, train_w = motion_windows(var_a, fps), motion_windows(var_b, fps)
-            acc = {kind: two_sample_accuracy(real_train, train_w, real_test, test_w, classifier_seed, steps=steps,
-                                             kind=kind)["balanced_accuracy"] for kind in ("window", "frame")}
+            runs = {kind: [two_sample_accuracy(real_train, train_w, real_test, test_w, classifier_seed + k, steps=steps,
+                                               kind=kind)["balanced_accuracy"] for k in range(classifier_seeds)]
+                    for kind in ("window", "frame")}
+            acc = {kind: float(np.mean(v)) for kind, v in runs.items()}
             line = real_summ.get("pose_change_median")
-            r = {"seeds": [n for s, n in names if s == style], "two_sample": acc, "hip_bob": hip_bob(test_w, fps),
+            r = {"seeds": [n for s, n in names if s == style], "two_sample": acc, "two_sample_runs": runs,
+                 "hip_bob": hip_bob(test_w, fps),
                  **motion_summary(var_a, fps, FREEZE_FRACTION * line if line else None),
                  "windows": {"real_train": len(real_train), "real_test": len(real_test), "generated": len(test_w)}}
             m["styles"][style] = r
