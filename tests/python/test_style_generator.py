@@ -101,3 +101,11 @@ def test_each_style_is_drawn_equally_often(corpus_clips):
     # within a style, in proportion to the (weighted) frames
     w = sampling_weights(np.array([0, 0, 1]), np.array([1.0, 3.0, 5.0]))
     assert np.allclose(w, [0.125, 0.375, 0.5])
+    # or CMU with a share of its own, the Bandai styles splitting the rest
+    w = sampling_weights(np.array([0, 0, 1, 2]), np.array([1.0, 3.0, 5.0, 1.0]), cmu_share=0.5)
+    assert np.allclose(w, [0.125, 0.375, 0.25, 0.25])
+    corpus = StyleCorpus(clips, speed_factors=(1.0,), mirror=False, cmu_share=0.25)
+    assert np.isclose(corpus.weights[corpus.train_styles == 0].sum(), 0.25)
+    assert np.allclose([corpus.weights[corpus.train_styles == s].sum() for s in range(1, len(STYLES))], 0.75 / 7)
+    with pytest.raises(ValueError, match="cmu_share"):
+        sampling_weights(np.array([1, 2]), np.array([1.0, 1.0]), cmu_share=0.5)

@@ -11,7 +11,8 @@ frames, with CMU's running drawn RUN_WEIGHT times as often as the Corpus draws i
 Bandai's running is 22% of each style already, so it keeps its share). Why equal shares: every style is measured on
 its own (held-out NLL, two-sample test, the style check), so each embedding needs about as many updates. Drawing by
 frames would hardly differ for the Bandai styles (11.5-12.5 minutes each, 11-12% of the frames) and would give CMU 20%;
-equal shares keep CMU at 12.5%, which is still more CMU windows in a 150-minute run than the shipped generator saw.
+equal shares keep CMU at 12.5%. `cmu_share` gives CMU another share of the windows (the Bandai styles split the rest
+equally), for a run in which the CMU style must keep up with the shipped CMU-only generator.
 """
 from __future__ import annotations
 
@@ -60,7 +61,7 @@ class StyleCorpus:
     encode with (default: fitted to the training clips, as the Corpus does)."""
 
     def __init__(self, clips: list[StyledClip], references: np.ndarray | None = None,
-                 speed_factors=SPEED_FACTORS, mirror: bool = True):
+                 speed_factors=SPEED_FACTORS, mirror: bool = True, cmu_share: float | None = None):
         train = [c for c in clips if not is_validation(c.clip)]
         held = [c for c in clips if is_validation(c.clip)]
         self.codec = FeatureCodec(references=references)
@@ -80,7 +81,7 @@ class StyleCorpus:
         self.std = np.maximum(allx.std(axis=0), 1e-2)
         self.train = [self.normalise(s) for s in seqs]
         self.train_styles = np.array(styles)
-        self.weights = sampling_weights(self.train_styles, np.array(frames))
+        self.weights = sampling_weights(self.train_styles, np.array(frames), cmu_share)
         self.valid = [self.normalise(self.codec.encode(c.clip.root, c.clip.rotations, c.clip.contacts)) for c in held]
         self.valid_styles = np.array([c.style_id for c in held])
         self.valid_contents = [c.content for c in held]
@@ -106,11 +107,15 @@ class StyleCorpus:
         return torch.from_numpy(x), torch.from_numpy(mask), torch.from_numpy(self.train_styles[picks].astype(np.int64))
 
 
-def sampling_weights(styles: np.ndarray, frames: np.ndarray) -> np.ndarray:
-    """Each style present gets an equal share; within a style, sequences in proportion to `frames` (already weighted)."""
+def sampling_weights(styles: np.ndarray, frames: np.ndarray, cmu_share: float | None = None) -> np.ndarray:
+    """Each style present gets an equal share (or CMU, style 0, `cmu_share` and the others equal shares of the rest);
+    within a style, sequences in proportion to `frames` (already weighted)."""
     w = np.zeros(len(styles))
     present = np.unique(styles)
+    if cmu_share is not None and not (0 < cmu_share < 1 and 0 in present and len(present) > 1):
+        raise ValueError(f"cmu_share {cmu_share}: needs CMU and another style, and a share between 0 and 1")
     for s in present:
         sel = styles == s
-        w[sel] = frames[sel] / frames[sel].sum() / len(present)
+        share = 1 / len(present) if cmu_share is None else cmu_share if s == 0 else (1 - cmu_share) / (len(present) - 1)
+        w[sel] = frames[sel] / frames[sel].sum() * share
     return w

@@ -25,6 +25,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--window", type=int, default=50)
     parser.add_argument("--lr", type=float, default=1e-3)
     parser.add_argument("--dropout", type=float, default=0.25)
+    parser.add_argument("--cmu-share", type=float, default=None,
+                        help="CMU's share of the windows (default: every style equally often, 1/8)")
     parser.add_argument("--fit-references", action="store_true",
                         help="fit the rotation references to the training clips instead of the shipped generator's")
     args = parser.parse_args(argv)

@@ -5,7 +5,7 @@ The generator's recipe (training/generator/training.py, Wang, Chai, Xia §4.1.3:
 decayed by 0.95 per epoch of --iters-per-epoch, gradients clipped to [-5, 5], batches of 20 windows of 50 frames,
 dropout 0.25) on data/style_locomotion.py's StyleCorpus, with one learned embedding per style (CMU is style 0, Bandai's
 seven are 1-7) concatenated to the input frame at every step (models/generator.py MixtureLSTM(styles=8)). Windows are
-drawn with each style equally often (StyleCorpus). Validation: mean NLL per frame over the held-out clips of each
+drawn with each style equally often (StyleCorpus), or CMU's windows with --cmu-share. Validation: mean NLL per frame over the held-out clips of each
 style (teacher forcing, no noise), and their mean over styles, which picks best.pt.
 
 The rotation references are the shipped generator's (public/models/generator.json) unless --fit-references: the CMU
@@ -87,7 +87,7 @@ def train_style_generator(args: argparse.Namespace) -> tuple[float, Path]:
     loop = TrainingLoop(args)
     run = loop.run
     references = None if args.fit_references else shipped_references()
-    corpus = StyleCorpus(load_styled_clips(args.mocap), references)
+    corpus = StyleCorpus(load_styled_clips(args.mocap), references, cmu_share=args.cmu_share)
     dim = corpus.mean.shape[0]
     model = MixtureLSTM(dim, args.hidden, dropout=args.dropout, styles=len(STYLES), style_dim=args.style_dim)
     optimiser = torch.optim.RMSprop(model.parameters(), lr=args.lr, alpha=0.9)
