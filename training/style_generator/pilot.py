@@ -17,7 +17,7 @@ import torch
 
 from ..data.style_locomotion import STYLES
 from ..paths import REPORTS_DIR
-from .pilots import PILOT_FRAMES, measure, shipped_candidate, style_candidate
+from .pilots import PILOT_FRAMES, TEMPERATURE, measure, shipped_candidate, style_candidate
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -26,6 +26,7 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--frames", type=int, default=PILOT_FRAMES, help="frames per seed and stream set")
     parser.add_argument("--steps", type=int, default=None, help="classifier training steps (default 1,500, the report's)")
     parser.add_argument("--classifier-seeds", type=int, default=1, help="classifiers per test (the report uses 3)")
+    parser.add_argument("--temperature", type=float, default=TEMPERATURE, help="sampling temperature of both models (the page's 0.5)")
     parser.add_argument("--styles", default=",".join(STYLES), help="styles the style generator is sampled in")
     parser.add_argument("--out", type=Path, default=REPORTS_DIR / "style-generator-pilot.json")
     parser.add_argument("--mocap", default=None)
@@ -40,7 +41,7 @@ def main(argv: list[str] | None = None) -> None:
         cands.append(style_candidate(args.checkpoint))
         styles[cands[1].name] = [s for s in args.styles.split(",") if s]
     result = measure(cands, styles, args.frames, steps=args.steps, mocap=args.mocap,
-                     classifier_seeds=args.classifier_seeds)
+                     classifier_seeds=args.classifier_seeds, temperature=args.temperature)
     result["checkpoint"] = str(args.checkpoint) if args.checkpoint else None
     args.out.write_text(json.dumps(result, indent=1) + "\n")
     print(f"wrote {args.out} ({result['minutes']:.1f} min)")

@@ -214,13 +214,14 @@ def physical_nll(cand: Candidate, clips: list[StyledClip], style: str) -> float:
 
 def measure(cands: list[Candidate], styles_by_cand: dict[str, list[str]], frames: int = PILOT_FRAMES,
             classifier_seed: int = 0, steps: int | None = None, mocap: str | None = None, classifier_seeds: int = 1,
+            temperature: float = TEMPERATURE,
             log=lambda line: print(line, flush=True)) -> dict:
     """Every measure above, for each candidate on each of its styles (the shipped one: CMU only, since it has no
     style input; its NLL on every style all the same)."""
     t0 = time.perf_counter()
     clips = load_styled_clips(mocap)
     fps = 30.0
-    out = {"frames_per_seed": frames, "temperature": TEMPERATURE, "noise_correlation": 0.8,
+    out = {"frames_per_seed": frames, "temperature": temperature, "noise_correlation": 0.8,
            "classifier_seed": classifier_seed, "classifier_seeds": classifier_seeds, "classifier_steps": steps or 1500, "real": {}, "models": {}}
     codec = cands[0].codec  # both candidates encode with the shipped references: the real motion is the same
     real_cache = {}
@@ -240,7 +241,7 @@ def measure(cands: list[Candidate], styles_by_cand: dict[str, list[str]], frames
                 seeds.append((STYLES.index(style) if cand.styled else 0, x))
                 names.append((style, name))
         start = initial_states(cand, seeds)
-        streams = [sample(cand, start, frames, np.random.default_rng(s)) for s in STREAM_SEEDS]
+        streams = [sample(cand, start, frames, np.random.default_rng(s), temperature) for s in STREAM_SEEDS]
         log(f"{cand.name}: sampled {len(seeds)} streams x {frames} frames x 2 sets ({(time.perf_counter() - t0) / 60:.1f} min)")
         for style in measured:
             rows = [k for k, (s, _) in enumerate(names) if s == style]
