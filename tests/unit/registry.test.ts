@@ -100,6 +100,22 @@ describe('the model registry', () => {
     expect(registry.label('aclstm-vanilla')).toBe('vanilla LSTM (baseline)');
   });
 
+  it('says what each shipped model was trained on and under what licence; a non-commercial model is labelled so', () => {
+    const registry = new Registry(MANIFEST);
+    for (const m of MANIFEST) {
+      expect(m.data, m.id).toMatch(/CMU/);
+      expect(m.licence, m.id).toMatch(/free for research and commercial use/);
+      expect(m.commercial, m.id).toBe(true);
+    }
+    expect(registry.provenance('generator')).toMatch(/^Trained on CMU motion capture .*\. Licence: CMU .*commercial use\.$/);
+    const styled: ModelInfo = { ...MANIFEST.find((m) => m.id === 'generator')!, id: 'styled', data: 'CMU and Bandai Namco', licence: 'CC BY-NC 4.0', commercial: false };
+    const withStyled = new Registry([...MANIFEST, styled]);
+    expect(withStyled.label('styled')).toBe('styled (non-commercial)');
+    expect(withStyled.ids('walk')).toEqual(['generator', 'styled']); // the CMU-only model stays the default
+    expect(() => parseManifest({ models: [{ ...styled, commercial: 'no' }] })).toThrow(/commercial must be true or false/);
+    expect(() => parseManifest({ models: [{ ...styled, licence: 4 }] })).toThrow(/licence must be a string/);
+  });
+
   it('offers a new kind as soon as the manifest lists a model of it and its folder describes it', () => {
     const dancer = { ...descriptorsByKind().get('aclstm')!, kind: 'test-dancer', shortName: 'test dancer' } satisfies ModelDescriptor;
     const kinds = descriptorsByKind({ './test_dancer/descriptor.ts': { descriptor: dancer }, ...Object.fromEntries([...descriptorsByKind()].map(([k, d]) => [`./${k}/descriptor.ts`, { descriptor: d }])) });

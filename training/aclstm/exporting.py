@@ -30,7 +30,8 @@ FIXTURE = REPO_ROOT / "tests" / "fixtures" / "aclstm_reference.json"
 def load_dance_model(checkpoint: Path) -> tuple[DanceLSTM, dict, dict]:
     state = torch.load(checkpoint, weights_only=False)
     meta = state["meta"]
-    model = DanceLSTM(meta["dim"], len(meta["styles"]), meta["hidden"], meta["layers"], meta.get("head", "mean"))
+    model = DanceLSTM(meta["dim"], len(meta["styles"]), meta["hidden"], meta["layers"], meta.get("head", "mean"),
+                       meta.get("components", 10))
     model.load_state_dict(state["model"])
     return model.eval(), meta, state
 
@@ -131,7 +132,7 @@ def _publish(info: dict, onnx_path: Path, model_id: str, out: Path) -> None:
         write_reference_fixture(onnx_path, info)
     if out == MODELS_DIR:
         register_model({"id": model_id, "kind": "aclstm", "skeleton": "aclstm-standard", "fps": info["fps"],
-                        "styles": info["styles"], "bytes": info["bytes"], "file": info["file"]})
+                        "styles": info["styles"], "bytes": info["bytes"], "file": info["file"]}, "aclstm-dance")
 
 
 def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | None, weights: str = "int8",

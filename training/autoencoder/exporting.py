@@ -172,7 +172,7 @@ def export_autoencoder(model: MotionAutoencoder, meta: dict, corpus: WindowCorpu
     (out / "manifold.json").write_text(json.dumps(info) + "\n")
     if out == MODELS_DIR:
         register_model({"id": "manifold", "kind": "autoencoder", "skeleton": "cmu-canonical", "fps": meta["fps"],
-                        "bytes": info["bytes"], "file": "manifold-decoder.onnx", "files": info["files"]})
+                        "bytes": info["bytes"], "file": "manifold-decoder.onnx", "files": info["files"]}, "cmu-locomotion")
     print(f"wrote {encoder_path}, {decoder_path} ({info['bytes'] / 1e6:.2f} MB, {weights}), parity {parity}, "
           f"held-out reconstruction {info['report']['reconstruction_cm_clean']} cm")
     return info

@@ -127,7 +127,7 @@ def rewrite_generator(source: Path, out: Path, weights: str) -> Path:
         codec = FeatureCodec(canonical_skeleton(), quat_to_matrix(np.array(info["features"]["references"], np.float64)))
         write_reference_fixture(onnx_path, info, codec)
         register_model({"id": "generator", "kind": info["kind"], "skeleton": "cmu-canonical", "fps": info["fps"],
-                        "bytes": info["bytes"], "file": info["file"]})
+                        "bytes": info["bytes"], "file": info["file"]}, "cmu-locomotion")
     return onnx_path
 
 
@@ -183,5 +183,5 @@ def export_generator(checkpoint: Path, out: Path, mocap: str | None, weights: st
     if out == MODELS_DIR:  # a candidate exported elsewhere must not replace the shipped model's fixture
         write_reference_fixture(onnx_path, info, codec)
         register_model({"id": "generator", "kind": info["kind"], "skeleton": "cmu-canonical", "fps": info["fps"],
-                        "bytes": info["bytes"], "file": info["file"]})
+                        "bytes": info["bytes"], "file": info["file"]}, "cmu-locomotion")
     return onnx_path

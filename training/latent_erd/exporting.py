@@ -188,7 +188,7 @@ def _publish(info: dict, out: Path, norm: Normalisation) -> None:
     if out == MODELS_DIR:
         write_reference_fixture(path, out / "manifold-decoder.onnx", info, norm)
         register_model({"id": "latent-erd", "kind": "latent-erd", "skeleton": "cmu-canonical", "fps": info["fps"],
-                        "bytes": info["bytes"], "file": path.name})
+                        "bytes": info["bytes"], "file": path.name}, "cmu-locomotion")
 
 
 def _write_step(erd: ControlERD, path: Path, weights: str) -> dict:

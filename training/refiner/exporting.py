@@ -178,5 +178,5 @@ def export_refiner(checkpoint: Path, out: Path) -> Path:
     if out == MODELS_DIR:
         write_fixture(model, onnx_path, frames, info)
         register_model({"id": "refiner", "kind": "refiner", "skeleton": "cmu-canonical", "fps": info["fps"],
-                        "bytes": info["bytes"], "file": info["file"]})
+                        "bytes": info["bytes"], "file": info["file"]}, "cmu-locomotion")
     return onnx_path

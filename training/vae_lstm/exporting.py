@@ -241,7 +241,7 @@ def _publish(info: dict, stored: VaeLstm, out: Path) -> None:
     (out / "vae-lstm.json").write_text(json.dumps(info) + "\n")
     if out.resolve() == MODELS_DIR.resolve():
         register_model({"id": "vae-lstm", "kind": "vae-lstm", "skeleton": "cmu-canonical", "fps": info["fps"],
-                        "bytes": info["bytes"], "file": FILES["cell"], "files": FILES})
+                        "bytes": info["bytes"], "file": FILES["cell"], "files": FILES}, "cmu-locomotion")
         write_fixture(stored, info)
     print(f"wrote {', '.join(FILES.values())} in {out} ({info['bytes'] / 1e6:.2f} MB, {info['weights']}), "
           f"parity {info['parity_max_abs']}")

@@ -16,6 +16,11 @@ export interface ModelInfo {
   files?: { model: string; info: string };
   /** The pickers' label of such a model. */
   label?: string;
+  /** What it learnt from, and that data's terms (training/onnx/manifest.py TRAINED_ON); shown by the pickers. */
+  data?: string;
+  licence?: string;
+  /** False for a model trained on non-commercial data (the Bandai Namco set): labelled so wherever it is offered. */
+  commercial?: boolean;
 }
 
 export class ManifestError extends ModelInfoError {
@@ -32,7 +37,7 @@ export function parseManifest(raw: unknown, source = 'models/index.json'): Model
   return models.map((m: Record<string, unknown> | null, i) => {
     const entry = `entry ${i}${typeof m?.file === 'string' ? ` (${quoteInput(m.file)})` : ''}`;
     if (typeof m !== 'object' || m === null) return fail(`${entry} must be an object, got ${describeValue(m)}`);
-    const { id, kind, skeleton, fps, bytes, styles } = m;
+    const { id, kind, skeleton, fps, bytes, styles, data, licence, commercial } = m;
     if (typeof id !== 'string' || typeof kind !== 'string' || typeof skeleton !== 'string' || typeof fps !== 'number' || typeof bytes !== 'number') {
       return fail(`${entry} needs id, kind, skeleton (strings), fps and bytes (numbers)`);
     }
@@ -40,8 +45,15 @@ export function parseManifest(raw: unknown, source = 'models/index.json'): Model
     if (styles !== undefined && !(Array.isArray(styles) && styles.every((s) => typeof s === 'string'))) {
       fail(`${entry}: styles must be an array of strings, got ${describeValue(styles)}`);
     }
+    for (const [name, value] of [['data', data], ['licence', licence]] as const) {
+      if (value !== undefined && typeof value !== 'string') fail(`${entry}: ${name} must be a string, got ${describeValue(value)}`);
+    }
+    if (commercial !== undefined && typeof commercial !== 'boolean') fail(`${entry}: commercial must be true or false, got ${describeValue(commercial)}`);
     const info: ModelInfo = { id, kind, skeleton, fps, bytes };
     if (styles) info.styles = [...(styles as string[])];
+    if (typeof data === 'string') info.data = data;
+    if (typeof licence === 'string') info.licence = licence;
+    if (typeof commercial === 'boolean') info.commercial = commercial;
     return info;
   });
 }

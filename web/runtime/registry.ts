@@ -87,9 +87,16 @@ export class Registry {
     return m?.info.label ? id : (m?.descriptor.shortName ?? id); // a user's pack by its own name
   }
 
-  /** The picker's label of model `id`. */
+  /** The picker's label of model `id`; a model trained on non-commercial data says so. */
   label(id: string): string {
     const m = this.find(id);
-    return m?.info.label ?? m?.descriptor.labels?.[id] ?? id;
+    const label = m?.info.label ?? m?.descriptor.labels?.[id] ?? id;
+    return m?.info.commercial === false ? `${label} (non-commercial)` : label;
+  }
+
+  /** The picker's tooltip of model `id`: what it was trained on and under what terms ("" when the entry does not say). */
+  provenance(id: string): string {
+    const info = this.find(id)?.info;
+    return [info?.data && `Trained on ${info.data}.`, info?.licence && `Licence: ${info.licence}.`].filter(Boolean).join(' ');
   }
 }

@@ -99,7 +99,7 @@ export function readPack(files: readonly PackFile[], taken: readonly string[]): 
   const onnxName = typeof raw.file === 'string' ? baseName(raw.file) : `${id}.onnx`;
   const onnx = files.find((f) => f.name === onnxName);
   if (!onnx) throw new PackError(`the pack has no ${onnxName} (named by ${chosen.f.name})`);
-  const pack = (raw.pack ?? {}) as { card?: unknown; thumbnail?: unknown };
+  const pack = (raw.pack ?? {}) as { card?: unknown; thumbnail?: unknown; data_folder?: unknown; data_minutes?: unknown };
   const cardName = typeof pack.card === 'string' ? baseName(pack.card) : 'card.md';
   const thumbName = typeof pack.thumbnail === 'string' ? baseName(pack.thumbnail) : 'pose_change.png';
   const card = files.find((f) => f.name === cardName);
@@ -114,6 +114,8 @@ export function readPack(files: readonly PackFile[], taken: readonly string[]): 
     bytes: onnx.bytes.length,
     files: { model: blobUrl(onnx.bytes, 'application/octet-stream', urls), info: blobUrl(chosen.f.bytes, 'application/json', urls) },
     label: `${id} (your model)`,
+    data: typeof pack.data_folder === 'string' ? `your folder ${pack.data_folder}${typeof pack.data_minutes === 'number' ? ` (${pack.data_minutes.toFixed(1)} minutes)` : ''}` : 'your own motion',
+    licence: "your data's own terms",
   };
   return {
     info,

@@ -60,6 +60,20 @@ export class ModelChoice {
 export function fillSelect(select: HTMLSelectElement, registry: Registry, ids: readonly string[]): void {
   const fixed = [...select.options].filter((o) => o.value === '');
   const kept = select.value;
-  select.replaceChildren(...fixed, ...ids.map((id) => new Option(registry.label(id), id)));
+  select.replaceChildren(
+    ...fixed,
+    ...ids.map((id) => {
+      const option = new Option(registry.label(id), id);
+      option.title = registry.provenance(id);
+      return option;
+    }),
+  );
   if ([...select.options].some((o) => o.value === kept)) select.value = kept;
+  // The picker's own tooltip follows the chosen model (what it was trained on, its licence).
+  const showChosen = () => (select.title = select.selectedOptions[0]?.title ?? '');
+  showChosen();
+  if (!select.dataset.provenance) {
+    select.dataset.provenance = 'shown';
+    select.addEventListener('change', showChosen);
+  }
 }
