@@ -27,7 +27,7 @@ from ..mocap.contacts import contacts_for
 from ..mocap.skeleton import FOOT_POINTS, canonical_skeleton
 from .dance import dance_data, train_dance
 from .dataset import FPS, OwnData
-from .pack import STABILITY_FRAMES, number_or_na, plot_pose_change
+from .pack import STABILITY_FRAMES, card_data_lines, number_or_na, plot_pose_change
 
 STABILITY_SEEDS = 3
 # A run diverges when its limbs stretch or shrink by more than this share on average, or its root leaves the band of
@@ -122,8 +122,6 @@ def measure_dance_pack(out: Path, info: dict, data: OwnData, stability_frames: i
 
 def write_dance_card(path: Path, pack_id: str, data: OwnData, result: DanceRun, info: dict, measures: dict) -> None:
     real, stab = measures["real"], measures["stability"]
-    skeletons = "; ".join(f"{s['scheme']}, {s['joints']} joints ({s['files']} file{'s' * (s['files'] != 1)})"
-                          for s in data.skeletons)
     valid = (info["training"]["valid"] or {}).get(info["styles"][0], {})
     runs = stab["runs"]
     measured = [r for r in runs if r["finite"]]
@@ -135,13 +133,7 @@ def write_dance_card(path: Path, pack_id: str, data: OwnData, result: DanceRun, 
         f"{info['bytes'] / 1e6:.2f} MB ONNX, weights {info['onnx']['weights']}) trained by `python -m training.own --kind dance` "
         f"on the folder `{data.folder.name}` as one style, \"{info['styles'][0]}\". Every number below was measured on this "
         "pack's own ONNX file with onnxruntime.", "",
-        "## Data", "",
-        f"- {data.minutes:.2f} minutes of motion in {len(data.clips)} clips at {FPS:g} fps "
-        f"({len(data.held_out)} held out: {', '.join(data.held_out)}).",
-        f"- Skeleton: {skeletons}; mapped onto the canonical skeleton's 25 points by the humanoid mapper.",
-        f"- Unreadable, left out: {len(data.skipped)} file{'s' * (len(data.skipped) != 1)}" + (": " + "; ".join(data.skipped) if data.skipped else "."),
-        f"- Shorter than the training window ({data.min_seconds:.2f} s), left out: {len(data.too_short)} clip{'s' * (len(data.too_short) != 1)}"
-        + (": " + ", ".join(data.too_short) if data.too_short else "."),
+        *card_data_lines(data, "the canonical skeleton's 25 points"),
         "", "## Training", "",
         f"- {result.minutes:.1f} minutes, {result.iterations} iterations; stopped: {result.stopped}.",
         f"- Held-out mean squared error per feature (normalised, lower is better): {valid.get('teacher_forced', float('nan')):.4f} "

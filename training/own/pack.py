@@ -205,10 +205,23 @@ def number_or_na(v: float) -> str:
     return "n/a" if v != v else f"{v:.3f}"
 
 
-def write_card(path: Path, pack_id: str, data: OwnData, result: TrainingResult, info: dict, measures: dict) -> None:
-    real, gen, stab = measures["real"], measures["generated"], measures["stability"]
+def card_data_lines(data: OwnData, target: str) -> list[str]:
+    """The card's "Data" section: minutes, clips, held-out clips, skeletons (mapped onto `target`), files left out."""
     skeletons = "; ".join(f"{s['scheme']}, {s['joints']} joints ({s['files']} file{'s' * (s['files'] != 1)})"
                           for s in data.skeletons)
+    return [
+        "## Data", "",
+        f"- {data.minutes:.2f} minutes of motion in {len(data.clips)} clips at {FPS:g} fps "
+        f"({len(data.held_out)} held out: {', '.join(data.held_out)}).",
+        f"- Skeleton: {skeletons}; mapped onto {target} by the humanoid mapper.",
+        f"- Unreadable, left out: {len(data.skipped)} file{'s' * (len(data.skipped) != 1)}" + (": " + "; ".join(data.skipped) if data.skipped else "."),
+        f"- Shorter than the training window ({data.min_seconds:.2f} s), left out: {len(data.too_short)} clip{'s' * (len(data.too_short) != 1)}"
+        + (": " + ", ".join(data.too_short) if data.too_short else "."),
+    ]
+
+
+def write_card(path: Path, pack_id: str, data: OwnData, result: TrainingResult, info: dict, measures: dict) -> None:
+    real, gen, stab = measures["real"], measures["generated"], measures["stability"]
     ratio = gen["sliding_low_foot_locked"] / real["sliding_low_foot"] if real["sliding_low_foot"] > 0 else float("nan")
     frozen = stab["frozen_seconds"]
     lines = [
@@ -216,13 +229,7 @@ def write_card(path: Path, pack_id: str, data: OwnData, result: TrainingResult, 
         f"A locomotion generator (LSTM + Gaussian mixture, {info['onnx']['hidden']} hidden units, {info['bytes'] / 1e6:.2f} MB "
         f"ONNX, weights {info['weights']}) trained by `python -m training.own` on the folder `{data.folder.name}`. "
         "Every number below was measured on this pack's own ONNX file with onnxruntime.", "",
-        "## Data", "",
-        f"- {data.minutes:.2f} minutes of motion in {len(data.clips)} clips at {FPS:g} fps "
-        f"({len(data.held_out)} held out: {', '.join(data.held_out)}).",
-        f"- Skeleton: {skeletons}; mapped onto the canonical skeleton by the humanoid mapper.",
-        f"- Unreadable, left out: {len(data.skipped)} file{'s' * (len(data.skipped) != 1)}" + (": " + "; ".join(data.skipped) if data.skipped else "."),
-        f"- Shorter than the training window ({data.min_seconds:.2f} s), left out: {len(data.too_short)} clip{'s' * (len(data.too_short) != 1)}"
-        + (": " + ", ".join(data.too_short) if data.too_short else "."),
+        *card_data_lines(data, "the canonical skeleton"),
         "", "## Training", "",
         f"- {result.minutes:.1f} minutes, {result.iterations} iterations ({result.epochs_done} whole epoch{'s' * (result.epochs_done != 1)}); stopped: {result.stopped}.",
         f"- Held-out NLL per frame (normalised features, lower is better): {result.best_valid_nll:.3f}.",
