@@ -30,7 +30,8 @@ FIXTURE = REPO_ROOT / "tests" / "fixtures" / "aclstm_reference.json"
 def load_dance_model(checkpoint: Path) -> tuple[DanceLSTM, dict, dict]:
     state = torch.load(checkpoint, weights_only=False)
     meta = state["meta"]
-    model = DanceLSTM(meta["dim"], len(meta["styles"]), meta["hidden"], meta["layers"], meta.get("head", "mean"))
+    model = DanceLSTM(meta["dim"], len(meta["styles"]), meta["hidden"], meta["layers"], meta.get("head", "mean"),
+                       meta.get("components", 10))
     model.load_state_dict(state["model"])
     return model.eval(), meta, state
 

@@ -2,6 +2,11 @@
 
     python -m training.aclstm.pilot RUN [RUN ...] [--frames 3000] [--seeds 3] [--which best|last]
     python -m training.aclstm.pilot --feedback-noise 0.1 0.15 [--rho 0.9] [--pose-only] [--model aclstm] [--frames 20000]
+    python -m training.aclstm.pilot RUN --phrase-tune     # an mdn head: phrase sampling, chosen per style on held-out windows
+
+An mdn head's rollouts use the phrase sampler (training/aclstm/phrase_sampling.py): --temperature, --max-hold, --draw-rho
+and --threshold for every style, or --phrase-tune: each style's setting chosen from a grid on held-out seed windows
+that the judged runs do not start from (pilots.tune_phrase), written to docs/models/aclstm-phrase-tuning.json.
 
 Each RUN is a folder under runs/ (its best.pt, or last.pt with --which last). --feedback-noise measures an exported
 model (public/models/) with noise on each fed-back frame instead, 5 seeds per style. What is measured:
@@ -12,11 +17,14 @@ from __future__ import annotations
 import argparse
 import json
 
+from ..data.dance import STYLES
 from ..paths import MODELS_DIR, REPORTS_DIR
 from ..runs import RUNS_DIR
-from .pilots import feedback_noise_runs, measure_run, pilot_markdown, summary_line
+from .phrase_sampling import PhraseParams
+from .pilots import feedback_noise_runs, measure_run, pilot_markdown, summary_line, tune_phrase, tuning_grid
 
 PILOTS = REPORTS_DIR / "aclstm-pilots.json"
+TUNING = REPORTS_DIR / "aclstm-phrase-tuning.json"
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -33,6 +41,10 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--rollout-noise", type=float, default=0.0, help="white noise on each fed-back frame of a RUN's rollouts")
     parser.add_argument("--temperature", type=float, default=1.0, help="a Gaussian head's draws in the rollouts: its σ times this")
     parser.add_argument("--draw-rho", type=float, default=0.0, help="a Gaussian head's draws from AR(1) normals with this coefficient (0: white)")
+    parser.add_argument("--max-hold", type=int, default=30, help="an mdn head's phrase: redraw the component at least every this many frames")
+    parser.add_argument("--threshold", type=float, default=0.05, help="an mdn head's phrase: redraw when the held component's weight falls below this")
+    parser.add_argument("--phrase-tune", action="store_true", help="an mdn head: choose temperature, max hold and rho per style on held-out windows")
+    parser.add_argument("--tune-frames", type=int, default=1200)
     args = parser.parse_args(argv)
     if not args.runs and not args.feedback_noise:
         parser.error("give RUN names or --feedback-noise")
@@ -51,12 +63,29 @@ def main(argv: list[str] | None = None) -> None:
               f"{w['passes']}/{len(w['runs'])} pass, {w['diverged']} diverged")
     for name in args.runs:
         run_dir = RUNS_DIR / name
-        m = measure_run(run_dir / f"{args.which}.pt", args.frames or 3000, args.seeds, args.mocap, args.rollout_noise, args.temperature, args.draw_rho)
+        checkpoint = run_dir / f"{args.which}.pt"
+        phrase, tag = None, ""
+        if args.phrase_tune:
+            tuned = tune_phrase(checkpoint, tuning_grid(args.threshold), args.tune_frames, mocap=args.mocap)
+            TUNING.write_text(json.dumps({**(json.loads(TUNING.read_text()) if TUNING.exists() else {}),
+                                          f"{name}:{args.which}": tuned}, indent=1))
+            phrase = {s: PhraseParams(**v["best"]) for s, v in tuned["styles"].items()}
+            tag = " phrase tuned"
+            for s, v in tuned["styles"].items():
+                print(f"{s}: chosen {v['best']} (tuning: {v['table'][0]['passes']}/{v['table'][0]['runs']} pass, "
+                      f"median {v['table'][0]['median_ratio']:.0%}, jitter {v['table'][0]['jitter_vs_real']:.1f}x)")
+        elif args.temperature != 1 or args.draw_rho or args.max_hold != 30:
+            phrase = {s: PhraseParams(args.temperature, args.max_hold, args.draw_rho, args.threshold) for s in STYLES}
+            tag = f" phrase t {args.temperature:g} hold {args.max_hold} rho {args.draw_rho:g}"
+        m = measure_run(checkpoint, args.frames or 3000, args.seeds, args.mocap, args.rollout_noise, args.temperature, args.draw_rho, phrase)
         summary = json.loads((run_dir / "summary.json").read_text()) if (run_dir / "summary.json").exists() else {}
         m.pop("details")
-        key = (f"{name}:{args.which}" + (f" +noise {args.rollout_noise:g}" if args.rollout_noise else "")
-               + (f" temperature {args.temperature:g}" if args.temperature != 1 else "")
-               + (f" draw rho {args.draw_rho:g}" if args.draw_rho else ""))
+        if m["args"].get("head") == "mdn":
+            key = f"{name}:{args.which}" + (tag or " phrase default")
+        else:
+            key = (f"{name}:{args.which}" + (f" +noise {args.rollout_noise:g}" if args.rollout_noise else "")
+                   + (f" temperature {args.temperature:g}" if args.temperature != 1 else "")
+                   + (f" draw rho {args.draw_rho:g}" if args.draw_rho else ""))
         table[key] = {**m, "summary": summary}
         mine.add(key)
         print(summary_line(key, m))

@@ -16,8 +16,10 @@ import torch
 from .. import metrics
 from ..data.dance import LIMB_MIN_LENGTH, MODEL_FPS, STYLES, bone_length_error, decode, load_clips
 from ..models.aclstm import draw
-from .exporting import load_dance_model, pick_seeds
+from ..data.dance import encode, resample_positions
+from .exporting import SEED_FRAMES, load_dance_model, pick_seeds
 from .freeze_rule import jitter_cm, judge, real_jitter_cm, real_reference
+from .phrase_sampling import PhraseParams, phrase_rollout
 from .report import BONE_ERROR_LIMIT, HEIGHT_BAND, per_second
 
 
@@ -49,27 +51,42 @@ def rollout(model, meta: dict, seed_frames: np.ndarray, styles: list[str], frame
     return out * std + mean
 
 
+def judge_rollout(f: np.ndarray, style: str, skel, ref: dict, real_jitter: dict) -> dict:
+    """One rollout's features (frames, dim; physical units): divergence (NaN, a root outside HEIGHT_BAND, a second
+    over the limb-length limit), jitter against the style's real clips and the freeze rule's verdicts."""
+    finite = bool(np.isfinite(f).all())
+    pos = decode(np.nan_to_num(f.astype(np.float64)))
+    curve = metrics.pose_change_per_second(pos, MODEL_FPS)
+    limb = per_second(bone_length_error(pos, skel, LIMB_MIN_LENGTH), MODEL_FPS)
+    height = pos[:, 0, 1]
+    diverged = (not finite or float(limb.max()) > BONE_ERROR_LIMIT
+                or not (HEIGHT_BAND[0] <= height.min() and height.max() <= HEIGHT_BAND[1]))
+    return {"style": style, "diverged": diverged, "jitter_vs_real": jitter_cm(pos) / real_jitter[style], **judge(curve, ref[style])}
+
+
 def measure_run(checkpoint: Path, frames: int = 3000, seeds_per_style: int = 3, mocap: str | None = None,
-                feedback_noise: float = 0.0, temperature: float = 1.0, draw_rho: float = 0.0) -> dict:
-    """The pilot measure of one checkpoint (a Gaussian head's draws with σ × `temperature`): per style and seed the freeze-rule numbers; validation from the run."""
+                feedback_noise: float = 0.0, temperature: float = 1.0, draw_rho: float = 0.0,
+                phrase: dict[str, PhraseParams] | None = None) -> dict:
+    """The pilot measure of one checkpoint (a Gaussian head's draws with σ × `temperature`; an mdn head's by the
+    phrase sampler with `phrase`'s parameters per style, default PhraseParams()): per style and seed the
+    freeze-rule numbers; validation from the run."""
     skel, clips = load_clips(mocap)
     model, meta, state = load_dance_model(checkpoint)
     ref = real_reference(clips)
     real_jitter = real_jitter_cm(clips)
     chosen = [s for style in STYLES for s in [x for x in pick_seeds(clips) if x["style"] == style][:seeds_per_style]]
-    feats = rollout(model, meta, np.array([s["frames"] for s in chosen], np.float32), [s["style"] for s in chosen], frames,
-                    feedback_noise, temperature, draw_rho)
+    seed_frames, seed_styles = np.array([s["frames"] for s in chosen], np.float32), [s["style"] for s in chosen]
+    redraws = None
+    if model.head == "mdn":
+        phrase = phrase or {}
+        feats, redraws = phrase_rollout(model, meta, seed_frames, seed_styles, frames,
+                                        [phrase.get(s, PhraseParams()) for s in seed_styles])
+    else:
+        feats = rollout(model, meta, seed_frames, seed_styles, frames, feedback_noise, temperature, draw_rho)
     runs = []
-    for seed, f in zip(chosen, feats):
-        finite = bool(np.isfinite(f).all())
-        pos = decode(np.nan_to_num(f.astype(np.float64)))
-        curve = metrics.pose_change_per_second(pos, MODEL_FPS)
-        limb = per_second(bone_length_error(pos, skel, LIMB_MIN_LENGTH), MODEL_FPS)
-        height = pos[:, 0, 1]
-        diverged = (not finite or float(limb.max()) > BONE_ERROR_LIMIT
-                    or not (HEIGHT_BAND[0] <= height.min() and height.max() <= HEIGHT_BAND[1]))
-        runs.append({"style": seed["style"], "seed": seed["name"], "diverged": diverged,
-                     "jitter_vs_real": jitter_cm(pos) / real_jitter[seed["style"]], **judge(curve, ref[seed["style"]])})
+    for k, (seed, f) in enumerate(zip(chosen, feats)):
+        runs.append({"seed": seed["name"], **judge_rollout(f, seed["style"], skel, ref, real_jitter),
+                     **({"phrases_per_minute": float(redraws[k]) / (frames / MODEL_FPS / 60)} if redraws is not None else {})})
     per_style = {}
     for style in STYLES:
         mine = [r for r in runs if r["style"] == style]
@@ -82,8 +99,66 @@ def measure_run(checkpoint: Path, frames: int = 3000, seeds_per_style: int = 3, 
     valid = state.get("valid") or (state.get("history") or [{}])[-1].get("valid") or {}  # best.pt, else the last epoch
     return {"checkpoint": str(checkpoint), "iteration": state.get("iteration"), "frames": frames, "args": meta.get("args", {}),
             "rollout_feedback_noise": feedback_noise, "rollout_temperature": temperature, "rollout_draw_rho": draw_rho,
+            **({"phrase": {s: (phrase or {}).get(s, PhraseParams()).to_json() for s in STYLES}} if model.head == "mdn" else {}),
             "valid": {s: valid.get(s) for s in STYLES} if valid else None, "real": ref, "per_style": per_style,
             "passes": sum(p["passes"] for p in per_style.values()), "runs": len(runs), "details": runs}
+
+
+TUNING_FRACTIONS = (0.55, 0.7, 0.85)  # of each held-out clip: seed windows apart from pick_seeds' (at most 0.34 of a clip)
+
+
+def tuning_grid(threshold: float = 0.05) -> list[PhraseParams]:
+    """The phrase sampler's settings tried per style: temperature, longest hold (0.5, 1, 2 s) and AR(1) coefficient."""
+    return [PhraseParams(t, h, r, threshold) for t in (0.2, 0.35, 0.5, 0.7) for h in (15, 30, 60) for r in (0.0, 0.9)]
+
+
+def tuning_seeds(clips, style: str, per_style: int = 3) -> np.ndarray:
+    """Seed motions for choosing the phrase sampler's parameters: SEED_FRAMES real frames of the style's held-out
+    clips, at TUNING_FRACTIONS of each clip, never the windows the judged runs start from (pick_seeds)."""
+    held = [c for c in clips if c.style == style and c.held_out]
+    out = []
+    for k in range(per_style):
+        c = held[k % len(held)]
+        start = TUNING_FRACTIONS[k % len(TUNING_FRACTIONS)] * c.seconds
+        pos = resample_positions(c.positions, c.fps, start, SEED_FRAMES + 1)
+        pos[..., [0, 2]] -= pos[-1:, :1, [0, 2]]
+        out.append(encode(pos))
+    return np.array(out, np.float32)
+
+
+def tuning_score(runs: list[dict], jitter_limit: float = 1.3) -> tuple:
+    """Lower is better: settings whose tuning rollouts all pass (a)–(c) without divergence and with jitter within
+    `jitter_limit` × real come first, closest median to the real one among them; then the fewest failures."""
+    median = float(np.median([r["median_ratio"] for r in runs]))
+    jitter = max(r["jitter_vs_real"] for r in runs)
+    fails = sum(r["diverged"] or not r["passes"] for r in runs)
+    feasible = fails == 0 and jitter <= jitter_limit
+    penalty = 10 * sum(r["diverged"] for r in runs) + fails + max(0.0, jitter - jitter_limit)
+    return (0 if feasible else 1, 0.0 if feasible else penalty, abs(np.log(max(median, 1e-6))))
+
+
+def tune_phrase(checkpoint: Path, grid: list[PhraseParams], frames: int = 1200, per_style: int = 3,
+                mocap: str | None = None) -> dict:
+    """Every setting of `grid` rolled out `frames` frames from each style's tuning seeds (held-out clips, not the
+    judged windows), in one batch; per style the settings ranked by tuning_score and the best one."""
+    skel, clips = load_clips(mocap)
+    model, meta, _ = load_dance_model(checkpoint)
+    ref, real_jitter = real_reference(clips), real_jitter_cm(clips)
+    rows = [(style, p, seed) for style in STYLES for p in grid for seed in tuning_seeds(clips, style, per_style)]
+    feats, _ = phrase_rollout(model, meta, np.array([r[2] for r in rows]), [r[0] for r in rows], frames, [r[1] for r in rows])
+    out = {}
+    for style in STYLES:
+        table = []
+        for p in grid:
+            runs = [judge_rollout(f, st, skel, ref, real_jitter) for (st, q, _), f in zip(rows, feats) if st == style and q == p]
+            table.append({"params": p.to_json(), "score": list(tuning_score(runs)),
+                          "passes": sum(r["passes"] and not r["diverged"] for r in runs), "runs": len(runs),
+                          "diverged": sum(r["diverged"] for r in runs),
+                          "median_ratio": float(np.median([r["median_ratio"] for r in runs])),
+                          "jitter_vs_real": max(r["jitter_vs_real"] for r in runs)})
+        table.sort(key=lambda t: tuple(t["score"]))
+        out[style] = {"best": table[0]["params"], "table": table}
+    return {"frames": frames, "seeds_per_style": per_style, "fractions": TUNING_FRACTIONS, "styles": out}
 
 
 def summary_line(name: str, m: dict) -> str:
@@ -103,7 +178,10 @@ def recipe(args: dict) -> str:
              f"u={args.get('ground_truth', 5)} v={args.get('condition', 5)}"
              + (f"->{args['condition_max']}" if args.get("condition_max") else ""),
              f"lr {args.get('lr', 1e-3):g} x{args.get('decay', 0.95):g}/epoch"]
-    if args.get("head", "mean") != "mean":
+    if args.get("head", "mean") == "mdn":
+        parts.append(f"mdn head K={args.get('components', 10)}, held-component draws fed back"
+                     + (f" at σ × {args['draw_temperature']:g}" if args.get("draw_temperature", 1.0) != 1.0 else ""))
+    elif args.get("head", "mean") != "mean":
         parts.append(f"{args['head']} head, draws fed back")
     if args.get("feedback_noise"):
         parts.append(f"feedback noise {args['feedback_noise']:g}")
@@ -128,7 +206,10 @@ def pilot_markdown(table: dict, sweeps: dict | None = None) -> str:
              "stretch lasts 5 s or more, and (c) its median is at least 50% of the real median. Each style's cell gives the "
              "passes and, over its seeds, the worst low share, the longest low stretch and the lowest median (share of real). "
              "Rows marked *+noise σ* are rolled out with white noise σ (normalised units) on each fed-back frame; rows "
-             "marked *temperature τ* draw a Gaussian head's frames with its σ × τ. *jitter* (where measured) is the mean "
+             "marked *temperature τ* draw a Gaussian head's frames with its σ × τ; rows marked *phrase* draw an mdn head's frames "
+             "by the phrase sampler (`training/aclstm/phrase_sampling.py`: a component held for up to *hold* frames or until its "
+             "weight falls below 0.05, its σ × τ, AR(1) normals with coefficient ρ), *phrase tuned* with each style's setting "
+             "chosen on held-out windows the judged runs do not start from (`aclstm-phrase-tuning.json`). *jitter* (where measured) is the mean "
              "second difference of the joints relative to the root against the real clips' (a shaking dancer also passes "
              "(a)–(c)).",
              "",
@@ -143,7 +224,9 @@ def pilot_markdown(table: dict, sweeps: dict | None = None) -> str:
             p = m["per_style"][style]
             cells.append(f"{p['passes']}/{p['runs']}: {p['low_share_worst']:.0%} low, {p['longest_low_s_worst']} s, "
                          f"median {p['median_ratio_worst']:.0%}" + (f", {p['diverged']} diverged" if p["diverged"] else "")
-                         + (f", jitter {p['jitter_vs_real'][0]:.1f}–{p['jitter_vs_real'][1]:.1f}×" if "jitter_vs_real" in p else ""))
+                         + (f", jitter {p['jitter_vs_real'][0]:.1f}–{p['jitter_vs_real'][1]:.1f}×" if "jitter_vs_real" in p else "")
+                         + (f"; phrase τ {m['phrase'][style]['temperature']:g}, hold ≤ {m['phrase'][style]['max_hold']} frames, "
+                            f"ρ {m['phrase'][style]['rho']:g}" if m.get("phrase") else ""))
         valid = "/".join(f"{m['valid'][s]['auto_conditioned']:.3f}" for s in STYLES) if m.get("valid") else "—"
         minutes = m.get("summary", {}).get("minutes")
         lines.append(f"| {name} | {recipe(m.get('args', {}))} | {m['iteration']} | "

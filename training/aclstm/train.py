@@ -26,8 +26,12 @@ def main(argv: list[str] | None = None) -> None:
                         help="weight of the motion-energy term (each channel's RMS frame-to-frame change against the real window's)")
     parser.add_argument("--feedback-noise", type=float, default=0.0,
                         help="Gaussian noise (normalised units) on each self-fed frame in training, as the inference-time lever adds it")
-    parser.add_argument("--head", choices=["mean", "gauss"], default="mean",
-                        help="output: the next frame (squared error) or a Gaussian over it (likelihood; draws are fed back)")
+    parser.add_argument("--head", choices=["mean", "gauss", "mdn"], default="mean",
+                        help="output: the next frame (squared error), a Gaussian over it (likelihood; draws are fed back) or "
+                             "a mixture of --components Gaussians (likelihood; a component held over each self-fed stretch, its draws fed back)")
+    parser.add_argument("--components", type=int, default=10, help="K, the mdn head's mixture components")
+    parser.add_argument("--draw-temperature", type=float, default=1.0,
+                        help="the mdn head's fed-back draws in training: the held component's sigma times this")
     parser.add_argument("--hidden", type=int, default=256)
     parser.add_argument("--layers", type=int, default=3)
     parser.add_argument("--batch", type=int, default=32)

@@ -21,7 +21,7 @@ import numpy as np
 import torch
 
 from ..data.dance import MODEL_FPS, STYLES, DanceClip, DanceSkeleton, encode, load_clips, mirror, mirror_pairs, resample_positions, rotate_y
-from ..models.aclstm import DanceLSTM
+from ..models.aclstm import DanceLSTM, mixture_nll
 from ..models.losses import energy_loss
 from ..runs import TrainingLoop
 
@@ -131,10 +131,12 @@ def train_dance_model(args: argparse.Namespace,
     styles = STYLES if data is None else data[2]
     corpus = DanceCorpus(clips, args.window, np.random.default_rng(12345), skel.names, not args.no_mirror, styles)
     dim = corpus.mean.shape[0]
-    model = DanceLSTM(dim, len(styles), args.hidden, args.layers, args.head)
+    components = getattr(args, "components", 10)
+    model = DanceLSTM(dim, len(styles), args.hidden, args.layers, args.head, components)
     optimiser = torch.optim.Adam(model.parameters(), lr=args.lr)
     scheduler = torch.optim.lr_scheduler.ExponentialLR(optimiser, gamma=args.decay)
-    meta = {"dim": dim, "styles": list(styles), "hidden": args.hidden, "layers": args.layers, "head": args.head, "fps": MODEL_FPS,
+    meta = {"dim": dim, "styles": list(styles), "hidden": args.hidden, "layers": args.layers, "head": args.head,
+            **({"components": components} if args.head == "mdn" else {}), "fps": MODEL_FPS,
             "mean": corpus.mean.tolist(), "std": corpus.std.tolist(), "skeleton": skel.to_json(),
             "valid_files": corpus.valid_files, "args": vars(args)}
     iteration = loop.start(meta, model=model, optimiser=optimiser, scheduler=scheduler)
@@ -162,11 +164,17 @@ def train_dance_model(args: argparse.Namespace,
             sigma = args.input_noise[0] + (args.input_noise[1] - args.input_noise[0]) * progress
             if sigma > 0:
                 inputs = inputs + sigma * torch.randn(inputs.shape, generator=noise_rng)
-            pred, log_sigma = model.auto_conditioned_distribution(inputs, style, args.ground_truth, condition, args.feedback_noise)
-            if log_sigma is None:
-                loss = ((pred - x[:, 1:]) ** 2).mean()
-            else:  # Gaussian negative log-likelihood per channel (constant dropped)
-                loss = (0.5 * ((x[:, 1:] - pred) * torch.exp(-log_sigma)) ** 2 + log_sigma).mean()
+            if args.head == "mdn":  # mixture likelihood; the self-fed frames are held-component draws (models/aclstm.py)
+                logits, mus, log_sigmas = model.auto_conditioned_mixture(inputs, style, args.ground_truth, condition,
+                                                                         getattr(args, "draw_temperature", 1.0), noise_rng)
+                loss = mixture_nll(logits, mus, log_sigmas, x[:, 1:])
+                pred = (torch.softmax(logits, -1).unsqueeze(-1) * mus).sum(-2)  # the mixture's mean, for the energy term
+            else:
+                pred, log_sigma = model.auto_conditioned_distribution(inputs, style, args.ground_truth, condition, args.feedback_noise)
+                if log_sigma is None:
+                    loss = ((pred - x[:, 1:]) ** 2).mean()
+                else:  # Gaussian negative log-likelihood per channel (constant dropped)
+                    loss = (0.5 * ((x[:, 1:] - pred) * torch.exp(-log_sigma)) ** 2 + log_sigma).mean()
             if args.energy:
                 # Motion energy: each channel's RMS change between frames over the window should match the real
                 # window's. A frozen pose is the mean regression's cheapest answer; this term prices it.

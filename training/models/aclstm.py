@@ -3,9 +3,11 @@
 One model serves every dance style: a one-hot style vector is appended to each frame's input.
 The same network trained with teacher forcing only is the paper's "vanilla" baseline.
 
-Two output heads: "mean" (the paper's: the next frame, trained by squared error) and "gauss" (issue 18's
+Three output heads: "mean" (the paper's: the next frame, trained by squared error), "gauss" (issue 18's
 pilot lever: a diagonal Gaussian over the next frame, trained by likelihood, whose samples are fed back, since
-regressing the mean pulls a long rollout toward a static pose).
+regressing the mean pulls a long rollout toward a static pose) and "mdn" (issue 42's first lever: a mixture of K
+diagonal Gaussians over the next frame, trained by likelihood; in the self-fed stretch of training the component is
+drawn once and held for the stretch, as training/aclstm/phrase_sampling.py holds it over a phrase at inference).
 """
 from __future__ import annotations
 
@@ -13,6 +15,7 @@ import torch
 from torch import nn
 
 LOG_SIGMA_RANGE = (-5.0, 1.0)  # the Gaussian head's log standard deviation, normalised units
+HEADS = ("mean", "gauss", "mdn")
 
 
 def draw(mu: torch.Tensor, log_sigma: torch.Tensor, temperature: float, normals: torch.Tensor) -> torch.Tensor:
@@ -22,13 +25,15 @@ def draw(mu: torch.Tensor, log_sigma: torch.Tensor, temperature: float, normals:
 
 
 class DanceLSTM(nn.Module):
-    def __init__(self, dim: int, styles: int, hidden: int = 256, layers: int = 3, head: str = "mean"):
+    def __init__(self, dim: int, styles: int, hidden: int = 256, layers: int = 3, head: str = "mean", components: int = 10):
         super().__init__()
-        if head not in ("mean", "gauss"):
-            raise ValueError(f"unknown head {head!r}: use 'mean' or 'gauss'")
+        if head not in HEADS:
+            raise ValueError(f"unknown head {head!r}: use 'mean', 'gauss' or 'mdn'")
         self.dim, self.styles, self.hidden, self.layers, self.head = dim, styles, hidden, layers, head
+        self.components = components if head == "mdn" else 0
         self.lstm = nn.LSTM(dim + styles, hidden, num_layers=layers, batch_first=True)
-        self.decoder = nn.Linear(hidden, dim if head == "mean" else 2 * dim)
+        out = {"mean": dim, "gauss": 2 * dim, "mdn": components * (2 * dim + 1)}[head]
+        self.decoder = nn.Linear(hidden, out)
 
     def zero_state(self, batch: int) -> tuple[torch.Tensor, torch.Tensor]:
         z = torch.zeros(self.layers, batch, self.hidden)
@@ -42,6 +47,9 @@ class DanceLSTM(nn.Module):
         out = self.decoder(y)
         if self.head == "mean":
             return out, None, state
+        if self.head == "mdn":  # the mixture's mean (a point estimate; mixture() gives the components)
+            logits, mu, _ = self._split_mixture(out)
+            return (torch.softmax(logits, -1).unsqueeze(-1) * mu).sum(-2), None, state
         mu, log_sigma = out.split(self.dim, dim=-1)
         return mu, log_sigma.clamp(*LOG_SIGMA_RANGE), state
 
@@ -62,6 +70,9 @@ class DanceLSTM(nn.Module):
         With condition=0 this is plain teacher forcing. Gradients flow through the fed-back frames.
         `feedback_noise`: Gaussian noise (normalised units) added to each fed-back frame, as at generation
         with the inference-time lever (the prediction itself is returned clean)."""
+        if self.head == "mdn":  # the mixture's mean at every position, its own held-component draws fed back
+            logits, mu, _ = self.auto_conditioned_mixture(x, style, ground_truth, condition)
+            return (torch.softmax(logits, -1).unsqueeze(-1) * mu).sum(-2)
         return self.auto_conditioned_distribution(x, style, ground_truth, condition, feedback_noise)[0]
 
     def auto_conditioned_distribution(self, x, style, ground_truth: int, condition: int, feedback_noise: float = 0.0):
@@ -88,6 +99,60 @@ class DanceLSTM(nn.Module):
                 prev, state = step(fed, state)
                 t += 1
         return torch.cat(mus, dim=1), None if self.head == "mean" else torch.cat(sigmas, dim=1)
+
+    def _split_mixture(self, out: torch.Tensor):
+        k, d = self.components, self.dim
+        logits = out[..., :k]
+        mu = out[..., k:k + k * d].unflatten(-1, (k, d))
+        log_sigma = out[..., k + k * d:].unflatten(-1, (k, d)).clamp(*LOG_SIGMA_RANGE)
+        return logits, mu, log_sigma
+
+    def mixture(self, x: torch.Tensor, style: torch.Tensor, state=None):
+        """The mdn head: x (batch, time, dim) -> mixture logits (batch, time, K), component means and log standard
+        deviations (batch, time, K, dim), (h, c)."""
+        if self.head != "mdn":
+            raise ValueError("mixture() needs the 'mdn' head")
+        s = style.unsqueeze(1).expand(-1, x.shape[1], -1)
+        y, state = self.lstm(torch.cat([x, s], dim=-1), state)
+        logits, mu, log_sigma = self._split_mixture(self.decoder(y))
+        return logits, mu, log_sigma, state
+
+    def auto_conditioned_mixture(self, x, style, ground_truth: int, condition: int, temperature: float = 1.0,
+                                 generator: torch.Generator | None = None):
+        """The acRNN unroll of the mdn head: (logits, mu, log_sigma) for every input position. In each self-fed
+        stretch the component is drawn once from the mixture weights at the stretch's first frame and held for
+        the stretch (the phrase sampler's rule at inference, training/aclstm/phrase_sampling.py); each fed-back
+        frame is that component's mean + temperature · σ · normal, reparameterised so gradients flow through it
+        (not through the choice of component)."""
+        if condition == 0:
+            logits, mu, log_sigma, _ = self.mixture(x, style)
+            return logits, mu, log_sigma
+        outs, state, t, total = [], None, 0, x.shape[1]
+        rows = torch.arange(x.shape[0])
+        while t < total:
+            n = min(ground_truth, total - t)
+            logits, mu, log_sigma, state = self.mixture(x[:, t:t + n], style, state)
+            outs.append((logits, mu, log_sigma))
+            t += n
+            held = None
+            for _ in range(min(condition, total - t)):
+                if held is None:
+                    held = torch.multinomial(torch.softmax(logits[:, -1].detach(), -1), 1, generator=generator)[:, 0]
+                normals = torch.randn(mu[:, -1, 0].shape, generator=generator)
+                fed = mu[rows, -1, held] + temperature * torch.exp(log_sigma[rows, -1, held]) * normals
+                logits, mu, log_sigma, state = self.mixture(fed.unsqueeze(1), style, state)
+                outs.append((logits, mu, log_sigma))
+                t += 1
+        return tuple(torch.cat([o[i] for o in outs], dim=1) for i in range(3))
+
+
+def mixture_nll(logits: torch.Tensor, mu: torch.Tensor, log_sigma: torch.Tensor, target: torch.Tensor) -> torch.Tensor:
+    """Mean negative log-likelihood of `target` (..., dim) under the mixture (logits (..., K), mu and log_sigma
+    (..., K, dim)), per frame and divided by dim (so it reads per channel, like the Gaussian head's loss; the
+    constant ½ log 2π dropped)."""
+    z = (target.unsqueeze(-2) - mu) * torch.exp(-log_sigma)
+    per_component = (-0.5 * z ** 2 - log_sigma).sum(-1)
+    return -(torch.logsumexp(torch.log_softmax(logits, -1) + per_component, dim=-1)).mean() / target.shape[-1]
 
 
 class DanceStep(nn.Module):
