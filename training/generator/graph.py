@@ -30,6 +30,8 @@ def step_graph(model: MixtureLSTM) -> onnx.ModelProto:
     fc1 and fc2 are Gemm + Relu (fused by onnxruntime); fc3 is three
     Gemms (mixture logits, means, log standard deviations), so no output is a slice of a larger tensor.
     Initializers are named after the torch layers; training/generator/recovery.py reads them back.
+    A model with styles (MixtureLSTM(styles=N), issue 39) has a fourth input, style (B, N) float weights over the
+    styles: x_styled = Concat(x, MatMul(style, style.weight)) feeds fc1 (training/style_generator/graph.py).
     """
     sd = {k: v.detach().cpu().numpy().astype(np.float32) for k, v in model.state_dict().items()}
     H, D, M = model.hidden, model.dim, model.mixtures
@@ -43,7 +45,13 @@ def step_graph(model: MixtureLSTM) -> onnx.ModelProto:
     def gates(w):  # rows in PyTorch's gate order -> GATE_ORDER
         return w.reshape(4, H, *w.shape[1:])[GATE_ORDER].reshape(4 * H, *w.shape[1:])
 
-    y = node("Relu", [gemm("x", "fc1", sd["fc1.weight"], sd["fc1.bias"], "fc1")], ["fc1_relu"])
+    inputs = [("x", ["batch", D]), ("h", [2, "batch", H]), ("c", [2, "batch", H])]
+    fc1_input = "x"
+    if model.styles > 0:  # the style generator (issue 39): x concatenated with style @ E; none of this without styles
+        embedding = node("MatMul", ["style", const("style.weight", sd["style.weight"])], ["style_embedding"])
+        fc1_input = node("Concat", ["x", embedding], ["x_styled"], axis=1)
+        inputs.append(("style", ["batch", model.styles]))
+    y = node("Relu", [gemm(fc1_input, "fc1", sd["fc1.weight"], sd["fc1.bias"], "fc1")], ["fc1_relu"])
     y = node("Relu", [gemm(y, "fc2", sd["fc2.weight"], sd["fc2.bias"], "fc2")], ["fc2_relu"])
     per_layer = const("per_layer", np.array([1, 1], np.int64))
     h_in = node("Split", ["h", per_layer], ["h0", "h1"], axis=0)  # (1, B, H) each
@@ -85,8 +93,7 @@ def step_graph(model: MixtureLSTM) -> onnx.ModelProto:
     log_sigma = node("Reshape", [out["log_sigma"], mixture_shape], ["log_sigma"])
     node("Exp", [node("Max", [log_sigma, const("log_sigma_min", np.array(LOG_SIGMA_MIN, np.float32))], ["log_sigma_clamped"])], ["sigma"])
 
-    return builder.model("generator_step",
-        [("x", ["batch", D]), ("h", [2, "batch", H]), ("c", [2, "batch", H])],
+    return builder.model("generator_step", inputs,
         [("weights", ["batch", M]), ("mu", ["batch", M, D]), ("sigma", ["batch", M, D]),
          ("h_out", [2, "batch", H]), ("c_out", [2, "batch", H])],
         "training.generator.export")

@@ -39,12 +39,18 @@ class MixtureLSTM(nn.Module):
 
     def forward(self, x: torch.Tensor, state=None, style: torch.Tensor | None = None):
         """x (batch, time, dim) -> logits (b, t, M), mu (b, t, M, dim), log_sigma (b, t, M, dim), (h, c).
-        style: (batch,) style ids, required when the model has styles and refused when it has none."""
+        style: (batch,) style ids, or (batch, styles) float weights over the styles (a one-hot, or a convex combination
+        of one-hots blending the embeddings: embedding = style @ E, as the exported step computes it); required when the
+        model has styles and refused when it has none."""
         b, t, _ = x.shape
         if self.styles > 0:
             if style is None:
-                raise ValueError("this generator has a style input: pass style ids (batch,)")
-            x = torch.cat([x, self.style(style.reshape(b)).unsqueeze(1).expand(b, t, self.style_dim)], dim=-1)
+                raise ValueError("this generator has a style input: pass style ids (batch,) or weights (batch, styles)")
+            if style.is_floating_point():
+                embedding = style.reshape(b, self.styles) @ self.style.weight
+            else:
+                embedding = self.style(style.reshape(b))
+            x = torch.cat([x, embedding.unsqueeze(1).expand(b, t, self.style_dim)], dim=-1)
         elif style is not None:
             raise ValueError("this generator has no style input")
         y = self.drop(torch.relu(self.fc2(self.drop(torch.relu(self.fc1(x))))))
