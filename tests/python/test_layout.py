@@ -114,7 +114,8 @@ MAY_IMPORT = {
     "own": {"mocap", "data", "models", "generator", "aclstm"} | SHARED,
     "style_generator": {"mocap", "data", "models", "generator", "refiner"} | SHARED,
     "bench": {"models"} | SHARED,
-    "fixtures": {"mocap", "data", "models", "generator", "refiner", "aclstm", "control", "autoencoder", "latent_erd", "own"} | SHARED,
+    "fixtures": {"mocap", "data", "models", "generator", "refiner", "aclstm", "control", "autoencoder", "latent_erd", "own",
+                 "style_generator"} | SHARED,
 }
 
 
