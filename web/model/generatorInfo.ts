@@ -13,6 +13,15 @@ export interface GeneratorInfo {
   pack?: { measures?: { real?: { sliding_low_foot?: number } } };
   /** ONNX file name, relative to the JSON. */
   file: string;
+  /**
+   * A style-conditioned generator (python -m training.style_generator.export, issue 39): its style names in the order of
+   * the step's `style` input, the first the default. The step then takes a fourth input, style (B × styles weights: a
+   * one-hot, or a convex combination of one-hots that blends the styles' embeddings). Absent: no style input.
+   */
+  styles?: string[];
+  /** The terms the model comes under (a style generator: CC BY-NC 4.0, non-commercial) and what it was trained on. */
+  licence?: string;
+  data?: string;
   description?: string;
   skeleton: {
     joints: string[];
@@ -21,13 +30,16 @@ export interface GeneratorInfo {
     offsets: number[];
   };
   onnx: {
-    inputs: string[]; // [x, h, c]
+    inputs: string[]; // [x, h, c], or [x, h, c, style] with `styles`
     outputs: string[]; // [weights, mu, sigma, h_out, c_out]
     opset?: number;
     layers: number;
     hidden: number;
     mixtures: number;
     dim: number;
+    /** With `styles`: how many (the style input's width) and each style's embedding size. */
+    styles?: number;
+    style_dim?: number;
   };
   features: {
     names: string[];
@@ -53,6 +65,8 @@ export function noiseCorrelation(info: GeneratorInfo): number {
 export interface GeneratorSeed {
   name: string;
   category?: string;
+  /** With `styles`: the style this seed's state was estimated under (one of `styles`). */
+  style?: string;
   /** First input frame, normalised (dim values). */
   x: number[];
   /** LSTM state, layers × hidden, layer-major. */
@@ -61,14 +75,67 @@ export interface GeneratorSeed {
 }
 
 export const EXPECTED_INPUTS = ['x', 'h', 'c'] as const;
+/** A style generator's step inputs. */
+export const STYLED_INPUTS = ['x', 'h', 'c', 'style'] as const;
 export const EXPECTED_OUTPUTS = ['weights', 'mu', 'sigma', 'h_out', 'c_out'] as const;
 
-/** The ONNX step's inputs, flattened: x (B×D), h and c (layers×B×H). */
+/** The ONNX step's inputs, flattened: x (B×D), h and c (layers×B×H); a style generator's also style (B×styles). */
 export interface StepInputs {
   batch: number;
   x: ArrayLike<number>;
   h: ArrayLike<number>;
   c: ArrayLike<number>;
+  style?: ArrayLike<number>;
+}
+
+/** The style names of a style generator; [] for a generator without a style input. */
+export function styleNames(info: GeneratorInfo): string[] {
+  return info.styles ?? [];
+}
+
+/** How far a blend's weights may sum away from 1 (they are float32 on the way to the step). */
+const BLEND_SUM_TOLERANCE = 1e-4;
+
+/**
+ * The style input for one row: a style's name gives its one-hot; weights (one per style, each ≥ 0, summing to 1) blend
+ * the styles' embeddings, as the page does over a second when the style is switched; undefined gives the first style.
+ * Throws for a model without styles, an unknown name or weights that are not a convex combination.
+ */
+export function styleVector(info: GeneratorInfo, style?: string | ArrayLike<number>): Float32Array {
+  const styles = styleNames(info);
+  if (!styles.length) throw new Error(`the model "${info.id}" has no styles`);
+  const out = new Float32Array(styles.length);
+  if (style === undefined) {
+    out[0] = 1;
+  } else if (typeof style === 'string') {
+    const k = styles.indexOf(style);
+    if (k < 0) throw new Error(`unknown style "${style}" for the model "${info.id}": it has ${styles.join(', ')}`);
+    out[k] = 1;
+  } else {
+    if (style.length !== styles.length) throw new Error(`a style blend needs ${styles.length} weights (${styles.join(', ')}), got ${style.length}`);
+    let sum = 0;
+    for (let k = 0; k < styles.length; k++) {
+      const w = style[k];
+      if (typeof w !== 'number' || !Number.isFinite(w) || w < 0) throw new Error(`style weight ${k} (${styles[k]}) must be a finite number ≥ 0, got ${String(w)}`);
+      out[k] = w;
+      sum += w;
+    }
+    if (Math.abs(sum - 1) > BLEND_SUM_TOLERANCE) throw new Error(`style weights must sum to 1, got ${sum}`);
+  }
+  return out;
+}
+
+/** The seed states of `style` (all seeds for a model without styles, or with `style` undefined: the first style's). */
+export function styleSeeds(info: GeneratorInfo, style?: string): number[] {
+  const styles = styleNames(info);
+  const all = info.seeds.map((_, i) => i);
+  if (!styles.length) {
+    if (style !== undefined) throw new Error(`the model "${info.id}" has no styles`);
+    return all;
+  }
+  const name = style ?? styles[0];
+  if (!styles.includes(name)) throw new Error(`unknown style "${name}" for the model "${info.id}": it has ${styles.join(', ')}`);
+  return all.filter((i) => info.seeds[i].style === name);
 }
 
 export interface StepOutputs {
@@ -86,8 +153,20 @@ const format = modelInfoFormat<GeneratorInfo>('GeneratorInfoError', 'generator.j
   const { fail, obj, posInt, numbers, strings } = check;
   const J = check.skeleton(root.skeleton);
 
+  let styleCount = 0;
+  if (root.styles !== undefined) {
+    const styles = strings(root.styles, 'styles');
+    if (styles.length === 0) fail('styles must name at least one style');
+    if (new Set(styles).size !== styles.length) fail(`styles has a name twice: [${styles}]`);
+    styleCount = styles.length;
+  }
+  for (const key of ['licence', 'data'] as const) {
+    if (root[key] !== undefined && (typeof root[key] !== 'string' || !(root[key] as string).trim())) fail(`${key} must be a non-empty string`);
+  }
+
   const onnx = obj(root.onnx, 'onnx');
-  check.names(onnx.inputs, 'onnx.inputs', EXPECTED_INPUTS);
+  check.names(onnx.inputs, 'onnx.inputs', styleCount ? STYLED_INPUTS : EXPECTED_INPUTS);
+  if (styleCount && onnx.styles !== undefined && onnx.styles !== styleCount) fail(`onnx.styles is ${String(onnx.styles)} but styles names ${styleCount}`);
   check.names(onnx.outputs, 'onnx.outputs', EXPECTED_OUTPUTS);
   const layers = posInt(onnx.layers, 'onnx.layers');
   const hidden = posInt(onnx.hidden, 'onnx.hidden');
@@ -126,7 +205,13 @@ const format = modelInfoFormat<GeneratorInfo>('GeneratorInfoError', 'generator.j
     numbers(seed.x, `seeds[${i}].x`, D);
     numbers(seed.h, `seeds[${i}].h`, layers * hidden);
     numbers(seed.c, `seeds[${i}].c`, layers * hidden);
+    if (styleCount && !(root.styles as string[]).includes(seed.style as string)) {
+      fail(`seeds[${i}].style must be one of the styles (${(root.styles as string[]).join(', ')}), got ${String(seed.style)}`);
+    }
   });
+  for (const style of styleCount ? (root.styles as string[]) : []) {
+    if (!(root.seeds as { style?: unknown }[]).some((s) => s.style === style)) fail(`no seed state of style "${style}"`);
+  }
 
   if (root.sampling !== undefined) {
     const c = obj(root.sampling, 'sampling').noise_correlation;

@@ -5,7 +5,7 @@
 // more locally (the cross-entropy search of search.ts). The best particle's first 17 frames are kept and
 // the next window starts from its state.
 import { decodeFeatures, type RootStart } from '../model/featureDecode';
-import { noiseCorrelation, type GeneratorInfo } from '../model/generatorInfo';
+import { noiseCorrelation, styleSeeds, type GeneratorInfo } from '../model/generatorInfo';
 import { Rng } from '../model/sampler';
 import { contactCost, lastToes, particleFeatures, type ToeState } from './objective';
 import { angleDifference, GroundPath } from './path';
@@ -94,6 +94,8 @@ export interface FollowPathOptions {
   path: GroundPath;
   gait: Gait;
   seed: number;
+  /** A style generator's style, whose seed states the walk starts from (default its first); `step` must feed the same style. */
+  style?: string;
   /** σ_fit of eq. (17), metres (default 0.1). */
   fitSigma?: number;
   temperature?: number;
@@ -260,10 +262,12 @@ function pathCost(r: RolloutResult, b: number, path: GroundPath, startArc: numbe
  * Seed states of a gait: those whose names start with it ("walk 02_01"). A model whose seeds name no gait at all
  * (a user's pack: its seeds are its own clips, named by file) starts every gait from any of them.
  */
-export function gaitSeeds(info: GeneratorInfo, gait: Gait): number[] {
-  const found = info.seeds.flatMap((s, i) => (s.name.startsWith(gait) ? [i] : []));
-  const namesGaits = info.seeds.some((s) => (Object.keys(GAITS) as string[]).some((g) => s.name.startsWith(g)));
-  if (!found.length && !namesGaits) return info.seeds.map((_, i) => i);
+export function gaitSeeds(info: GeneratorInfo, gait: Gait, style?: string): number[] {
+  // A style generator's seeds of `style` (default its first style); every seed of a generator without styles.
+  const pool = styleSeeds(info, style);
+  const found = pool.filter((i) => info.seeds[i].name.startsWith(gait));
+  const namesGaits = pool.some((i) => (Object.keys(GAITS) as string[]).some((g) => info.seeds[i].name.startsWith(g)));
+  if (!found.length && !namesGaits) return pool;
   if (!found.length) throw new Error(`the generator has no "${gait}" seed states (it has ${info.seeds.map((s) => s.name).join(', ')})`);
   return found;
 }
@@ -278,7 +282,7 @@ export async function followPath(o: FollowPathOptions): Promise<FollowPathResult
   const fitSigma = o.fitSigma ?? 0.1;
   const temperature = o.temperature ?? 0.5;
   const rng = new Rng(o.seed);
-  const seeds = gaitSeeds(info, gait);
+  const seeds = gaitSeeds(info, gait, o.style);
   const seedIndex = seeds[(o.seed >>> 0) % seeds.length];
   const start: RootStart = { x: path.xs[0], z: path.zs[0], heading: path.headingAt(0) };
   let state = seedStreamState(info.seeds[seedIndex], start);

@@ -35,7 +35,7 @@ serveModel({
     const loadPackRefiner = () => Promise.reject(new Error("refine is not available for your own model (a pack has no refiner)"));
     return new GeneratorCore(session, info, ort.Tensor, threads, { loadRefiner: (core) => (refinerInfoUrl ? loadRefiner(refinerInfoUrl, core.info, threads) : loadPackRefiner()) });
   },
-  streamParams: (r: StreamParams): StreamParams => ({ seed: r.seed, temperature: r.temperature, seedIndex: r.seedIndex, ...(r.refine === undefined ? {} : { refine: r.refine }) }),
+  streamParams: (r: StreamParams): StreamParams => ({ seed: r.seed, temperature: r.temperature, seedIndex: r.seedIndex, ...(r.refine === undefined ? {} : { refine: r.refine }), ...(r.style === undefined ? {} : { style: r.style }) }),
   requests: {
     refinerParity: (r: { inputs: RefinerStepInputs; frames?: number[] }, core: GeneratorCore) => refinerParity(core, r),
     denoise: (r: DenoiseParams, core: GeneratorCore, progress, signal) =>

@@ -4,7 +4,7 @@
 import type { InferenceSession, TensorConstructor } from 'onnxruntime-web';
 import { decodeFeatures, type RootStart } from '../../model/featureDecode';
 import { setStateRow } from '../../model/lstmState';
-import { noiseCorrelation, type GeneratorInfo, type StepInputs, type StepOutputs } from '../../model/generatorInfo';
+import { noiseCorrelation, styleNames, styleSeeds, styleVector, type GeneratorInfo, type StepInputs, type StepOutputs } from '../../model/generatorInfo';
 import type { GeneratedChunk, GenerateParams, InitResult, ParityResult, StreamInfo, StreamParams } from './protocol';
 import type { BenchmarkResult } from '../worker/protocol';
 import type { RefinerCore, RefinerStream } from '../refiner/refinerCore';
@@ -21,6 +21,8 @@ export interface GeneratorStream {
   rng: Rng;
   /** The sampler's normals, held over frames (generator.json sampling.noise_correlation). */
   noise: HeldNoise;
+  /** A style generator's style input for this stream (weights over info.styles: a one-hot, or a blend); undefined without styles. */
+  style?: Float32Array;
   root: RootStart;
   frame: number;
   /** With params.refine: the refiner's state behind this stream (made on the first advance). */
@@ -37,6 +39,8 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
   private readonly H: number;
   private readonly M: number;
   private readonly D: number;
+  /** The style input's width (info.styles.length); 0 for a generator without styles. */
+  private readonly S: number;
   private readonly loadRefiner: GeneratorCoreOptions['loadRefiner'];
   private refinerLoading: Promise<RefinerCore> | undefined;
 
@@ -44,6 +48,7 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
   constructor(session: InferenceSession, info: GeneratorInfo, Tensor: TensorConstructor, threads = 1, options: GeneratorCoreOptions = {}) {
     super(session, info, Tensor, threads);
     ({ layers: this.L, hidden: this.H, mixtures: this.M, dim: this.D } = info.onnx);
+    this.S = styleNames(info).length;
     this.loadRefiner = options.loadRefiner;
   }
 
@@ -85,14 +90,23 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
       parents: info.skeleton.parents,
       dim: info.onnx.dim,
       seeds: info.seeds.map((s) => s.name),
+      ...(info.styles ? { styles: [...info.styles] } : {}),
+      ...(info.licence ? { licence: info.licence } : {}),
       ...(typeof info.pack?.measures?.real?.sliding_low_foot === 'number' ? { heldOutSliding: info.pack.measures.real.sliding_low_foot } : {}),
     };
   }
 
-  /** One raw session call: x (B×D normalised), h and c (layers×B×H); with `signal`, a cancellation checkpoint first. */
-  async step(batch: number, x: Float32Array, h: Float32Array, c: Float32Array, signal?: AbortSignal): Promise<StepOutputs> {
+  /**
+   * One raw session call: x (B×D normalised), h and c (layers×B×H); with `signal`, a cancellation checkpoint first.
+   * A style generator's `style`: one row of weights over the styles for every row (S values) or one per row (B×S);
+   * default the first style. A generator without styles refuses one.
+   */
+  async step(batch: number, x: Float32Array, h: Float32Array, c: Float32Array, signal?: AbortSignal, style?: ArrayLike<number>): Promise<StepOutputs> {
     const { L, H, M, D } = this;
-    const read = await this.run({ x: [x, [batch, D]], h: [h, [L, batch, H]], c: [c, [L, batch, H]] }, signal);
+    const inputs: Record<string, [Float32Array, number[]]> = { x: [x, [batch, D]], h: [h, [L, batch, H]], c: [c, [L, batch, H]] };
+    if (this.S) inputs.style = [this.styleRows(batch, style), [batch, this.S]];
+    else if (style !== undefined) throw new Error(`the model "${this.info.id}" has no style input`);
+    const read = await this.run(inputs, signal);
     return {
       weights: read('weights', batch * M),
       mu: read('mu', batch * M * D),
@@ -102,15 +116,43 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
     };
   }
 
-  /** A new stream at the origin, heading 0, from its seed state. */
+  /** The style input for `batch` rows: `style` as one row for all (S values) or per row (B×S); default the first style. */
+  private styleRows(batch: number, style?: ArrayLike<number>): Float32Array {
+    const S = this.S;
+    const row = style === undefined ? styleVector(this.info) : style;
+    if (row.length === batch * S) return row instanceof Float32Array ? row : Float32Array.from(row);
+    if (row.length !== S) throw new Error(`the style input needs ${S} or ${batch * S} values, got ${row.length}`);
+    const out = new Float32Array(batch * S);
+    for (let b = 0; b < batch; b++) out.set(row, b * S);
+    return out;
+  }
+
+  /** A style generator's style input for `style` (a name, or weights blending the styles; default the first style). */
+  styleInput(style?: string | ArrayLike<number>): Float32Array | undefined {
+    if (!this.S) {
+      if (style !== undefined) throw new Error(`the model "${this.info.id}" has no styles`);
+      return undefined;
+    }
+    return styleVector(this.info, style);
+  }
+
+  /** Changes a stream's style from its next frame on: a name, or weights (a blend, as a style switch passes through). */
+  setStreamStyle(stream: GeneratorStream, style: string | ArrayLike<number>): void {
+    if (!this.S) throw new Error(`the model "${this.info.id}" has no styles`);
+    stream.style = styleVector(this.info, style);
+  }
+
+  /** A new stream at the origin, heading 0, from its seed state (a style generator: one of its style's seeds by default). */
   createStream(params: StreamParams): GeneratorStream {
     if (typeof params.seed !== 'number' || !Number.isFinite(params.seed)) throw new Error(`seed must be a finite number, got ${params.seed}`);
     if (typeof params.temperature !== 'number' || !Number.isFinite(params.temperature) || params.temperature < 0) {
       throw new Error(`temperature must be a finite number ≥ 0, got ${params.temperature}`);
     }
     if (params.refine !== undefined && typeof params.refine !== 'boolean') throw new Error(`refine must be true or false, got ${String(params.refine)}`);
+    if (params.style !== undefined && typeof params.style !== 'string') throw new Error(`style must be a style's name, got ${String(params.style)}`);
     const count = this.info.seeds.length;
-    const seedIndex = params.seedIndex ?? (params.seed >>> 0) % count;
+    const seeds = styleSeeds(this.info, params.style); // every seed for a generator without styles
+    const seedIndex = params.seedIndex ?? seeds[(params.seed >>> 0) % seeds.length];
     if (!Number.isInteger(seedIndex) || seedIndex < 0 || seedIndex >= count) {
       throw new Error(`seedIndex must be an integer from 0 to ${count - 1}, got ${params.seedIndex}`);
     }
@@ -123,13 +165,15 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
       c: Float32Array.from(seed.c),
       rng: new Rng(params.seed),
       noise: { correlation: noiseCorrelation(this.info) },
+      ...(this.S ? { style: styleVector(this.info, params.style) } : {}),
       root: { x: 0, z: 0, heading: 0 },
       frame: 0,
     };
   }
 
   streamInfo(stream: GeneratorStream): StreamInfo {
-    return { seedIndex: stream.seedIndex, seedName: this.info.seeds[stream.seedIndex].name };
+    const style = stream.params.style ?? this.info.styles?.[0];
+    return { seedIndex: stream.seedIndex, seedName: this.info.seeds[stream.seedIndex].name, ...(this.S && style ? { style } : {}) };
   }
 
   /**
@@ -150,7 +194,7 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
     // What the refiner reads: the frames exactly as fed back to the generator (normalised, contacts snapped).
     const fedBack = refiner ? new Float32Array(frames * D) : undefined;
     for (let t = 0; t < frames; t++) {
-      const out = await this.step(1, stream.x, stream.h, stream.c, signal);
+      const out = await this.step(1, stream.x, stream.h, stream.c, signal, stream.style);
       const x = sampleMixture({ weights: out.weights, mu: out.mu, sigma: out.sigma, batch: 1, mixtures: M, dim: D }, stream.params.temperature, stream.rng, undefined, stream.noise);
       snapContacts(x, D, this.mean, this.std);
       denormalise(x, this.mean, this.std, features.subarray(t * D, (t + 1) * D));
@@ -195,10 +239,14 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
     });
   }
 
-  /** One raw step; without inputs, the first and last seed states at batch 2 (the Python fixture's inputs). */
+  /**
+   * One raw step; without inputs, the first and last seed states at batch 2 (the Python fixture's inputs), a style
+   * generator's rows in their seeds' styles. A style generator's inputs may carry `style` (B×S; default the first style).
+   */
   async parity(inputs?: StepInputs): Promise<ParityResult> {
-    const { L, H, D } = this;
+    const { L, H, D, S } = this;
     let batch: number, x: Float32Array, h: Float32Array, c: Float32Array;
+    let style: Float32Array | undefined;
     if (inputs) {
       batch = inputs.batch;
       x = Float32Array.from(inputs.x);
@@ -207,12 +255,23 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
       if (!Number.isInteger(batch) || batch < 1 || x.length !== batch * D || h.length !== L * batch * H || c.length !== L * batch * H) {
         throw new Error(`parity inputs do not fit batch ${batch}: x has ${x.length} values (expected ${batch * D}), h ${h.length} and c ${c.length} (expected ${L * batch * H})`);
       }
+      if (inputs.style !== undefined) {
+        if (!S) throw new Error(`the model "${this.info.id}" has no style input`);
+        if (inputs.style.length !== batch * S) throw new Error(`parity inputs do not fit batch ${batch}: style has ${inputs.style.length} values (expected ${batch * S})`);
+        style = Float32Array.from(inputs.style);
+      }
     } else {
       batch = 2;
-      ({ x, h, c } = this.batchInputs([0, this.info.seeds.length - 1]));
+      const rows = [0, this.info.seeds.length - 1];
+      ({ x, h, c } = this.batchInputs(rows));
+      if (S) {
+        style = new Float32Array(batch * S);
+        rows.forEach((s, b) => style!.set(styleVector(this.info, this.info.seeds[s].style), b * S));
+      }
     }
-    const outputs = await this.step(batch, x.slice(), h.slice(), c.slice());
-    return { inputs: { batch, x, h, c }, outputs };
+    if (S) style ??= this.styleRows(batch);
+    const outputs = await this.step(batch, x.slice(), h.slice(), c.slice(), undefined, style?.slice());
+    return { inputs: { batch, x, h, c, ...(style ? { style } : {}) }, outputs };
   }
 
   /** Batch inputs whose row b starts from seed state seedIndices[b]. */

@@ -15,20 +15,25 @@ import type { GeneratorCore } from './generatorCore';
 import type { ControlChunkReply, ControlStartParams, ControlTargetParams, FollowPathChunk, FollowPathParams, SimulateControlParams, SimulatedControlChunk, StreamInfo } from './protocol';
 
 export class OptimizerRequests {
-  private live: { controller: LiveController; seedIndex: number; feet: PlantedFeet } | undefined;
+  private live: { controller: LiveController; seedIndex: number; feet: PlantedFeet; style?: string } | undefined;
 
   constructor(private readonly core: GeneratorCore) {}
 
-  /** The generator step the optimiser runs; with `signal`, each step is a cancellation checkpoint. */
-  private stepFn(signal?: AbortSignal): StepFn {
-    return (batch, x, h, c) => this.core.step(batch, x, h, c, signal);
+  /**
+   * The generator step the optimiser runs; with `signal`, each step is a cancellation checkpoint. A style generator's
+   * steps all carry `style` (a name; default its first style); a generator without styles refuses one.
+   */
+  private stepFn(signal?: AbortSignal, style?: string): StepFn {
+    const input = this.core.styleInput(checkStyle(style));
+    return (batch, x, h, c) => this.core.step(batch, x, h, c, signal, input);
   }
 
-  private controller(seed: number, gait: Gait, signal?: AbortSignal): { controller: LiveController; seedIndex: number } {
+  private controller(seed: number, gait: Gait, signal?: AbortSignal, style?: string): { controller: LiveController; seedIndex: number } {
     const info = this.core.info;
-    const seeds = gaitSeeds(info, gait);
+    const step = this.stepFn(signal, style);
+    const seeds = gaitSeeds(info, gait, style);
     const seedIndex = seeds[seed % seeds.length];
-    return { controller: new LiveController({ step: this.stepFn(signal), info, mean: this.core.mean, std: this.core.std, seed, seedIndex }), seedIndex };
+    return { controller: new LiveController({ step, info, mean: this.core.mean, std: this.core.std, seed, seedIndex }), seedIndex };
   }
 
   async followPath(p: FollowPathParams, progress: (fraction: number) => void, signal?: AbortSignal): Promise<FollowPathChunk> {
@@ -36,7 +41,8 @@ export class OptimizerRequests {
     const { gait, seed, lock, origin, ground: path } = checkFollowRequest(p);
     const fitSigma = checkFitSigma(optional(p.fitSigma, 0.1));
     const info = this.core.info;
-    const r = await followPath({ step: this.stepFn(signal), info, mean: this.core.mean, std: this.core.std, path, gait, seed, fitSigma, onProgress: progress });
+    const step = this.stepFn(signal, p.style);
+    const r = await followPath({ step, info, mean: this.core.mean, std: this.core.std, path, gait, seed, style: p.style, fitSigma, onProgress: progress });
     const shown = lock ? this.plant(r.positions, r.contacts) : { positions: r.positions, contacts: r.contacts };
     const stats = { ...r.stats, ...footStats(this.core.info, r.frames, shown, { positions: r.positions, contacts: r.contacts }) };
     return { frames: r.frames, features: r.features, positions: moveBack(shown.positions, origin), contacts: shown.contacts, rootHeading: r.rootHeading, seedIndex: r.seedIndex, startFrame: 0, stats, path: path.flatAt(origin) };
@@ -51,8 +57,9 @@ export class OptimizerRequests {
   controlStart(p: ControlStartParams): StreamInfo {
     this.live = undefined;
     const { joints, offsets } = this.core.info.skeleton;
-    this.live = { ...this.controller(checkSeed(p.seed), checkGait(p.gait)), feet: new PlantedFeet(joints, offsets, this.core.info.fps) };
-    return { seedIndex: this.live.seedIndex, seedName: this.core.info.seeds[this.live.seedIndex].name };
+    this.live = { ...this.controller(checkSeed(p.seed), checkGait(p.gait), undefined, p.style), feet: new PlantedFeet(joints, offsets, this.core.info.fps), style: p.style };
+    const style = p.style ?? this.core.info.styles?.[0];
+    return { seedIndex: this.live.seedIndex, seedName: this.core.info.seeds[this.live.seedIndex].name, ...(style ? { style } : {}) };
   }
 
   async controlPull(p: ControlTargetParams & { frames: number; particles?: number }): Promise<ControlChunkReply> {
@@ -78,7 +85,7 @@ export class OptimizerRequests {
     const schedule = checkSchedule(p.schedule);
     const seed = checkSeed(p.seed);
     const gait = p.gait === undefined ? (schedule[0].speed >= 2 ? 'run' : 'walk') : checkGait(p.gait);
-    const { controller, seedIndex } = this.controller(seed, gait, signal);
+    const { controller, seedIndex } = this.controller(seed, gait, signal, p.style);
     const fps = this.core.info.fps;
     const sim = await simulateControl(controller, schedule, p.seconds, fps, progress);
     const frames = sim.targets.length;
@@ -115,4 +122,10 @@ export class OptimizerRequests {
     if (lock) ({ positions: out.positions, contacts: out.contacts } = this.plant(out.positions, out.contacts));
     return out;
   }
+}
+
+/** A request's `style`: absent, or a style's name (which names a model has is checked by the core). */
+function checkStyle(style: unknown): string | undefined {
+  if (style !== undefined && typeof style !== 'string') throw new Error(`style must be a style's name, got ${String(style)}`);
+  return style;
 }

@@ -13,6 +13,8 @@ export interface GenerateParams {
   seedIndex?: number;
   /** Also run the refiner (loaded on first use) behind the generator: chunks then carry `refined` too. */
   refine?: boolean;
+  /** A style generator's style (one of InitResult.styles; default the first); refused by a generator without styles. */
+  style?: string;
 }
 
 export type StreamParams = Omit<GenerateParams, 'frames'>;
@@ -22,6 +24,9 @@ export interface InitResult extends ModelInit {
   seeds: string[];
   /** The real held-out clips' foot sliding (lowest foot point, m/s) a user's pack measured on its card; absent for shipped models. */
   heldOutSliding?: number;
+  /** A style generator's style names (the first is the default) and its licence; absent for a generator without styles. */
+  styles?: string[];
+  licence?: string;
 }
 
 /** A decoded run of generated frames. */
@@ -80,13 +85,15 @@ export interface RefinerParityResult {
 export interface StreamInfo {
   seedIndex: number;
   seedName: string;
+  /** A style generator's stream: its style. */
+  style?: string;
 }
 
 /** The generator worker's replies (the same shape as every model worker's). */
 export type GeneratorReply = WorkerReply;
 
 export interface ParityResult {
-  inputs: { batch: number; x: Float32Array; h: Float32Array; c: Float32Array };
+  inputs: { batch: number; x: Float32Array; h: Float32Array; c: Float32Array; style?: Float32Array };
   outputs: StepOutputs;
 }
 
@@ -94,6 +101,8 @@ export interface ParityResult {
 export interface FollowPathParams extends FollowPathRequest {
   /** σ_fit (m) of the path-fit term; default 0.1. */
   fitSigma?: number;
+  /** A style generator's style (default its first). */
+  style?: string;
 }
 
 export interface FollowPathChunk extends GeneratedChunk {
@@ -106,6 +115,8 @@ export interface FollowPathChunk extends GeneratedChunk {
 export interface ControlStartParams {
   seed: number;
   gait: 'walk' | 'run';
+  /** A style generator's style (default its first). */
+  style?: string;
 }
 
 export interface ControlTargetParams {
@@ -130,6 +141,8 @@ export interface SimulateControlParams {
   schedule: { t: number; speed: number; heading: number }[];
   seed: number;
   gait?: 'walk' | 'run';
+  /** A style generator's style (default its first). */
+  style?: string;
 }
 
 export interface SimulatedControlChunk extends GeneratedChunk {
