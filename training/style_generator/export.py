@@ -5,8 +5,9 @@
 Writes DIR/<id>.onnx (one step: x, h, c, style -> weights, mu, sigma, h_out, c_out; style is float32 (batch, styles),
 a one-hot or a blend of styles; the batch dimension is dynamic; training/style_generator/graph.py) and DIR/<id>.json
 (the generator's fields plus styles, licence, data, seeds per style from held-out clips, training and parity numbers;
-training/style_generator/exporting.py). It does not touch public/models/index.json: shipping is a later step
-(docs/models/style-generator.md, "Export").
+training/style_generator/exporting.py). With --out public/models it also adds the model to public/models/index.json
+(data and licence: CC BY-NC 4.0, non-commercial); elsewhere it writes only the two files (docs/models/style-generator.md,
+"Export").
 """
 from __future__ import annotations
 

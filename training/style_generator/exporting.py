@@ -1,6 +1,8 @@
 """Exporting a style-generator checkpoint (issue 39): the ONNX step with its style input (graph.py), the JSON with the
 generator's fields plus its styles, licence and data, seed states per style, and a reference step for the page's parity
-test. Nothing here writes public/models/index.json: the model is not shipped yet (docs/models/style-generator.md)."""
+test. Exported into public/models (MODELS_DIR) it also gets its manifest entry, with the data and licence of
+training/onnx/manifest.py's "cmu-and-bandai" (non-commercial), as every exporter registers its model there; exported
+anywhere else, nothing else is written."""
 from __future__ import annotations
 
 import json
@@ -19,7 +21,9 @@ from ..mocap.skeleton import canonical_skeleton
 from ..models.generator import MixtureLSTM, StyledGenerator
 from ..onnx.compact import weight_format
 from ..onnx.graph import OPSET
+from ..onnx.manifest import register_model
 from ..onnx.sessions import cpu_session
+from ..paths import MODELS_DIR
 from .graph import INPUTS, OUTPUTS, check_style_parity, export_style_onnx, model_from_style_onnx
 
 LICENCE = "CC BY-NC 4.0 (non-commercial): trained on the Bandai Namco Research Motiondataset and CMU"
@@ -154,7 +158,7 @@ def reference_step(onnx_path: Path, info: dict) -> dict:
 
 def export_style_generator(model: MixtureLSTM, meta: dict, state: dict, clips: list[StyledClip], out: Path,
                            model_id: str = "style-generator", weights: str = "int8") -> tuple[Path, dict]:
-    """Writes out/<id>.onnx and out/<id>.json; returns the ONNX path and the JSON."""
+    """Writes out/<id>.onnx and out/<id>.json, and into MODELS_DIR the manifest entry; returns the ONNX path and the JSON."""
     out.mkdir(parents=True, exist_ok=True)
     onnx_path = out / f"{model_id}.onnx"
     parity = write_style_graph(model, onnx_path, weights)
@@ -163,4 +167,7 @@ def export_style_generator(model: MixtureLSTM, meta: dict, state: dict, clips: l
     frames = style_seed_frames(clips, styles, set(meta["valid_files"]), codec, np.array(meta["mean"]), np.array(meta["std"]))
     info = style_info(model_id, model, meta, state, onnx_path, estimated_style_seeds(model, frames, styles), parity)
     (out / f"{model_id}.json").write_text(json.dumps(info) + "\n")
+    if out.resolve() == MODELS_DIR.resolve():  # shipping: the page lists it (non-commercial, labelled so in the pickers)
+        register_model({"id": model_id, "kind": info["kind"], "skeleton": "cmu-canonical", "fps": info["fps"],
+                        "styles": info["styles"], "bytes": info["bytes"], "file": info["file"]}, "cmu-and-bandai")
     return onnx_path, info
