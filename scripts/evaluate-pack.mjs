@@ -32,15 +32,24 @@ const FREEZE_FRACTION = 0.2;
 const COVERAGE_TOLERANCE = 0.15;
 
 const files = readdirSync(PACK_DIR).filter((f) => /\.(json|onnx|md|png)$/.test(f));
-const jsonName = files.find((f) => f.endsWith('.json'));
+// The pack's JSON is the one with a "pack" field (as the page's readPack chooses).
+const jsonName = files.filter((f) => f.endsWith('.json')).find((f) => 'pack' in JSON.parse(readFileSync(path.join(PACK_DIR, f), 'utf8')));
+if (!jsonName) {
+  console.error(`${PACK_DIR}: no JSON with a "pack" field: not a python -m training.own pack`);
+  process.exit(2);
+}
 const info = JSON.parse(readFileSync(path.join(PACK_DIR, jsonName), 'utf8'));
 const card = info.pack.measures;
+if (info.kind !== 'aclstm' && !card?.real) {
+  console.error(`${jsonName} has no pack.measures: not a finished python -m training.own pack`);
+  process.exit(2);
+}
 const fmt = (v, d = 3) => (Number.isFinite(v) ? v.toFixed(d) : String(v));
 
 async function main() {
   const { server, url } = await startServer();
   const browser = await launchBrowser();
-  const report = { pack: info.id, date: new Date().toISOString().slice(0, 10), seeds: SEEDS, frames: FRAMES, real: card.real };
+  const report = { pack: info.id, date: new Date().toISOString().slice(0, 10), seeds: SEEDS, frames: FRAMES, real: card?.real };
   try {
     const { context, page, problems } = await openPlayground(browser, url);
     await context.route(`${url}mypack/**`, (route) => {
@@ -75,7 +84,7 @@ async function main() {
 
     if (info.kind === 'aclstm') {
       report.dance = [];
-      const style = info.styles[0];
+      for (const style of info.styles) {
       const median = info.real_pose_change[style];
       for (let seed = 0; seed < SEEDS; seed++) {
         const r = await page.evaluate(
@@ -92,12 +101,13 @@ async function main() {
         );
         const sorted = [...r.seconds].sort((a, b) => a - b);
         const row = {
-          seed, frames: r.frames, finite: r.finite, generateSeconds: r.ms / 1000, rootHeight: r.rootHeight,
+          style, seed, frames: r.frames, finite: r.finite, generateSeconds: r.ms / 1000, rootHeight: r.rootHeight,
           medianRatio: sorted[Math.floor(sorted.length / 2)] / median, lowestRatio: sorted[0] / median,
           secondsBelowFreeze: r.seconds.filter((v) => v < FREEZE_FRACTION * median).length, seconds: r.seconds.length,
         };
         report.dance.push(row);
-        console.log(`dance seed ${seed}: ${row.frames} frames in ${fmt(row.generateSeconds, 1)} s, finite ${row.finite}, root height ${fmt(row.rootHeight[0], 2)}-${fmt(row.rootHeight[1], 2)} m; median pose change ${fmt(row.medianRatio, 2)}x the held-out median, ${row.secondsBelowFreeze}/${row.seconds} s below 20%`);
+        console.log(`dance ${style} seed ${seed}: ${row.frames} frames in ${fmt(row.generateSeconds, 1)} s, finite ${row.finite}, root height ${fmt(row.rootHeight[0], 2)}-${fmt(row.rootHeight[1], 2)} m; median pose change ${fmt(row.medianRatio, 2)}x the held-out median, ${row.secondsBelowFreeze}/${row.seconds} s below 20%`);
+      }
       }
       report.problems = problems;
       return;

@@ -19,7 +19,7 @@ const SEEDS = Number(option('--seeds', 3));
 const OUT = option('--out', null);
 const RUN_FRACTION = 0.5;
 const STOPPED_S = 3; // the gait has stopped running once it goes this many seconds without a running one
-// Two 60 m paths: straight, and a gentle S (arcs of 20 m radius, 30 m each way).
+// Two paths: straight, 60 m, and a gentle S (a sine of 6 m amplitude over 58 m: about 63 m long, tightest radius about 14 m).
 const STRAIGHT = Array.from({ length: 61 }, (_, i) => [0, i]);
 const S_CURVE = Array.from({ length: 61 }, (_, i) => {
   const a = (i / 60) * Math.PI * 2;
@@ -72,7 +72,10 @@ async function main() {
   try {
     const { page } = await openPlayground(browser, url);
     const listed = await page.evaluate(() => window.playground.models().map((m) => m.id));
-    const models = option('--models', 'generator,latent-erd,vae-lstm').split(',').filter((m) => listed.includes(m));
+    const asked = option('--models', 'generator,latent-erd,vae-lstm').split(',');
+    const unknown = asked.filter((m) => !listed.includes(m));
+    if (unknown.length) throw new Error(`not listed in models/index.json: ${unknown.join(', ')} (listed: ${listed.join(', ')})`);
+    const models = asked;
     for (const model of models) {
       for (const [name, points] of Object.entries(PATHS)) {
         for (let seed = 0; seed < SEEDS; seed++) {

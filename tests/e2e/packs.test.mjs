@@ -83,8 +83,10 @@ describe('model packs', { timeout: 900_000 }, () => {
       // The shipped models are still listed, the default first.
       assert.ok((await page.evaluate(() => $ui('walk-model').options.length)) >= 2);
 
-      // Random walk with the pack's model: frames stream, finite.
+      // Random walk with the pack's model: frames stream, finite (refine was on for the shipped generator).
       await page.evaluate(() => {
+        $ui('walk-refine').checked = true;
+        $ui('walk-refine').dispatchEvent(new Event('change'));
         $ui('walk-model').value = 'my-walks';
         $ui('walk-model').dispatchEvent(new Event('change'));
         $ui('mode-walk').click();
@@ -100,7 +102,17 @@ describe('model packs', { timeout: 900_000 }, () => {
       const labels = await page.evaluate(() => ({ reference: $ui('walk-skating-reference').textContent, header: document.querySelector('motion-playground').shadowRoot.textContent }));
       assert.equal(labels.reference, `your held-out clips: ${packJson().pack.measures.real.sliding_low_foot.toFixed(2)} m/s`);
       assert.match(labels.header, /my-walks · 30 fps · live/);
-      assert.deepEqual(await page.evaluate(() => [$ui('walk-refine').disabled, $ui('walk-refine').title]), [true, 'Your model has no refiner']);
+      // Refine was on for the shipped generator before: off and disabled for the pack, back on with the generator.
+      assert.deepEqual(await page.evaluate(() => [$ui('walk-refine').disabled, $ui('walk-refine').checked, $ui('walk-refine').title]), [true, false, 'Your model has no refiner']);
+      assert.deepEqual(await page.evaluate(() => {
+        $ui('walk-model').value = 'generator';
+        $ui('walk-model').dispatchEvent(new Event('change'));
+        return [$ui('walk-refine').disabled, $ui('walk-refine').checked];
+      }), [false, true]);
+      await page.evaluate(() => {
+        $ui('walk-model').value = 'my-walks';
+        $ui('walk-model').dispatchEvent(new Event('change'));
+      });
 
       // Its card, from the Path picker.
       await page.evaluate(() => {
@@ -118,6 +130,8 @@ describe('model packs', { timeout: 900_000 }, () => {
         return { open: dialog?.open, text: dialog?.querySelector('pre')?.textContent ?? '', plot: img?.naturalWidth ?? 0 };
       });
       assert.ok(card, 'a card button beside the Path picker');
+      // The Steer picker follows the Path picker's choice, and its tooltip says where that model's data came from.
+      assert.match(await page.evaluate(() => $ui('steer-model').title), /^Trained on your folder my-walks \(0\.2 minutes\)\. Licence: your data's own terms\.$/);
       assert.equal(card.open, true);
       assert.match(card.text, /^# my-walks/);
       assert.ok(card.plot > 100, 'the pose-change plot is shown');

@@ -41,7 +41,8 @@ def folder(tmp_path_factory, mocap):
 def pack(folder, tmp_path_factory):
     out = tmp_path_factory.mktemp("pack") / "my-salsa"
     run = tmp_path_factory.mktemp("run")
-    done = run_own("--data", folder, "--kind", "dance", "--out", out, "--run", run, *SMALL)
+    done = run_own("--data", folder, "--kind", "dance", "--out", out, "--run", run, *SMALL, "--non-commercial",
+                   "--licence", "CMU: free for research and commercial use (tested as if it were not)")
     assert done.returncode == 0, done.stderr[-3000:]
     return out, run, done
 
@@ -91,6 +92,8 @@ def test_the_dance_card_is_written_from_measurements(pack):
         assert r["finite"] and f"| {r['seed']} | yes | {r['median_ratio']:.2f} |" in card
     passing = sum(r["passes"] for r in runs)
     assert f"{passing} of 3 runs pass the freeze rule" in card
+    assert info["pack"]["commercial"] is False and info["pack"]["licence"].startswith("CMU: free")
+    assert "- Licence: CMU: free for research and commercial use (tested as if it were not); non-commercial use only." in card
     assert f"{m['real']['sliding_low_foot']:.3f}" in card
     assert (out / "pose_change.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
@@ -110,4 +113,4 @@ def test_dance_refusals(folder, tmp_path):
     done = run_own("--data", folder, "--kind", "locomotion", "--out", tmp_path / "p", "--layers", "3")
     assert done.returncode != 0 and "--layers is for --kind dance" in done.stderr
     done = run_own("--data", folder, "--kind", "dance", "--out", tmp_path / "p", "--source-fps", "0")
-    assert done.returncode != 0 and "--source-fps must be a positive frame rate" in done.stderr
+    assert done.returncode != 0 and "argument --source-fps: must be a positive frame rate, got 0" in done.stderr

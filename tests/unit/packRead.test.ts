@@ -30,6 +30,12 @@ describe('readPack', () => {
     expect(registry.shortName('my-walks')).toBe('my-walks');
     expect(looksLikePack(['my-walks.onnx', 'my-walks.json'])).toBe(true);
     expect(looksLikePack(['walk.bvh'])).toBe(false);
+    // A pack trained with --non-commercial (and its --licence) is labelled so; without them, the user's own terms.
+    expect(fromFolder.info).toMatchObject({ licence: "your data's own terms", data: 'your folder my-walks (0.2 minutes)' });
+    const nc = readPack(withJson({ ...json(), pack: { ...json().pack, licence: 'CC BY-NC 4.0 (Bandai Namco Research)', commercial: false } }), []);
+    expect(nc.info).toMatchObject({ licence: 'CC BY-NC 4.0 (Bandai Namco Research)', commercial: false });
+    const withNc = new Registry([nc.info]);
+    expect(withNc.label('my-walks')).toBe('my-walks (your model) (non-commercial)');
   });
 
   it('refuses a broken or incompatible pack with a short message', () => {
@@ -45,7 +51,8 @@ describe('readPack', () => {
       [refusal(folder(), ['my-walks']), /a model "my-walks" is already listed/],
       [refusal(folder().filter((f) => !f.name.endsWith('.onnx'))), /the pack has no my-walks\.onnx/],
       [refusal(folder().filter((f) => !f.name.endsWith('.json'))), /no model JSON in the pack/],
-      [refusal(withJson({ ...json(), kind: 'latent-erd' })), /kind must be "lstm-gmm" \(a locomotion pack\) or "aclstm" \(a dance pack\), got "latent-erd"/],
+      [refusal(withJson({ ...json(), kind: 'latent-erd' })), /kind must be "lstm-gmm" \(a locomotion pack\) or "aclstm" \(a dance pack\); got "latent-erd"/],
+      [refusal(withJson({ ...json(), kind: undefined })), /kind must be .*; it has none$/],
       // A generator's JSON that calls itself a dance model is checked as one.
       [refusal(withJson({ ...json(), kind: 'aclstm' })), /styles/],
       [refusal(withJson({ ...json(), seeds: [] })), /seeds must be a non-empty array/],

@@ -20,8 +20,9 @@ from pathlib import Path
 
 from .dataset import OwnCorpus, RefusedFolder, load_folder
 from .distributed import launched_rank
-from .dance_pack import train_and_pack_dance
-from .options import add_own_arguments, apply_kind_defaults, min_clip_frames, pack_id, run_folder
+from .dance import train_dance
+from .dance_pack import write_dance_pack
+from .options import add_own_arguments, apply_kind_defaults, min_clip_frames, pack_id, pack_terms, run_folder
 from .pack import export_pack, measure_pack, plot_pose_change, record_measures, write_card
 from .trainer import train_locomotion
 
@@ -47,7 +48,16 @@ def main(argv: list[str] | None = None) -> None:
     say(f"data: {data.minutes:.2f} minutes in {len(data.clips)} clips ({len(data.held_out)} held out), "
           f"read in {time.perf_counter() - t0:.0f} s")
     if args.kind == "dance":
-        return train_and_pack_dance(args, data, model_id)
+        result = train_dance(data, args)
+        if result.interrupted:
+            print(f"stopped by Ctrl-C after {result.iterations} iterations; the checkpoint is in {args.run}: "
+                  "run the same command with --resume to go on")
+            raise SystemExit(130)
+        print(f"trained {result.minutes:.1f} minutes, {result.iterations} iterations ({result.stopped}); "
+              f"held-out error {result.best:.4f}; run in {args.run}")
+        onnx_path, json_path = write_dance_pack(args, data, model_id, result)
+        print(f"wrote the pack {model_id} to {args.out}: {onnx_path.name}, {json_path.name}, card.md, pose_change.png")
+        return
     result = train_locomotion(OwnCorpus(data), args)
     if result.interrupted:
         say(f"stopped by Ctrl-C after {result.iterations} iterations; the checkpoint is in {args.run}: "
@@ -57,7 +67,8 @@ def main(argv: list[str] | None = None) -> None:
         return
     print(f"trained {result.minutes:.1f} minutes, {result.iterations} iterations ({result.stopped}); "
           f"held-out NLL {result.best_valid_nll:.3f} per frame; run in {args.run}")
-    onnx_path, json_path, info = export_pack(Path(args.run) / "best.pt", data, model_id, args.out, args.weights)
+    onnx_path, json_path, info = export_pack(Path(args.run) / "best.pt", data, model_id, args.out, args.weights,
+                                              pack_terms(args))
     measures = measure_pack(onnx_path, info, data, args.stability_frames)
     plot_pose_change(measures["stability"], measures["real"]["median_pose_change"], args.out / "pose_change.png")
     write_card(args.out / "card.md", model_id, data, result, info, measures)

@@ -25,8 +25,9 @@ from ..aclstm.training import DanceRun
 from ..data.dance import LIMB_MIN_LENGTH, bone_length_error, decode, real_pose_change
 from ..mocap.contacts import contacts_for
 from ..mocap.skeleton import FOOT_POINTS, canonical_skeleton
-from .dance import dance_data, train_dance
+from .dance import dance_data
 from .dataset import FPS, OwnData
+from .options import pack_terms
 from .pack import STABILITY_FRAMES, card_data_lines, number_or_na, plot_pose_change
 
 STABILITY_SEEDS = 3
@@ -36,7 +37,7 @@ DIVERGED_BONES = 0.25
 DIVERGED_HEIGHT = 0.5
 
 
-def export_dance_pack(checkpoint: Path, data: OwnData, pack_id: str, out: Path, weights: str) -> tuple[Path, Path, dict]:
+def export_dance_pack(checkpoint: Path, data: OwnData, pack_id: str, out: Path, weights: str, terms: dict) -> tuple[Path, Path, dict]:
     """Writes out/<id>.onnx (parity checked) and out/<id>.json; returns both paths and the info."""
     model, meta, state = load_dance_model(checkpoint)
     skel, clips, styles = dance_data(data)
@@ -60,7 +61,7 @@ def export_dance_pack(checkpoint: Path, data: OwnData, pack_id: str, out: Path, 
         "training": {"iterations": state.get("iteration"), "valid": state.get("valid"), "valid_files": meta["valid_files"],
                      "args": meta["args"]},
         "parity": parity,
-        "pack": {"card": "card.md", "thumbnail": "pose_change.png", "data_folder": data.folder.name,
+        "pack": {**terms, "card": "card.md", "thumbnail": "pose_change.png", "data_folder": data.folder.name,
                  "data_minutes": round(data.minutes, 3), "clips": len(data.clips)},
     }
     info["bytes"] = onnx_path.stat().st_size
@@ -133,7 +134,7 @@ def write_dance_card(path: Path, pack_id: str, data: OwnData, result: DanceRun, 
         f"{info['bytes'] / 1e6:.2f} MB ONNX, weights {info['onnx']['weights']}) trained by `python -m training.own --kind dance` "
         f"on the folder `{data.folder.name}` as one style, \"{info['styles'][0]}\". Every number below was measured on this "
         "pack's own ONNX file with onnxruntime.", "",
-        *card_data_lines(data, "the canonical skeleton's 25 points"),
+        *card_data_lines(data, "the canonical skeleton's 25 points", info),
         "", "## Training", "",
         f"- {result.minutes:.1f} minutes, {result.iterations} iterations; stopped: {result.stopped}.",
         f"- Held-out mean squared error per feature (normalised, lower is better): {valid.get('teacher_forced', float('nan')):.4f} "
@@ -181,19 +182,12 @@ def record_dance_measures(json_path: Path, info: dict, result: DanceRun, measure
     json_path.write_text(json.dumps(info) + "\n")
 
 
-def train_and_pack_dance(args: argparse.Namespace, data: OwnData, model_id: str) -> None:
-    """python -m training.own --kind dance after reading the folder: train, then write and measure the pack."""
-    result = train_dance(data, args)
-    if result.interrupted:
-        print(f"stopped by Ctrl-C after {result.iterations} iterations; the checkpoint is in {args.run}: "
-              "run the same command with --resume to go on")
-        raise SystemExit(130)
-    print(f"trained {result.minutes:.1f} minutes, {result.iterations} iterations ({result.stopped}); "
-          f"held-out error {result.best:.4f}; run in {args.run}")
-    onnx_path, json_path, info = export_dance_pack(Path(args.run) / "best.pt", data, model_id, args.out, args.weights)
+def write_dance_pack(args: argparse.Namespace, data: OwnData, model_id: str, result: DanceRun) -> tuple[Path, Path]:
+    """The dance pack of a finished run into args.out: ONNX, JSON, measured card and plot; returns the ONNX and JSON."""
+    onnx_path, json_path, info = export_dance_pack(Path(args.run) / "best.pt", data, model_id, args.out, args.weights,
+                                                   pack_terms(args))
     measures = measure_dance_pack(args.out, info, data, args.stability_frames)
     plot_pose_change(measures["stability"], measures["real"]["median_pose_change"], args.out / "pose_change.png")
     write_dance_card(args.out / "card.md", model_id, data, result, info, measures)
     record_dance_measures(json_path, info, result, measures)
-    print(f"wrote the pack {model_id} to {args.out}: {onnx_path.name}, {json_path.name}, card.md, pose_change.png")
-
+    return onnx_path, json_path

@@ -59,8 +59,6 @@ def load_folder(folder: Path, min_frames: int, log=print, source_fps: float | No
         raise RefusedFolder(f"{folder} is not a folder")
     raws, skipped = read_folder(folder)
     if source_fps is not None:
-        if not source_fps > 0:
-            raise RefusedFolder(f"--source-fps must be a positive frame rate, got {source_fps:g}")
         for raw in raws:
             raw.fps = source_fps
     for problem in skipped:

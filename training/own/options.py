@@ -16,9 +16,14 @@ def add_own_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--kind", choices=KINDS, required=True, help="locomotion: the LSTM-GMM generator; dance: the acLSTM")
     parser.add_argument("--out", type=Path, required=True, help="folder the pack is written to")
     parser.add_argument("--id", default=None, help="the pack's model id (default: the --out folder's name)")
-    parser.add_argument("--source-fps", type=float, default=None,
+    parser.add_argument("--source-fps", type=positive_rate, default=None,
                         help="the files' true frame rate, for files whose header is wrong (the acLSTM salsa files say 120, "
                              "were captured at 60); default each file's own (AMC: 120)")
+    parser.add_argument("--licence", default=None,
+                        help="the terms of your data, shown with the model (default: \"your data's own terms\")")
+    parser.add_argument("--non-commercial", action="store_true",
+                        help="the data may not be used commercially (e.g. the Bandai Namco set, CC BY-NC 4.0): the page "
+                             "labels the model \"(non-commercial)\"")
     parser.add_argument("--minutes", type=float, default=20.0, help="training time budget (minutes)")
     parser.add_argument("--iterations", type=int, default=None, help="stop after this many iterations in all (default: the time budget decides)")
     parser.add_argument("--run", default=None, help="run folder for the log and checkpoints (default runs/own-<id>)")
@@ -38,6 +43,22 @@ def add_own_arguments(parser: argparse.ArgumentParser) -> None:
                         help="iterations between learning-rate decays (locomotion 200, dance 250)")
     parser.add_argument("--weights", choices=("float32", "float16", "int8"), default="int8", help="how the ONNX stores its weights")
     parser.add_argument("--stability-frames", type=int, default=10_000, help="frames of the card's stability run")
+
+
+def positive_rate(text: str) -> float:
+    """--source-fps: a positive frame rate, refused before anything is read."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a frame rate, got {text!r}") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be a positive frame rate, got {text}")
+    return value
+
+
+def pack_terms(args: argparse.Namespace) -> dict:
+    """The pack's licence fields (its JSON's `pack`): what the page shows with the model."""
+    return {"licence": args.licence or "your data's own terms", "commercial": not args.non_commercial}
 
 
 # Each kind's recipe: the shipped generator's (training/generator) and the shipped acLSTM's (training/aclstm).

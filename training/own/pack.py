@@ -56,7 +56,8 @@ def pick_seeds(data: OwnData, codec: FeatureCodec, mean: np.ndarray, std: np.nda
     return seeds
 
 
-def export_pack(checkpoint: Path, data: OwnData, pack_id: str, out: Path, weights: str, seed_iterations: int = 300) -> tuple[Path, Path, dict]:
+def export_pack(checkpoint: Path, data: OwnData, pack_id: str, out: Path, weights: str, terms: dict,
+                seed_iterations: int = 300) -> tuple[Path, Path, dict]:
     """Writes out/<id>.onnx and out/<id>.json (the shipped generator.json's fields); returns both paths and the info."""
     # The seed states' small optimisations run many times slower on several threads of a busy machine.
     torch.set_num_threads(1)
@@ -99,7 +100,7 @@ def export_pack(checkpoint: Path, data: OwnData, pack_id: str, out: Path, weight
                      "valid_files": meta["valid_files"], "train_frames": meta["train_frames"], "args": meta["args"]},
         "parity": parity,
         "weights": weight_format(onnx.load(str(onnx_path))),
-        "pack": {"card": "card.md", "thumbnail": "pose_change.png", "data_folder": data.folder.name,
+        "pack": {**terms, "card": "card.md", "thumbnail": "pose_change.png", "data_folder": data.folder.name,
                  "data_minutes": round(data.minutes, 3), "clips": len(data.clips)},
     }
     json_path = out / f"{pack_id}.json"
@@ -205,8 +206,9 @@ def number_or_na(v: float) -> str:
     return "n/a" if v != v else f"{v:.3f}"
 
 
-def card_data_lines(data: OwnData, target: str) -> list[str]:
-    """The card's "Data" section: minutes, clips, held-out clips, skeletons (mapped onto `target`), files left out."""
+def card_data_lines(data: OwnData, target: str, info: dict) -> list[str]:
+    """The card's "Data" section: minutes, clips, held-out clips, skeletons (mapped onto `target`), files left out,
+    and the data's terms (the pack's licence fields in `info`)."""
     skeletons = "; ".join(f"{s['scheme']}, {s['joints']} joints ({s['files']} file{'s' * (s['files'] != 1)})"
                           for s in data.skeletons)
     return [
@@ -217,6 +219,7 @@ def card_data_lines(data: OwnData, target: str) -> list[str]:
         f"- Unreadable, left out: {len(data.skipped)} file{'s' * (len(data.skipped) != 1)}" + (": " + "; ".join(data.skipped) if data.skipped else "."),
         f"- Shorter than the training window ({data.min_seconds:.2f} s), left out: {len(data.too_short)} clip{'s' * (len(data.too_short) != 1)}"
         + (": " + ", ".join(data.too_short) if data.too_short else "."),
+        f"- Licence: {info['pack']['licence']}" + ("; non-commercial use only." if not info["pack"]["commercial"] else "."),
     ]
 
 
@@ -229,7 +232,7 @@ def write_card(path: Path, pack_id: str, data: OwnData, result: TrainingResult, 
         f"A locomotion generator (LSTM + Gaussian mixture, {info['onnx']['hidden']} hidden units, {info['bytes'] / 1e6:.2f} MB "
         f"ONNX, weights {info['weights']}) trained by `python -m training.own` on the folder `{data.folder.name}`. "
         "Every number below was measured on this pack's own ONNX file with onnxruntime.", "",
-        *card_data_lines(data, "the canonical skeleton"),
+        *card_data_lines(data, "the canonical skeleton", info),
         "", "## Training", "",
         f"- {result.minutes:.1f} minutes, {result.iterations} iterations ({result.epochs_done} whole epoch{'s' * (result.epochs_done != 1)}); stopped: {result.stopped}.",
         f"- Held-out NLL per frame (normalised features, lower is better): {result.best_valid_nll:.3f}.",

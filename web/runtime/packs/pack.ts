@@ -86,7 +86,8 @@ export function readPack(files: readonly PackFile[], taken: readonly string[]): 
   const kind = typeof raw.kind === 'string' && Object.hasOwn(PACK_KINDS, raw.kind) ? PACK_KINDS[raw.kind] : undefined;
   if (!kind) {
     const kinds = Object.entries(PACK_KINDS).map(([k, v]) => `"${k}" (${v.what})`).join(' or ');
-    throw new PackError(`${chosen.f.name}: kind must be ${kinds}, got ${JSON.stringify(raw.kind)?.slice(0, 40)}`);
+    const got = raw.kind === undefined ? 'it has none' : `got ${JSON.stringify(raw.kind)?.slice(0, 40)}`;
+    throw new PackError(`${chosen.f.name}: kind must be ${kinds}; ${got}`);
   }
   try {
     kind.parse(raw, chosen.f.name);
@@ -99,7 +100,7 @@ export function readPack(files: readonly PackFile[], taken: readonly string[]): 
   const onnxName = typeof raw.file === 'string' ? baseName(raw.file) : `${id}.onnx`;
   const onnx = files.find((f) => f.name === onnxName);
   if (!onnx) throw new PackError(`the pack has no ${onnxName} (named by ${chosen.f.name})`);
-  const pack = (raw.pack ?? {}) as { card?: unknown; thumbnail?: unknown; data_folder?: unknown; data_minutes?: unknown };
+  const pack = (raw.pack ?? {}) as { card?: unknown; thumbnail?: unknown; data_folder?: unknown; data_minutes?: unknown; licence?: unknown; commercial?: unknown };
   const cardName = typeof pack.card === 'string' ? baseName(pack.card) : 'card.md';
   const thumbName = typeof pack.thumbnail === 'string' ? baseName(pack.thumbnail) : 'pose_change.png';
   const card = files.find((f) => f.name === cardName);
@@ -115,7 +116,9 @@ export function readPack(files: readonly PackFile[], taken: readonly string[]): 
     files: { model: blobUrl(onnx.bytes, 'application/octet-stream', urls), info: blobUrl(chosen.f.bytes, 'application/json', urls) },
     label: `${id} (your model)`,
     data: typeof pack.data_folder === 'string' ? `your folder ${pack.data_folder}${typeof pack.data_minutes === 'number' ? ` (${pack.data_minutes.toFixed(1)} minutes)` : ''}` : 'your own motion',
-    licence: "your data's own terms",
+    licence: typeof pack.licence === 'string' && pack.licence.trim() ? pack.licence.slice(0, 200) : "your data's own terms",
+    // Trained with --non-commercial (e.g. on the Bandai Namco set): labelled so in the pickers.
+    ...(pack.commercial === false ? { commercial: false } : {}),
   };
   return {
     info,

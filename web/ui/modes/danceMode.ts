@@ -8,7 +8,7 @@ import { DanceClient, type DanceInitResult, type DanceMotion } from '../../runti
 import type { Registry } from '../../runtime/registry';
 import { $ } from '../dom';
 import { PoseChangePlot } from '../poseChangePlot';
-import { fillSelect } from './modelChoice';
+import { fillSelect, showProvenance } from './modelChoice';
 import type { ModeHost } from './host';
 import { LiveMode, type LiveStream } from './liveMode';
 
@@ -44,6 +44,7 @@ export class DanceMode extends LiveMode<DanceMotion> {
   /** Picks the dance model a view names (the stream restarts with it once the mode is on). */
   selectModel(id: string): void {
     this.model.value = id;
+    showProvenance(this.model);
   }
 
   private get modelLabel(): string {

@@ -43,7 +43,10 @@ export class ModelChoice {
 
   set(model: string): void {
     // A select without this model keeps showing the model its mode runs.
-    for (const select of this.selects) select.value = [...select.options].some((o) => o.value === model) ? model : this.lastSteerable;
+    for (const select of this.selects) {
+      select.value = [...select.options].some((o) => o.value === model) ? model : this.lastSteerable;
+      showProvenance(select);
+    }
     if (model === this.current) return;
     this.current = model;
     if (this.steerIds.includes(model)) this.lastSteerable = model;
@@ -69,11 +72,14 @@ export function fillSelect(select: HTMLSelectElement, registry: Registry, ids: r
     }),
   );
   if ([...select.options].some((o) => o.value === kept)) select.value = kept;
-  // The picker's own tooltip follows the chosen model (what it was trained on, its licence).
-  const showChosen = () => (select.title = select.selectedOptions[0]?.title ?? '');
-  showChosen();
+  showProvenance(select);
   if (!select.dataset.provenance) {
     select.dataset.provenance = 'shown';
-    select.addEventListener('change', showChosen);
+    select.addEventListener('change', () => showProvenance(select));
   }
+}
+
+/** The picker's own tooltip: the chosen model's (what it was trained on, its licence). Call after setting its value. */
+export function showProvenance(select: HTMLSelectElement): void {
+  select.title = select.selectedOptions[0]?.title ?? '';
 }

@@ -48,6 +48,8 @@ export class RandomWalk extends LiveMode<WalkChunk> {
   private readonly seedState = $<HTMLSelectElement>('walk-seed-state');
   private readonly seed = $<HTMLInputElement>('walk-seed');
   private readonly refine = $<HTMLInputElement>('walk-refine');
+  /** The user's own refine choice, kept while a model without a refiner (a pack) has refine off. */
+  private refineWanted = false;
   private readonly sideBySide = $<HTMLInputElement>('walk-side-by-side');
   private readonly skating = $('walk-skating');
   private readonly skatingRaw = $('walk-skating-raw');
@@ -66,11 +68,13 @@ export class RandomWalk extends LiveMode<WalkChunk> {
       // Another model has other seed states.
       this.seedState.replaceChildren(this.seedState.options[0]);
       this.seedsListed = false;
+      this.showRefinerAvailability(this.app.registry.find(this.model.value)?.info.files !== undefined);
       this.restartIfActive();
     });
     this.seed.addEventListener('change', () => this.restartIfActive());
     $('walk-restart').addEventListener('click', () => this.restartIfActive());
     this.refine.addEventListener('change', () => {
+      this.refineWanted = this.refine.checked;
       if (!this.refine.checked) {
         this.sideBySide.checked = false;
         this.showCompanion();
@@ -80,7 +84,7 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     this.sideBySide.addEventListener('change', () => {
       // Side by side needs the refined stream; a refined stream already carries the raw frames.
       if (this.sideBySide.checked && !this.refine.checked) {
-        this.refine.checked = true;
+        this.refine.checked = this.refineWanted = true;
         this.restartIfActive();
       } else {
         this.showCompanion();
@@ -112,6 +116,20 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     return { seed, temperature, ...(idx === undefined ? {} : { seedIndex: idx }), refine: this.refine.checked };
   }
 
+  /**
+   * A user's pack (its files are its own) has no refiner trained for it: refine and side by side are off and disabled
+   * while it is chosen, and the user's own refine choice comes back with a model that has one.
+   */
+  private showRefinerAvailability(noRefiner: boolean): void {
+    this.refine.disabled = this.sideBySide.disabled = noRefiner;
+    this.refine.title = this.sideBySide.title = noRefiner ? 'Your model has no refiner' : '';
+    const refine = this.refineWanted && !noRefiner;
+    if (this.refine.checked === refine) return;
+    this.refine.checked = refine;
+    if (!refine) this.sideBySide.checked = false;
+    this.showCompanion();
+  }
+
   /** Lists the registry's walking models in the model picker. */
   list(registry: Registry): void {
     fillSelect(this.model, registry, registry.ids('walk'));
@@ -123,14 +141,7 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     const walker = (this.model.value && registry.can(this.model.value, 'walk') ? registry.find(this.model.value) : undefined) ?? registry.defaultFor('walk');
     if (!walker) throw new Error('no model for Random walk is listed in models/index.json');
     const id = walker.info.id;
-    // A user's pack (its files are its own) has no refiner trained for it: refine and side by side are off for it.
-    const noRefiner = walker.info.files !== undefined;
-    this.refine.disabled = this.sideBySide.disabled = noRefiner;
-    this.refine.title = this.sideBySide.title = noRefiner ? 'Your model has no refiner' : '';
-    if (noRefiner && this.refine.checked) {
-      this.refine.checked = this.sideBySide.checked = false;
-      this.showCompanion();
-    }
+    this.showRefinerAvailability(walker.info.files !== undefined);
     const { client } = await this.app.host(id).load();
     if (!(client instanceof GeneratorClient)) throw new Error(`model "${id}" cannot stream a random walk`);
     const info = client.initResult;
