@@ -55,6 +55,14 @@ describe('generate checks', () => {
     expect(messageOf(() => checkGenerate({ model: 'generator', frames: 10, seed: NaN }, MODELS))).toMatch(/seed must be an integer .*, got NaN$/);
     expect(messageOf(() => checkGenerate({ model: 'generator', frames: 10, seed: 0, temperature: '0.5' }, MODELS))).toMatch(/got "0\.5"$/);
     expect(messageOf(() => checkGenerate({ model: 'aclstm', frames: 10, seed: 0, style: 7 }, MODELS))).toMatch(/^unknown style 7 for model "aclstm"/);
+    // A style generator (issue 39) takes one of its styles, default its first; the CMU-only generator takes none.
+    const styled = [...MODELS, { id: 'style-generator', kind: 'lstm-gmm', skeleton: 'cmu-canonical', fps: 30, styles: ['cmu', 'elderly'], bytes: 1, commercial: false }];
+    expect(checkGenerate({ model: 'style-generator', frames: 10, seed: 0 }, styled)).toMatchObject({ style: 'cmu' });
+    expect(checkGenerate({ model: 'style-generator', frames: 10, seed: 0, style: 'elderly' }, styled)).toMatchObject({ style: 'elderly' });
+    expect(messageOf(() => checkGenerate({ model: 'style-generator', frames: 10, seed: 0, style: 'tired' }, styled))).toMatch(/^unknown style "tired" for model "style-generator" \(styles: cmu, elderly\)/);
+    expect(messageOf(() => checkGenerate({ model: 'generator', frames: 10, seed: 0, style: 'elderly' }, styled))).toMatch(/^style is not an option of model "generator": it has no styles/);
+    expect(checkGenerate({ model: 'generator', frames: 10, seed: 0 }, styled)).not.toHaveProperty('style');
+    expect(messageOf(() => checkGenerate({ model: 'style-generator', frames: 10, seed: 0, refine: true }, [...styled, { id: 'refiner', kind: 'refiner', skeleton: 'cmu-canonical', fps: 30, bytes: 1 }]))).toMatch(/^refine is not available for model "style-generator"/);
     expect(messageOf(() => checkGenerate({ model: 'x'.repeat(1e6), frames: 10, seed: 0 }, MODELS)).length).toBeLessThan(150);
     expect(messageOf(() => checkGenerate({ model: 'generator', frames: 10, seed: 0, ['y'.repeat(1e6)]: 1 }, MODELS)).length).toBeLessThan(150);
   });

@@ -20,8 +20,8 @@ export const descriptor: ModelDescriptor<GeneratorClient> = {
   createClient: (entry, threads) => new GeneratorClient(clientFiles(entry, threads)),
 
   generate: {
-    options: ['model', 'frames', 'seed', 'temperature', 'refine'],
-    check(o, _entry, models) {
+    options: ['model', 'frames', 'seed', 'temperature', 'refine', 'style'],
+    check(o, entry, models) {
       const temperature = optional(o.temperature, GENERATE_DEFAULT_TEMPERATURE);
       if (typeof temperature !== 'number' || !Number.isFinite(temperature) || temperature < 0 || temperature > 2) {
         throw new RangeError(`temperature must be a number from 0 to 2, got ${describeValue(temperature)}`);
@@ -29,11 +29,21 @@ export const descriptor: ModelDescriptor<GeneratorClient> = {
       if (o.refine !== undefined && typeof o.refine !== 'boolean') throw new TypeError(`refine must be true or false, got ${describeValue(o.refine)}`);
       const refine = o.refine === true;
       if (refine && !models.some((m) => m.kind === 'refiner')) throw new Error('refine is not available: no refiner model is listed in models/index.json');
-      return { temperature, refine };
+      // A style generator (its entry lists styles) takes one of them, default its first; any other generator none.
+      const styles = entry.styles ?? [];
+      if (o.style !== undefined) {
+        if (styles.length === 0) throw new TypeError(`style is not an option of model "${entry.id}": it has no styles; leave it out`);
+        if (typeof o.style !== 'string' || !styles.includes(o.style)) {
+          throw new RangeError(`unknown style ${describeValue(o.style)} for model "${entry.id}" (styles: ${styles.join(', ')})`);
+        }
+      }
+      if (refine && styles.length) throw new TypeError(`refine is not available for model "${entry.id}": the refiner learnt from the CMU-only generator; leave it out`);
+      return { temperature, refine, ...(styles.length ? { style: (o.style as string | undefined) ?? styles[0] } : {}) };
     },
     async run(client, call, { signal }) {
       const refine = call.refine === true;
-      const m = await client.generate({ frames: call.frames, seed: call.seed, temperature: call.temperature as number, ...(refine ? { refine: true } : {}) }, { signal });
+      const style = typeof call.style === 'string' ? { style: call.style } : {};
+      const m = await client.generate({ frames: call.frames, seed: call.seed, temperature: call.temperature as number, ...(refine ? { refine: true } : {}), ...style }, { signal });
       const shown = refine ? m.refined : m;
       if (!shown) throw new Error('the generator worker returned no refined frames');
       return motionOf(m, shown.positions, shown.contacts);
