@@ -113,21 +113,24 @@ describe('the <motion-playground> element', { timeout: 240_000 }, () => {
     const r = await page.evaluate(async () => {
       const el = document.querySelector('motion-playground');
       const ui = (id) => el.shadowRoot.getElementById(id);
-      const settle = () => new Promise((resolve) => setTimeout(resolve, 120)); // the element reflects its UI a moment after a change
+      // The element reflects its UI a moment after a change (a timer): wait for the state, not for a fixed time.
+      const until = async (ok, ms = 10_000) => {
+        for (const t0 = performance.now(); !ok() && performance.now() - t0 < ms; ) await new Promise((resolve) => setTimeout(resolve, 20));
+      };
       const out = { props: { mode: el.mode, seed: el.seed, temperature: el.temperature, refine: el.refine, cameraControls: el.cameraControls, autoplay: el.autoplay } };
       out.ui = { seed: ui('walk-seed').value, temperature: Number(ui('walk-temperature').value) };
       el.seed = 11; // property → attribute → UI
       out.seedAttribute = el.getAttribute('seed');
       await el.ready;
-      await settle();
+      await until(() => ui('walk-seed').value === '11');
       out.uiSeed = ui('walk-seed').value;
       el.setAttribute('temperature', '0.8'); // attribute → property → UI
-      await settle();
+      await until(() => Number(ui('walk-temperature').value) === 0.8);
       out.temperature = [el.temperature, Number(ui('walk-temperature').value)];
       const seedInput = ui('walk-seed'); // UI → attribute
       seedInput.value = '21';
       seedInput.dispatchEvent(new Event('change', { bubbles: true }));
-      await settle();
+      await until(() => el.getAttribute('seed') === '21');
       out.fromUi = [el.getAttribute('seed'), el.seed];
       el.cameraControls = false;
       out.cameraControls = [el.hasAttribute('camera-controls'), el.playground !== undefined];
