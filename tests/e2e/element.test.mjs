@@ -236,7 +236,10 @@ describe('the <motion-playground> element', { timeout: 240_000 }, () => {
     await waitUntil(first, () => window.playground.current()?.frames > 0 && $ui('path-progress')?.hidden !== false, null, { timeout: 90_000, message: 'the linked path is walked' });
     const shown = await first.evaluate(async () => {
       const el = document.querySelector('motion-playground');
-      await new Promise((resolve) => setTimeout(resolve, 120));
+      // The address bar follows the view on a timer: wait for it (10 s at most), not for a fixed time.
+      for (const t0 = performance.now(); new URL(el.shareLink).search !== location.search && performance.now() - t0 < 10_000; ) {
+        await new Promise((resolve) => setTimeout(resolve, 20));
+      }
       const m = window.playground.current();
       return { view: el.view, link: el.shareLink, address: location.href, frames: m.frames, sample: Array.from(m.positions.filter((_, i) => i % 997 === 0)) };
     });
