@@ -198,7 +198,7 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
     assert.match(m[9], /^generate: temperature is not meaningful for acLSTM models/);
     assert.match(m[10], /^generate: refine is not available for acLSTM models/);
     assert.match(m[11], /^generate: unknown option "tempo" for model "aclstm-vanilla" \(known: model, style, frames, seed, signal\)/);
-    assert.match(m[12], /^generate: unknown option "style" for model "generator"/);
+    assert.match(m[12], /^generate: style is not an option of model "generator": it has no styles; leave it out$/);
     assert.match(m[13], /^generate: unknown model "aclstm-plus" \(available: .*\baclstm\b.*\)/);
     assert.equal(results.same, true, 'current() is unchanged');
     assert.equal(results.state.frames, 30);
