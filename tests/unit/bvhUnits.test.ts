@@ -7,21 +7,11 @@ import { describe, expect, it } from 'vitest';
 import { parseBVH, exportBVH } from '../../web/motion/bvh';
 import type { Motion } from '../../web/motion/types';
 import { CORPUS_ROOT, readCorpus } from './corpus';
-import { jointIndex, maxHeight, position } from './motionStats';
+import { jointHeights, jointIndex, maxHeight, position } from './motionStats';
 
 /** The figure's standing height: the median over frames of its joints' vertical extent (m). */
 function standingHeight(m: Motion): number {
-  const heights: number[] = [];
-  for (let f = 0; f < m.frames; f++) {
-    let lo = Infinity, hi = -Infinity;
-    for (let j = 0; j < m.joints.length; j++) {
-      const y = position(m, f, j)[1];
-      lo = Math.min(lo, y);
-      hi = Math.max(hi, y);
-    }
-    heights.push(hi - lo);
-  }
-  heights.sort((a, b) => a - b);
+  const heights = jointHeights(m).sort((a, b) => a - b);
   return heights[heights.length >> 1];
 }
 

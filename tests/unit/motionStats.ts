@@ -16,9 +16,9 @@ export function distance(a: number[], b: number[]): number {
   return Math.hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
 }
 
-/** Largest y extent of the joints over all frames (standing height measured at the joints). */
-export function maxHeight(m: Motion): number {
-  let best = 0;
+/** Per frame, the y extent of the joints (metres): the figure's height measured at its joints. */
+export function jointHeights(m: Motion): number[] {
+  const heights: number[] = [];
   for (let f = 0; f < m.frames; f++) {
     let lo = Infinity, hi = -Infinity;
     for (let j = 0; j < m.joints.length; j++) {
@@ -26,8 +26,15 @@ export function maxHeight(m: Motion): number {
       lo = Math.min(lo, y);
       hi = Math.max(hi, y);
     }
-    best = Math.max(best, hi - lo);
+    heights.push(hi - lo);
   }
+  return heights;
+}
+
+/** Largest y extent of the joints over all frames (standing height measured at the joints). */
+export function maxHeight(m: Motion): number {
+  let best = 0;
+  for (const h of jointHeights(m)) best = Math.max(best, h);
   return best;
 }
 
