@@ -27,6 +27,10 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--dropout", type=float, default=0.25)
     parser.add_argument("--cmu-share", type=float, default=None,
                         help="CMU's share of the windows (default: every style equally often, 1/8)")
+    parser.add_argument("--init-from-shipped", action="store_true",
+                        help="start from the shipped CMU generator's weights (public/models/generator.onnx), every style as CMU")
+    parser.add_argument("--cmu-guard", type=float, default=None,
+                        help="best.pt only from epochs whose CMU held-out NLL is at most this above the first validation's")
     parser.add_argument("--fit-references", action="store_true",
                         help="fit the rotation references to the training clips instead of the shipped generator's")
     args = parser.parse_args(argv)

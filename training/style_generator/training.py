@@ -27,6 +27,7 @@ from ..mocap.rotations import quat_to_matrix
 from ..models.generator import MixtureLSTM, mixture_nll
 from ..paths import MODELS_DIR
 from ..runs import TrainingLoop
+from .warm_start import warm_start
 
 NOISE_SIGMA = 0.05
 LICENCE = "CC BY-NC 4.0 (trained on the Bandai Namco set: non-commercial)"
@@ -90,6 +91,8 @@ def train_style_generator(args: argparse.Namespace) -> tuple[float, Path]:
     corpus = StyleCorpus(load_styled_clips(args.mocap), references, cmu_share=args.cmu_share)
     dim = corpus.mean.shape[0]
     model = MixtureLSTM(dim, args.hidden, dropout=args.dropout, styles=len(STYLES), style_dim=args.style_dim)
+    if getattr(args, "init_from_shipped", False) and not args.resume:
+        warm_start(model, corpus.mean, corpus.std)
     optimiser = torch.optim.RMSprop(model.parameters(), lr=args.lr, alpha=0.9)
     scheduler = torch.optim.lr_scheduler.ExponentialLR(optimiser, gamma=0.95)
     rng = loop.seed()
@@ -105,6 +108,14 @@ def train_style_generator(args: argparse.Namespace) -> tuple[float, Path]:
                  "%d validation clips, %d iterations per epoch", dim, len(STYLES), ", ".join(STYLES), loop.parameters,
                  corpus.train_frames, len(corpus.valid), iters_per_epoch)
     run.log.info("training frames per style: %s", corpus.train_frames_per_style)
+    # CMU guard: best.pt is the best mean over styles among the epochs whose CMU held-out NLL is within --cmu-guard of
+    # the first validation's (the shipped weights' when warm-started), so CMU never gets worse than that by more.
+    cmu_limit = loop.resumed.get("cmu_limit") if loop.resumed else None
+    if cmu_limit is None and args.cmu_guard is not None:
+        first = validation_by_style(model, corpus)
+        cmu_limit = first["cmu"] + args.cmu_guard
+        run.log.info("before training: valid_nll mean %.3f | %s; CMU guard: best.pt needs cmu <= %.2f", first["mean"],
+                     " ".join(f"{k} {v:.2f}" for k, v in first.items() if k != "mean"), cmu_limit)
     bar = loop.progress_bar("style generator", args.epochs * iters_per_epoch, epoch * iters_per_epoch + iteration)
     out_of_time = False
     while epoch < args.epochs:
@@ -123,7 +134,7 @@ def train_style_generator(args: argparse.Namespace) -> tuple[float, Path]:
             losses.append(loss.item())
             bar.update(1)
             bar.set_postfix(epoch=epoch + 1, nll=f"{np.mean(losses[-50:]):.2f}")
-            out_of_time = loop.step_done(iteration, epoch=epoch)
+            out_of_time = loop.step_done(iteration, epoch=epoch, cmu_limit=cmu_limit)
             if out_of_time:
                 break
         if out_of_time:
@@ -131,12 +142,16 @@ def train_style_generator(args: argparse.Namespace) -> tuple[float, Path]:
         scheduler.step()
         val = validation_by_style(model, corpus)
         epoch, iteration = epoch + 1, 0
-        if val["mean"] < loop.best:
+        if val["mean"] < loop.best and (cmu_limit is None or val["cmu"] <= cmu_limit):
             loop.best = val["mean"]
             run.save({"model": model.state_dict(), "epoch": epoch, "valid_nll": val, "meta": meta}, run.best_path)
-        loop.save(iteration, epoch=epoch)
+        loop.save(iteration, epoch=epoch, cmu_limit=cmu_limit)
         run.log.info("epoch %d train_nll %.3f valid_nll mean %.3f best %.3f lr %.2e minutes %.1f | %s", epoch,
                      np.mean(losses), val["mean"], loop.best, scheduler.get_last_lr()[0], loop.elapsed() / 60,
                      " ".join(f"{k} {v:.2f}" for k, v in val.items() if k != "mean"))
-    loop.finish(iteration, {"best_valid_nll_mean_over_styles": loop.best, "epochs_done": epoch}, save_last=True, epoch=epoch)
+    if not run.best_path.exists():  # no epoch met the guard (or none ended): the weights as they are
+        run.save({"model": model.state_dict(), "epoch": epoch, "valid_nll": validation_by_style(model, corpus), "meta": meta},
+                 run.best_path)
+    loop.finish(iteration, {"best_valid_nll_mean_over_styles": loop.best, "epochs_done": epoch}, save_last=True,
+                epoch=epoch, cmu_limit=cmu_limit)
     return loop.best, run.dir
