@@ -1,6 +1,6 @@
 // The acLSTM (Zhou et al.: an auto-conditioned LSTM for endless dance) and its vanilla-LSTM baseline as
-// the page offers them: generate in a style, and Dance mode's endless stream. Deterministic: the seed picks
-// the seed motion.
+// the page offers them: generate in a style, and Dance mode's endless stream. Deterministic models: the seed picks
+// the seed motion; a sampled one (head "mdn", issue 42) also seeds its random draws with it.
 
 import { describeValue } from '../../motion/describe';
 import { clientFiles, motionOf, type ModelDescriptor } from '../descriptor';
@@ -15,9 +15,11 @@ export const descriptor: ModelDescriptor<DanceClient> = {
 
   generate: {
     options: ['model', 'style', 'frames', 'seed'],
-    // Dance models have no sampling and no refiner: say so rather than silently ignoring the option.
+    // No temperature (a sampled model has its own per-style settings) and no refiner: say so rather than silently ignoring the option.
     refused: {
-      temperature: 'temperature is not meaningful for acLSTM models: they are deterministic (the seed only picks the seed motion); leave it out',
+      temperature:
+        'temperature is not meaningful for acLSTM models: a deterministic one has no randomness (the seed only picks the seed motion), ' +
+        'a sampled one draws with its own per-style settings (the seed also seeds the draws); leave it out',
       refine: 'refine is not available for acLSTM models (there is no refiner for dance); leave it out',
     },
     check(o, entry) {

@@ -16,15 +16,26 @@ function checkSessionNames(session: InferenceSession, inputs: readonly string[],
   }
 }
 
-/** A float32 output of `size` values; `files` names the pair to blame on a size mismatch ("generator.json match generator.onnx"). */
-function readOutput(out: InferenceSession.OnnxValueMapType, name: string, size: number, files: string): Float32Array {
+/** A float32 (or, with `int64`, int64) output of `size` values; `files` names the pair to blame on a size mismatch ("generator.json match generator.onnx"). */
+function readOutput(out: InferenceSession.OnnxValueMapType, name: string, size: number, files: string): Float32Array;
+function readOutput(out: InferenceSession.OnnxValueMapType, name: string, size: number, files: string, int64: true): BigInt64Array;
+function readOutput(out: InferenceSession.OnnxValueMapType, name: string, size: number, files: string, int64 = false): Float32Array | BigInt64Array {
   const tensor = out[name] as Tensor | undefined;
   if (!tensor) throw new Error(`the model gave no output "${name}"`);
-  if (!(tensor.data instanceof Float32Array)) throw new Error(`model output "${name}" is ${tensor.type}, expected float32`);
-  if (tensor.data.length !== size) {
-    throw new Error(`model output "${name}" has ${tensor.data.length} values (dims ${tensor.dims.join('×')}), expected ${size}; does ${files}?`);
+  if (int64 ? !(tensor.data instanceof BigInt64Array) : !(tensor.data instanceof Float32Array)) {
+    throw new Error(`model output "${name}" is ${tensor.type}, expected ${int64 ? 'int64' : 'float32'}`);
   }
-  return tensor.data;
+  const data = tensor.data as Float32Array | BigInt64Array;
+  if (data.length !== size) {
+    throw new Error(`model output "${name}" has ${data.length} values (dims ${tensor.dims.join('×')}), expected ${size}; does ${files}?`);
+  }
+  return data;
+}
+
+/** Reads a call's outputs by name and size: float32, or int64 with `.int64` (a sampler's counters). */
+export interface OutputReader {
+  (name: string, size: number): Float32Array;
+  int64(name: string, size: number): BigInt64Array;
 }
 
 export const MAX_BENCHMARK_BATCH = 4096;
@@ -94,10 +105,10 @@ export abstract class SessionCore<Info extends SessionModelInfo> {
 
   /**
    * One session call on float32 (or int64: a BigInt64Array) feeds (`name: [data, dims]`); returns a reader for outputs of known
-   * size, which names the files to blame when a size disagrees with the JSON. With `signal`, passes a
+   * size (float32; int64 with `read.int64`), which names the files to blame when a size disagrees with the JSON. With `signal`, passes a
    * checkpoint first (cancellation.ts): throws CancelledError instead of running once it has aborted.
    */
-  protected async run(feeds: Record<string, [Float32Array | BigInt64Array, number[]]>, signal?: AbortSignal): Promise<(name: string, size: number) => Float32Array> {
+  protected async run(feeds: Record<string, [Float32Array | BigInt64Array, number[]]>, signal?: AbortSignal): Promise<OutputReader> {
     const look = signal && checkpoint(signal);
     if (look) await look;
     const tensors: Record<string, Tensor> = {};
@@ -106,6 +117,7 @@ export abstract class SessionCore<Info extends SessionModelInfo> {
     }
     const out = await this.session.run(tensors);
     const files = `${this.info.id ?? 'the model'}.json match ${this.info.file}`;
-    return (name, size) => readOutput(out, name, size, files);
+    const read = (name: string, size: number) => readOutput(out, name, size, files);
+    return Object.assign(read, { int64: (name: string, size: number) => readOutput(out, name, size, files, true) });
   }
 }

@@ -62,7 +62,8 @@ export class DanceMode extends LiveMode<DanceMotion> {
 
   /**
    * The style and seed the next dance starts with (a link, the element's attributes), before the model
-   * has listed its own: kept when the model has the style; the seed counts modulo the style's seed motions.
+   * has listed its own: kept when the model has the style; the seed counts modulo the style's seed motions (a sampled
+   * model keeps it: listSeeds).
    */
   preset(style: string | undefined, seed: number | undefined): void {
     if (style !== undefined) this.style.replaceChildren(new Option(style, style));
@@ -78,11 +79,18 @@ export class DanceMode extends LiveMode<DanceMotion> {
     return { model: this.model.value, style: this.style.value, seed: Number(this.seed.value) || 0 };
   }
 
-  /** The seed selector lists the seed motions of the selected style; option value = the API's `seed`. */
+  /**
+   * The seed selector lists the seed motions of the selected style; option value = the API's `seed`. A sampled
+   * model's seed also seeds its draws (every seed is its own dance), so a larger seed (a link's) is kept as one more
+   * option instead of being taken modulo the seed motions.
+   */
   private listSeeds(info: DanceInitResult, selected: number): void {
     const names = info.seeds.filter((s) => s.style === this.style.value).map((s) => s.name);
-    this.seed.replaceChildren(...names.map((name, i) => new Option(name, String(i))));
-    this.seed.value = String(names.length ? selected % names.length : 0);
+    const options = names.map((name, i) => new Option(name, String(i)));
+    const keep = info.sampled && names.length > 0 && selected >= names.length;
+    if (keep) options.push(new Option(`${names[selected % names.length]} · seed ${selected}`, String(selected)));
+    this.seed.replaceChildren(...options);
+    this.seed.value = String(keep ? selected : names.length ? selected % names.length : 0);
     this.seed.dataset.style = this.style.value;
   }
 
