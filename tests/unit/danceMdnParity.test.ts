@@ -27,8 +27,21 @@ interface MdnCase {
   outputs: Record<string, number[]>;
 }
 
+/**
+ * Optional `streams` in the fixture: the page's whole stream rule computed in torch (the seed motion `seed mod` the
+ * style's count; h = c = 0 warmed up on its frames; training.control.Rng(seed): D normals for the first wander, then
+ * per frame one uniform, as float32 and below 1, and D normals; phrase_sampling.PhraseSampler.step on them; the output
+ * filter at rest on the last seed frame): `features` (frames × D, physical units) are what generate must give.
+ */
+interface MdnStream {
+  style: string;
+  seed: number;
+  frames: number;
+  features: number[];
+}
+
 describe.skipIf(!present)('DanceCore on the exported sampled dance model (tests/fixtures/aclstm_mdn_reference.json)', () => {
-  const reference = present ? (JSON.parse(readFileSync(FIXTURE, 'utf8')) as { model: string; outputs_order: string[]; cases: Record<string, MdnCase> }) : undefined;
+  const reference = present ? (JSON.parse(readFileSync(FIXTURE, 'utf8')) as { model: string; outputs_order: string[]; cases: Record<string, MdnCase>; streams?: MdnStream[] }) : undefined;
   let core: DanceCore;
 
   beforeAll(async () => {
@@ -56,6 +69,13 @@ describe.skipIf(!present)('DanceCore on the exported sampled dance model (tests/
       expect(value.length, output).toBe(want.length);
       if (value instanceof BigInt64Array) expect(Array.from(value, Number), output).toEqual(want);
       else expect(maxAbsDiff(value, want), output).toBeLessThan(1e-4);
+    }
+  });
+
+  it.skipIf(!reference?.streams)('generates the fixture’s streams (the warm-up and the seeded randoms as in torch) within 1e-4', async () => {
+    for (const s of reference!.streams!) {
+      const chunk = await core.generate({ style: s.style, seed: s.seed, frames: s.frames });
+      expect(maxAbsDiff(chunk.features, s.features), `${s.style} seed ${s.seed}`).toBeLessThan(1e-4);
     }
   });
 
