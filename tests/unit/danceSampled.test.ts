@@ -87,6 +87,15 @@ describe('parseDanceInfo, sampled models', () => {
       }),
     ).toThrow(/onnx\.inputs is \[.*\], expected \[x,style,h,c,steps\]/);
     expect(broken((j) => (j.head = 'mdn '))).toThrow(DanceInfoError);
+    // The exporter's onnx block also names the head and K: they must agree with the file's.
+    expect(broken((j) => (j.onnx.components = FAKE_COMPONENTS))).not.toThrow();
+    expect(broken((j) => (j.onnx.components = 9))).toThrow(/onnx\.components is 9 but components is 4/);
+    expect(broken((j) => (j.onnx.head = 'mean'))).toThrow(/onnx\.head is "mean" but the file's head is "mdn"/);
+    const shipped = JSON.parse(readRepoFile('public/models/aclstm.json'));
+    shipped.onnx.head = 'mean';
+    expect(() => parseDanceInfo(shipped, 'test.json')).not.toThrow();
+    shipped.onnx.head = 'mdn';
+    expect(() => parseDanceInfo(shipped, 'test.json')).toThrow(/onnx\.head is "mdn" but the file's head is not "mdn"/);
   });
 });
 

@@ -117,6 +117,7 @@ const format = modelInfoFormat<DanceInfo>('DanceInfoError', 'aclstm.json', (chec
     for (const key of ['components', 'sampling'] as const) if (root[key] !== undefined) fail(`${key} is only read with head "mdn", and there is no head`);
   }
   const onnx = obj(root.onnx, 'onnx');
+  if (onnx.head !== undefined && (onnx.head === 'mdn') !== mdn) fail(`onnx.head is ${JSON.stringify(onnx.head)} but the file's head is ${mdn ? '"mdn"' : 'not "mdn"'}`);
   if (mdn) {
     nameSet(check, onnx.inputs, 'onnx.inputs', DANCE_MDN_INPUTS);
     nameSet(check, onnx.outputs, 'onnx.outputs', DANCE_MDN_OUTPUTS);
@@ -136,6 +137,7 @@ const format = modelInfoFormat<DanceInfo>('DanceInfoError', 'aclstm.json', (chec
   check.normalisation(root.normalisation, D);
   if (mdn) {
     if (posInt(root.components, 'components') < 2) fail(`components must be at least 2 for head "mdn", got ${String(root.components)}`);
+    if (onnx.components !== undefined && onnx.components !== root.components) fail(`onnx.components is ${String(onnx.components)} but components is ${String(root.components)}`);
     checkSampling(check, root.sampling, styles, root.fps as number);
   }
 
