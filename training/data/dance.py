@@ -1,5 +1,7 @@
 """The acLSTM dance set as joint positions, and the acLSTM feature layout (Zhou et al., "Data Representation").
 The cache (cache/aclstm_positions.npz) is built by python -m training.data.build_dance, or on first use.
+With extra=True, the set plus the two CMU trials it lacks (indian 01, martial 02: dance_extra.py brings them onto the
+standard skeleton), always training clips, in their own cache (cache/aclstm_positions_extra.npz, --extra).
 
 Every file in ../shared/mocap/aclstm/{salsa,indian,martial} is on one standard 57-point skeleton
 (43 joints + 14 end sites). The BVH headers all say 120 fps, but the set's readme gives salsa at 60 fps
@@ -22,6 +24,7 @@ from tqdm import tqdm
 from .. import metrics
 from ..mocap.bvh import global_transforms, load_bvh
 from ..paths import DEFAULT_CACHE, resolve_mocap_dir
+from .dance_extra import EXTRA_FILES, read_source, to_standard
 
 STYLES = ("salsa", "indian", "martial")
 SOURCE_FPS = {"salsa": 60.0, "indian": 120.0, "martial": 120.0}  # from aclstm/readme.txt
@@ -31,6 +34,8 @@ SOURCE_FPS = {"salsa": 60.0, "indian": 120.0, "martial": 120.0}  # from aclstm/r
 MODEL_FPS = 30.0
 CM = 0.01  # the set's BVH units are centimetres
 CACHE = DEFAULT_CACHE / "aclstm_positions.npz"
+EXTRA_CACHE = DEFAULT_CACHE / "aclstm_positions_extra.npz"  # the set and the two converted trials (extra=True)
+EXTRA_DIR = "aclstm-extra/"  # the converted trials' files start so; they are never held out
 # Held out per style for validation, the evaluation report and the browser's seed motions.
 HELD_OUT = {"salsa": ("10", "20", "30"), "indian": ("15",), "martial": ("10",)}
 
@@ -84,8 +89,26 @@ def is_held_out(style: str, path: Path | str) -> bool:
     return Path(path).name.split(".")[0] in HELD_OUT[style]
 
 
-def build_cache(mocap: Path, out: Path = CACHE) -> Path:
-    """World positions (metres) of every point of every clip at its source rate, feet on the floor."""
+def on_floor(pos: np.ndarray) -> np.ndarray:
+    """The clip moved vertically so that the floor is at 0: the 10th percentile of the lowest point over the clip.
+    Lower percentiles follow glitches: in indian/07 the feet dip 14 cm below their usual level in 3% of the frames."""
+    pos = pos.copy()
+    pos[..., 1] -= np.percentile(pos[..., 1].min(axis=1), 10)
+    return pos
+
+
+def extra_positions(mocap: Path, skel: DanceSkeleton) -> list[tuple[str, str, np.ndarray]]:
+    """(style, file, positions) of the two converted CMU trials (dance_extra.py): world metres on the standard
+    skeleton at the source rate (120 fps), feet on the floor."""
+    return [(style, motion, on_floor(to_standard(read_source(mocap, motion, skeleton), skel.names, skel.parents,
+                                                 skel.offsets)))
+            for style, motion, skeleton in EXTRA_FILES]
+
+
+def build_cache(mocap: Path, out: Path | None = None, extra: bool = False) -> Path:
+    """World positions (metres) of every point of every clip at its source rate, feet on the floor; with `extra`,
+    the two converted trials too (in EXTRA_CACHE unless `out` says otherwise)."""
+    out = out or (EXTRA_CACHE if extra else CACHE)
     positions, table = [], []
     skel = load_skeleton(mocap)
     for style, path in tqdm(dance_files(mocap), desc="acLSTM dance files", unit="file"):
@@ -93,11 +116,11 @@ def build_cache(mocap: Path, out: Path = CACHE) -> Path:
         if point_names(clip) != skel.names:
             raise SystemExit(f"error: {path} is not on the standard acLSTM skeleton")
         _, pos = global_transforms(clip)
-        pos = pos * CM
-        # The floor: the 10th percentile of the lowest point over the clip. Lower percentiles follow glitches:
-        # in indian/07 the feet dip 14 cm below their usual level in 3% of the frames.
-        pos[..., 1] -= np.percentile(pos[..., 1].min(axis=1), 10)
+        pos = on_floor(pos * CM)
         table.append((style, f"aclstm/{style}/{path.name}", sum(len(p) for p in positions), len(pos)))
+        positions.append(pos.astype(np.float32))
+    for style, file, pos in (extra_positions(mocap, skel) if extra else []):
+        table.append((style, file, sum(len(p) for p in positions), len(pos)))
         positions.append(pos.astype(np.float32))
     out.parent.mkdir(parents=True, exist_ok=True)
     np.savez_compressed(out, positions=np.concatenate(positions), style=[t[0] for t in table],
@@ -106,17 +129,19 @@ def build_cache(mocap: Path, out: Path = CACHE) -> Path:
     return out
 
 
-def load_clips(mocap_flag: str | None = None) -> tuple[DanceSkeleton, list[DanceClip]]:
-    """The skeleton and every clip, from the cache (built first when missing)."""
-    if not CACHE.exists():
-        build_cache(resolve_mocap_dir(mocap_flag))
-    d = np.load(CACHE)
+def load_clips(mocap_flag: str | None = None, extra: bool = False) -> tuple[DanceSkeleton, list[DanceClip]]:
+    """The skeleton and every clip, from the cache (built first when missing); with `extra`, the two converted CMU
+    trials too (training clips), from EXTRA_CACHE."""
+    cache = EXTRA_CACHE if extra else CACHE
+    if not cache.exists():
+        build_cache(resolve_mocap_dir(mocap_flag), extra=extra)
+    d = np.load(cache)
     skel = DanceSkeleton([str(n) for n in d["names"]], [int(p) for p in d["parents"]], d["offsets"])
     clips = []
     for style, file, start, frames in zip(d["style"], d["files"], d["start"], d["frames"]):
         style = str(style)
         clips.append(DanceClip(style, str(file), SOURCE_FPS[style], d["positions"][start:start + frames].astype(np.float64),
-                               is_held_out(style, str(file))))
+                               not str(file).startswith(EXTRA_DIR) and is_held_out(style, str(file))))
     return skel, clips
 
 
