@@ -21,7 +21,7 @@ import { capMessage } from '../motion/text';
 import { loadManifest, type ModelInfo } from '../model/manifest';
 import { assetUrl } from '../runtime/worker/assetBase';
 import { checkCleanupMotion, checkCleanupOptions, type CleanupMethod, type CleanupStats } from '../runtime/cleanup/cleanup';
-import type { Capability, GenerateCall, PathStats } from '../runtime/descriptor';
+import { checkStyleOption, type Capability, type GenerateCall, type PathStats } from '../runtime/descriptor';
 import { Registry, type RegisteredModel } from '../runtime/registry';
 import { mapSkeleton } from '../motion/skeletonMap';
 import { addNoise as addNoiseTo, checkNoiseOptions, type NoiseOptions } from '../motion/noise';
@@ -71,7 +71,11 @@ export interface GenerateOptions extends CancellableOptions {
    * drawn from the seed (web/motion/control.ts randomControl).
    */
   control?: [number, number, number][];
-  /** acLSTM models only, and required there: one of the model's `styles` ("salsa", "indian", "martial"). */
+  /**
+   * One of the model's `styles` (models()): required for the acLSTM models ("salsa", "indian", "martial"); for a
+   * style generator (an "lstm-gmm" model with styles, e.g. "elderly") left out means its first style. Refused for a
+   * model without styles.
+   */
   style?: string;
   /** Generator only. Sampling temperature 0…2 (left out: 0.5; null is refused): 0 = each step's most likely mixture mean, 1 = the trained distribution. */
   temperature?: number;
@@ -98,6 +102,8 @@ export interface FollowPathOptions extends CancellableOptions {
   fitTolerance?: number;
   /** Latent ERD and VAE-LSTM only. The forward speed asked for, above 0 and at most 4 m/s (default 1.2 walking, 2.8 running). */
   speed?: number;
+  /** A model with styles (models() lists them): one of them (left out: its first); refused for a model without styles. */
+  style?: string;
   /** Lock planted feet (the refiner issue's contact clean-up; default true). The root path is not changed. */
   footLock?: boolean;
 }
@@ -118,6 +124,8 @@ export interface SimulateControlOptions extends CancellableOptions {
   seed?: number;
   /** Seed states to start from: "walk", or "run"; default "run" when the first target speed is 2 m/s or more. */
   gait?: 'walk' | 'run';
+  /** A model with styles (models() lists them): one of them (left out: its first); refused for a model without styles. */
+  style?: string;
   /** Lock planted feet (default true). */
   footLock?: boolean;
 }
@@ -405,9 +413,9 @@ function controlModel(registry: Registry, capability: 'followPath' | 'liveContro
 }
 
 /** followPath's options every model takes; each model adds its own (its descriptor's followPath.options). */
-const FOLLOW_PATH_COMMON = ['model', 'points', 'gait', 'seed', 'footLock', 'signal'];
-const FOLLOW_PATH_SHAPE = '{ points: [[x, z], …], model?, gait?, seed?, fitTolerance? (generator) or speed? (latent-erd, vae-lstm), footLock?, signal? }';
-const SIMULATE_OPTIONS = ['model', 'seconds', 'schedule', 'seed', 'gait', 'footLock', 'signal'];
+const FOLLOW_PATH_COMMON = ['model', 'points', 'gait', 'seed', 'style', 'footLock', 'signal'];
+const FOLLOW_PATH_SHAPE = '{ points: [[x, z], …], model?, gait?, seed?, style? (a model with styles), fitTolerance? (generator) or speed? (latent-erd, vae-lstm), footLock?, signal? }';
+const SIMULATE_OPTIONS = ['model', 'seconds', 'schedule', 'seed', 'gait', 'style', 'footLock', 'signal'];
 
 /**
  * How the API's calls fail: `guarded(context, fn)` runs `fn`, and a failure is shown on the page as
@@ -579,7 +587,8 @@ export function createPlayground(app: App): Playground {
         await ready;
         const { info, descriptor } = controlModel(app.registry, 'followPath', (options as { model?: unknown }).model);
         const follow = descriptor.followPath!;
-        const o = checkKeys(options, [...FOLLOW_PATH_COMMON.slice(0, 4), ...follow.options, ...FOLLOW_PATH_COMMON.slice(4)], FOLLOW_PATH_SHAPE);
+        const o = checkKeys(options, [...FOLLOW_PATH_COMMON.slice(0, 5), ...follow.options, ...FOLLOW_PATH_COMMON.slice(5)], FOLLOW_PATH_SHAPE);
+        const style = checkStyleOption(o.style, info);
         // Checked here too (the worker checks again), so bad input fails fast and without a worker prefix.
         const points = checkPathPoints(o.points);
         GroundPath.fromPoints(points);
@@ -587,7 +596,7 @@ export function createPlayground(app: App): Playground {
         const seed = checkSeed(optional(o.seed, 0));
         const footLock = checkFootLock(o.footLock);
         const own = follow.check(o, gait);
-        const walk = await app.withModel(info.id, (client) => follow.run(client, { points, gait, seed, ...own, footLock }, { signal }));
+        const walk = await app.withModel(info.id, (client) => follow.run(client, { points, gait, seed, ...own, footLock, ...(style ? { style } : {}) }, { signal }));
         return { ...walk.motion, stats: walk.stats };
       });
     },
@@ -614,7 +623,7 @@ export function createPlayground(app: App): Playground {
 
     simulateControl(options) {
       return cancellable('simulateControl', options, async (signal) => {
-        const o = checkKeys(options, SIMULATE_OPTIONS, '{ seconds, schedule: [{ t, speed, heading }, …], model?, seed?, gait?, footLock?, signal? }');
+        const o = checkKeys(options, SIMULATE_OPTIONS, '{ seconds, schedule: [{ t, speed, heading }, …], model?, seed?, gait?, style? (a model with styles), footLock?, signal? }');
         const lockFeet = checkFootLock(o.footLock);
         const seconds = checkSeconds(o.seconds);
         const schedule = checkSchedule(o.schedule);
@@ -622,7 +631,8 @@ export function createPlayground(app: App): Playground {
         const gait = o.gait === undefined ? undefined : checkGait(o.gait);
         await ready;
         const { info, descriptor } = controlModel(app.registry, 'liveControl', o.model);
-        return app.withModel(info.id, (client) => descriptor.liveControl!.simulate(client, { seconds, schedule, seed, footLock: lockFeet, ...(gait ? { gait } : {}) }, { signal }));
+        const style = checkStyleOption(o.style, info);
+        return app.withModel(info.id, (client) => descriptor.liveControl!.simulate(client, { seconds, schedule, seed, footLock: lockFeet, ...(gait ? { gait } : {}), ...(style ? { style } : {}) }, { signal }));
       });
     },
   };

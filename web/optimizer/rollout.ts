@@ -25,7 +25,8 @@ const STEERED_CHANNELS = 3;
 export const INPUT_NOISE_SIGMA = 0.05;
 const LOG_2PI = Math.log(2 * Math.PI);
 
-export type StepFn = (batch: number, x: Float32Array, h: Float32Array, c: Float32Array) => Promise<StepOutputs>;
+/** One model step of `batch` rows; `frame`: which frame of the rollout it makes (0 = the first after the start state), where known. */
+export type StepFn = (batch: number, x: Float32Array, h: Float32Array, c: Float32Array, frame?: number) => Promise<StepOutputs>;
 
 /**
  * Where one stream stands: the next network input (normalised), the LSTM state, the root on the ground, and the
@@ -189,7 +190,7 @@ export async function rollout(o: RolloutOptions): Promise<RolloutResult> {
       }
       noiseCost[b] += 0.5 * noiseScale * noiseScale * n2; // = Σ d²/(2σ²) with d = σ·noiseScale·dz
     }
-    const out = await o.step(P, input, h, c);
+    const out = await o.step(P, input, h, c, t);
     for (let b = 0; b < P; b++) {
       const w = out.weights.subarray(b * M, (b + 1) * M);
       const comp = chooseComponent(w, tau, v.u[b * T + t], scratch);

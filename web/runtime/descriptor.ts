@@ -4,6 +4,7 @@
 // training/<model>/) exports one `descriptor`; the registry (registry.ts) joins them with the models that
 // public/models/index.json lists, and the API, the page and the modes iterate over it instead of naming models.
 
+import { describeValue } from '../motion/describe';
 import type { Motion } from '../motion/types';
 import type { ModelInfo } from '../model/manifest';
 import type { Gait } from '../optimizer/pathFollower';
@@ -40,10 +41,14 @@ export interface GenerateCall {
   [option: string]: unknown;
 }
 
-/** A path to walk, checked (optimizer/path.ts), with the model's own option (fitSigma or speed) added by its check. */
+/**
+ * A path to walk, checked (optimizer/path.ts), with the model's own option (fitSigma or speed) added by its check,
+ * and for a model with styles its style (checked by checkStyleOption; left out: the model's first).
+ */
 export interface PathRequest extends FollowPathRequest {
   fitSigma?: number;
   speed?: number;
+  style?: string;
 }
 
 /** One model's walk along a path: the motion (foot-locked, with its contacts), the path as followed, its numbers. */
@@ -73,6 +78,8 @@ export interface SimulateRequest {
   seed: number;
   footLock?: boolean;
   gait?: Gait;
+  /** A model with styles: one of them (left out: its first). */
+  style?: string;
 }
 
 /**
@@ -128,7 +135,10 @@ export interface ModelDescriptor<C extends ModelClientBase = ModelClientBase> {
     ahead?: number;
     /** The controller searches with particles: Steer adapts their number to the time a batch takes. */
     particles: boolean;
-    start(client: C, params: { seed: number; gait: Gait }, options: RequestOptions): Promise<{ seedName: string }>;
+    /** `style`: a model with styles only (its manifest entry lists them). */
+    start(client: C, params: { seed: number; gait: Gait; style?: string }, options: RequestOptions): Promise<{ seedName: string }>;
+    /** A model with styles: the running stream switches to `style` from its next frame, blended over about a second. */
+    switchStyle?(client: C, style: string, options: RequestOptions): Promise<unknown>;
     pull(client: C, frames: number, target: LiveTarget, options: RequestOptions): Promise<LiveControlChunk>;
     simulate(client: C, request: SimulateRequest, options: ProgressOptions): Promise<SimulatedControl>;
   };
@@ -148,6 +158,18 @@ export interface ModelDescriptor<C extends ModelClientBase = ModelClientBase> {
 export function clientFiles(entry: ModelInfo, threads: number): ModelFileOptions {
   if (entry.files) return { threads, modelUrl: entry.files.model, infoUrl: entry.files.info };
   return { threads, modelUrl: `models/${entry.id}.onnx`, infoUrl: `models/${entry.id}.json` };
+}
+
+/**
+ * A call's `style` for the model `entry` (generate, followPath, simulateControl, the view's style): undefined when
+ * left out; refused with a short reason for a model without styles, and for a name that is not one of its styles.
+ */
+export function checkStyleOption(value: unknown, entry: ModelInfo): string | undefined {
+  if (value === undefined) return undefined;
+  const styles = entry.styles ?? [];
+  if (styles.length === 0) throw new TypeError(`style is not an option of model "${entry.id}": it has no styles; leave it out`);
+  if (typeof value !== 'string' || !styles.includes(value)) throw new RangeError(`unknown style ${describeValue(value)} for model "${entry.id}" (styles: ${styles.join(', ')})`);
+  return value;
 }
 
 /** The public stats of a walk (a worker's stats carry more). */

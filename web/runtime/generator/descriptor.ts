@@ -4,7 +4,7 @@
 
 import { checkFitSigma, optional } from '../../optimizer/options';
 import { describeValue } from '../../motion/describe';
-import { clientFiles, motionOf, pathStatsOf, type ModelDescriptor } from '../descriptor';
+import { checkStyleOption, clientFiles, motionOf, pathStatsOf, type ModelDescriptor } from '../descriptor';
 import { GeneratorClient } from './generatorClient';
 
 /** Sampling temperature when generate's is left out (docs/api.md). */
@@ -31,14 +31,9 @@ export const descriptor: ModelDescriptor<GeneratorClient> = {
       if (refine && !models.some((m) => m.kind === 'refiner')) throw new Error('refine is not available: no refiner model is listed in models/index.json');
       // A style generator (its entry lists styles) takes one of them, default its first; any other generator none.
       const styles = entry.styles ?? [];
-      if (o.style !== undefined) {
-        if (styles.length === 0) throw new TypeError(`style is not an option of model "${entry.id}": it has no styles; leave it out`);
-        if (typeof o.style !== 'string' || !styles.includes(o.style)) {
-          throw new RangeError(`unknown style ${describeValue(o.style)} for model "${entry.id}" (styles: ${styles.join(', ')})`);
-        }
-      }
+      const style = checkStyleOption(o.style, entry);
       if (refine && styles.length) throw new TypeError(`refine is not available for model "${entry.id}": the refiner learnt from the CMU-only generator; leave it out`);
-      return { temperature, refine, ...(styles.length ? { style: (o.style as string | undefined) ?? styles[0] } : {}) };
+      return { temperature, refine, ...(styles.length ? { style: style ?? styles[0] } : {}) };
     },
     async run(client, call, { signal }) {
       const refine = call.refine === true;
@@ -53,8 +48,8 @@ export const descriptor: ModelDescriptor<GeneratorClient> = {
   followPath: {
     options: ['fitTolerance'],
     check: (o) => ({ fitSigma: checkFitSigma(optional(o.fitTolerance, DEFAULT_FIT_SIGMA), 'fitTolerance') }),
-    async run(client, { points, gait, seed, fitSigma, footLock, stroke }, options) {
-      const m = await client.followPath({ points, gait, seed, fitSigma, ...(footLock === undefined ? {} : { footLock }), ...(stroke ? { stroke } : {}) }, options);
+    async run(client, { points, gait, seed, fitSigma, footLock, stroke, style }, options) {
+      const m = await client.followPath({ points, gait, seed, fitSigma, ...(footLock === undefined ? {} : { footLock }), ...(stroke ? { stroke } : {}), ...(style ? { style } : {}) }, options);
       return { motion: motionOf(m), path: m.path, stats: pathStatsOf(m.stats) };
     },
     working: (gait) => `finding a ${gait} along the path`,
@@ -63,6 +58,7 @@ export const descriptor: ModelDescriptor<GeneratorClient> = {
   liveControl: {
     particles: true,
     start: (client, params, options) => client.controlStart(params, options),
+    switchStyle: (client, style, options) => client.controlStyle(style, options),
     pull: (client, frames, target, options) => client.controlPull(frames, target, options),
     async simulate(client, request, options) {
       const m = await client.simulateControl(request, options);

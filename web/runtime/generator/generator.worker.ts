@@ -2,7 +2,7 @@
 // Runs the locomotion generator off the main thread with onnxruntime-web's wasm execution provider
 // (setup and the requests are shared with the other model workers: ortWorker.ts). The refiner runs in the
 // same worker, in a second session loaded the first time a stream asks for `refine`.
-import { GeneratorCore } from './generatorCore';
+import { GeneratorCore, type GeneratorStream } from './generatorCore';
 import { loadGeneratorInfo } from '../../model/generatorInfo';
 import { ort, serveModel } from '../worker/ortWorker';
 import { OptimizerRequests } from './optimizerRequests';
@@ -47,7 +47,16 @@ serveModel({
         cleaner: (options, onProgress) => mapCleaner({ step: (b, x, h, c) => core.step(b, x, h, c, signal), info: core.info, mean: core.mean, std: core.std, options, onProgress, signal }),
       }, progress, signal),
     followPath: (r: FollowPathParams, core: GeneratorCore, progress, signal) => optimizerOf(core).followPath(r, progress, signal),
+    // A style switch of the endless stream, ramped over a second from its next frame (GeneratorCore.switchStreamStyle);
+    // a restart starts again in the new style.
+    streamStyle: async (r: { style: string }, core: GeneratorCore, _progress, _signal, stream) => {
+      if (!stream) throw new Error('no stream: send startStream first');
+      core.switchStreamStyle(stream.value as GeneratorStream, r.style);
+      stream.params = { ...(stream.params as StreamParams), style: r.style };
+      return core.streamInfo(stream.value as GeneratorStream);
+    },
     controlStart: async (r: ControlStartParams, core: GeneratorCore) => optimizerOf(core).controlStart(r),
+    controlStyle: async (r: { style: string }, core: GeneratorCore) => optimizerOf(core).controlStyle(r.style),
     controlPull: (r: ControlTargetParams & { frames: number }, core: GeneratorCore) => optimizerOf(core).controlPull(r),
     simulateControl: (r: SimulateControlParams, core: GeneratorCore, progress, signal) => optimizerOf(core).simulate(r, progress, signal),
   },

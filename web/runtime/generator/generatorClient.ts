@@ -85,6 +85,19 @@ export class GeneratorClient extends ModelClient<StreamParams, InitResult, Gener
     return { ...this.toMotion(chunk), stats: chunk.stats, path: chunk.path };
   }
 
+  /**
+   * A style generator's endless stream switches to `style` (one of InitResult.styles) from its next frame, blended over
+   * about a second (GeneratorCore.switchStreamStyle): frames already pulled are unchanged. A `restart` starts in it.
+   */
+  switchStyle(style: string, options: RequestOptions = {}): Promise<StreamInfo> {
+    return this.request<StreamInfo>('streamStyle', { style }, options);
+  }
+
+  /** The live-control stream switches to `style` from its next frame, blended over about a second (as switchStyle). */
+  controlStyle(style: string, options: RequestOptions = {}): Promise<StreamInfo> {
+    return this.request<StreamInfo>('controlStyle', { style }, options);
+  }
+
   /** Starts (or replaces) the live-control stream at the origin, facing +z. */
   controlStart(params: ControlStartParams, options: RequestOptions = {}): Promise<StreamInfo> {
     return this.request<StreamInfo>('controlStart', { ...params }, options);

@@ -8,6 +8,7 @@ import { noiseCorrelation, styleNames, styleSeeds, styleVector, type GeneratorIn
 import type { GeneratedChunk, GenerateParams, InitResult, ParityResult, StreamInfo, StreamParams } from './protocol';
 import type { BenchmarkResult } from '../worker/protocol';
 import type { RefinerCore, RefinerStream } from '../refiner/refinerCore';
+import { StyleRamp, STYLE_SWITCH_FRAMES } from '../../model/styleRamp';
 import { denormalise, Rng, sampleMixture, snapContacts, type HeldNoise } from '../../model/sampler';
 import { checkFrameCount, SessionCore, timeSteps } from '../worker/session';
 
@@ -23,6 +24,8 @@ export interface GeneratorStream {
   noise: HeldNoise;
   /** A style generator's style input for this stream (weights over info.styles: a one-hot, or a blend); undefined without styles. */
   style?: Float32Array;
+  /** A style switch under way (switchStreamStyle): the style input of each stream frame. */
+  ramp?: StyleRamp;
   root: RootStart;
   frame: number;
   /** With params.refine: the refiner's state behind this stream (made on the first advance). */
@@ -140,6 +143,21 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
   setStreamStyle(stream: GeneratorStream, style: string | ArrayLike<number>): void {
     if (!this.S) throw new Error(`the model "${this.info.id}" has no styles`);
     stream.style = styleVector(this.info, style);
+    stream.ramp = undefined;
+  }
+
+  /**
+   * Switches a stream to style `style` (a name) without a pop: from its next frame, the style input ramps from the
+   * weights in force to the new style's one-hot over `frames` frames (styleRamp.ts; default one second), one
+   * convex blend per frame. A switch during a switch carries on from the blend reached.
+   */
+  switchStreamStyle(stream: GeneratorStream, style: string, frames = STYLE_SWITCH_FRAMES): void {
+    if (!this.S) throw new Error(`the model "${this.info.id}" has no styles`);
+    if (typeof style !== 'string') throw new Error(`style must be a style's name, got ${String(style)}`);
+    const target = styleVector(this.info, style);
+    stream.ramp ??= new StyleRamp(stream.style ?? styleVector(this.info));
+    stream.ramp.switchTo(target, stream.frame, frames);
+    stream.params.style = style;
   }
 
   /** A new stream at the origin, heading 0, from its seed state (a style generator: one of its style's seeds by default). */
@@ -194,6 +212,7 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
     // What the refiner reads: the frames exactly as fed back to the generator (normalised, contacts snapped).
     const fedBack = refiner ? new Float32Array(frames * D) : undefined;
     for (let t = 0; t < frames; t++) {
+      if (stream.ramp) stream.style = stream.ramp.at(stream.frame + t);
       const out = await this.step(1, stream.x, stream.h, stream.c, signal, stream.style);
       const x = sampleMixture({ weights: out.weights, mu: out.mu, sigma: out.sigma, batch: 1, mixtures: M, dim: D }, stream.params.temperature, stream.rng, undefined, stream.noise);
       snapContacts(x, D, this.mean, this.std);

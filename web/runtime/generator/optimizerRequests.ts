@@ -11,11 +11,12 @@ import { moveBack } from '../../optimizer/path';
 import { PlantedFeet, plantFeet } from '../../motion/footLock';
 import { footStats } from '../../motion/footSkating';
 import type { StepFn } from '../../optimizer/rollout';
+import { StyleRamp } from '../../model/styleRamp';
 import type { GeneratorCore } from './generatorCore';
 import type { ControlChunkReply, ControlStartParams, ControlTargetParams, FollowPathChunk, FollowPathParams, SimulateControlParams, SimulatedControlChunk, StreamInfo } from './protocol';
 
 export class OptimizerRequests {
-  private live: { controller: LiveController; seedIndex: number; feet: PlantedFeet; style?: string } | undefined;
+  private live: { controller: LiveController; seedIndex: number; feet: PlantedFeet; style?: string; ramp?: StyleRamp } | undefined;
 
   constructor(private readonly core: GeneratorCore) {}
 
@@ -28,9 +29,9 @@ export class OptimizerRequests {
     return (batch, x, h, c) => this.core.step(batch, x, h, c, signal, input);
   }
 
-  private controller(seed: number, gait: Gait, signal?: AbortSignal, style?: string): { controller: LiveController; seedIndex: number } {
+  private controller(seed: number, gait: Gait, signal?: AbortSignal, style?: string, stepFn?: StepFn): { controller: LiveController; seedIndex: number } {
     const info = this.core.info;
-    const step = this.stepFn(signal, style);
+    const step = stepFn ?? this.stepFn(signal, style);
     const seeds = gaitSeeds(info, gait, style);
     const seedIndex = seeds[seed % seeds.length];
     return { controller: new LiveController({ step, info, mean: this.core.mean, std: this.core.std, seed, seedIndex }), seedIndex };
@@ -57,9 +58,29 @@ export class OptimizerRequests {
   controlStart(p: ControlStartParams): StreamInfo {
     this.live = undefined;
     const { joints, offsets } = this.core.info.skeleton;
-    this.live = { ...this.controller(checkSeed(p.seed), checkGait(p.gait), undefined, p.style), feet: new PlantedFeet(joints, offsets, this.core.info.fps), style: p.style };
+    const input = this.core.styleInput(checkStyle(p.style));
+    // A style generator's live stream carries its style as a ramp, so controlStyle can switch it mid-stream: every
+    // step of a search reads the weights of the stream frame it makes (the committed frames plus its rollout frame).
+    const ramp = input ? new StyleRamp(input) : undefined;
+    let committed = () => 0;
+    const step: StepFn | undefined = ramp ? (batch, x, h, c, frame) => this.core.step(batch, x, h, c, undefined, ramp.at(committed() + (frame ?? 0))) : undefined;
+    const made = this.controller(checkSeed(p.seed), checkGait(p.gait), undefined, p.style, step);
+    committed = () => made.controller.frame;
+    this.live = { ...made, feet: new PlantedFeet(joints, offsets, this.core.info.fps), style: p.style, ...(ramp ? { ramp } : {}) };
     const style = p.style ?? this.core.info.styles?.[0];
     return { seedIndex: this.live.seedIndex, seedName: this.core.info.seeds[this.live.seedIndex].name, ...(style ? { style } : {}) };
+  }
+
+  /** Switches the live stream's style over a second from its next frame (styleRamp.ts), as a stream's switch does. */
+  controlStyle(style: unknown): StreamInfo {
+    const live = this.live;
+    if (!live) throw new Error('no control stream: send controlStart first');
+    if (!live.ramp) throw new Error(`the model "${this.core.info.id}" has no styles`);
+    const name = checkStyle(style);
+    if (name === undefined) throw new Error('style must be a style\'s name, got undefined');
+    live.ramp.switchTo(this.core.styleInput(name)!, live.controller.frame);
+    live.style = name;
+    return { seedIndex: live.seedIndex, seedName: this.core.info.seeds[live.seedIndex].name, style: name };
   }
 
   async controlPull(p: ControlTargetParams & { frames: number; particles?: number }): Promise<ControlChunkReply> {

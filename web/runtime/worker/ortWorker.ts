@@ -117,9 +117,10 @@ export interface ModelCore<Stream, StreamParams> {
 
 /**
  * A model's own requests by type (the generator's path following and control, clean-up, …): each handler gets
- * the request as its client sent it, typed by the handler, and the loaded core.
+ * the request as its client sent it, typed by the handler, the loaded core, and the endless stream when one is
+ * running (`stream.value`; `stream.params`: what `restart` starts again with, which a handler may replace).
  */
-export type ModelRequests<Core> = Record<string, (request: never, core: Core, progress: Progress, signal: AbortSignal) => Promise<unknown>>;
+export type ModelRequests<Core> = Record<string, (request: never, core: Core, progress: Progress, signal: AbortSignal, stream: { value: unknown; params: unknown } | undefined) => Promise<unknown>>;
 
 export interface ModelWorker<Info, Stream, P, Core extends ModelCore<Stream, P> = ModelCore<Stream, P>> {
   /** Names the model in messages: "generator" → "generator worker: …", "the generator model is not loaded". */
@@ -194,7 +195,7 @@ export function serveModel<Info, Stream, P, StepInputs, Core extends ModelCore<S
         const handler = typeof type === 'string' && Object.hasOwn(spec.requests ?? {}, type) ? spec.requests![type] : undefined;
         if (!handler) throw new Error(`unknown request type "${type}"`);
         // The handler's type says what its client sends with this type (the protocol files).
-        return handler(request as never, requireCore(), progress, signal);
+        return handler(request as never, requireCore(), progress, signal, stream);
       }
     }
   });
