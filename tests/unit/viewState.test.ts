@@ -3,7 +3,7 @@ import { readFileSync } from 'node:fs';
 import { resolve } from 'node:path';
 import { parseManifest } from '../../web/model/manifest';
 import { Registry } from '../../web/runtime/registry';
-import { embedSnippet, modeModels, parseView, parseViewValue, viewQuery } from '../../web/ui/viewState';
+import { embedSnippet, modeModels, parseView, parseViewValue, styleAttribute, viewQuery } from '../../web/ui/viewState';
 import { checkSourceUrl, fetchMotionSource, MAX_SOURCE_BYTES } from '../../web/runtime/import/motionSource';
 
 describe('view state (attributes and links)', () => {
@@ -35,7 +35,7 @@ describe('view state (attributes and links)', () => {
     expect(errors.join('\n')).toMatch(/seed="-1": must be a whole number/);
     expect(errors.join('\n')).toMatch(/temperature="9": must be a number from 0 to 1.5/);
     expect(errors.join('\n')).toMatch(/refine="maybe"/);
-    expect(errors.join('\n')).toMatch(/style="<b>x<\/b>": must be a dance style name/);
+    expect(errors.join('\n')).toMatch(/style="<b>x<\/b>": must be a style name such as salsa or elderly/);
     expect(errors.join('\n')).toMatch(/path="1,2,3": must be x,z pairs/);
   });
 
@@ -58,6 +58,11 @@ describe('view state (attributes and links)', () => {
     const s = embedSnippet({ mode: 'dance', style: 'salsa', seed: 3 }, 'https://example.org/a"b/motion-playground.js');
     expect(s).toContain('src="https://example.org/a&quot;b/motion-playground.js"');
     expect(s).toContain('<motion-playground mode="dance" dance-style="salsa" seed="3" autoplay camera-controls controls="minimal"');
+    // A walking style (issue 39) goes into motion-style: the element's own style attribute is its inline CSS.
+    const walk = embedSnippet({ mode: 'walk', model: 'style-generator', style: 'elderly', seed: 2 }, 'https://example.org/motion-playground.js');
+    expect(walk).toContain('<motion-playground mode="walk" model="style-generator" motion-style="elderly" seed="2" ');
+    expect(styleAttribute('path')).toBe('motion-style');
+    expect(styleAttribute('dance')).toBe('dance-style');
   });
 });
 

@@ -12,7 +12,7 @@ import type { GLBExportOptions } from '../motion/gltf';
 import type { Motion } from '../motion/types';
 import { App } from '../ui/app';
 import { buildIn, errorMessage, type DomScope } from '../ui/dom';
-import { embedSnippet, FIRST_VIEW, formatViewValue, parseView, parseViewValue, viewQuery, VIEW_KEYS, type Mode, type ViewKey, type ViewState } from '../ui/viewState';
+import { embedSnippet, FIRST_VIEW, formatViewValue, parseView, parseViewValue, styleAttribute, viewQuery, VIEW_KEYS, type Mode, type ViewKey, type ViewState } from '../ui/viewState';
 import { fetchMotionSource, sourceName } from '../runtime/import/motionSource';
 import { capMessage, quoteInput } from '../motion/text';
 import { prefetchRuntime } from '../runtime/worker/workerClient';
@@ -28,7 +28,7 @@ type Loading = (typeof LOADING)[number];
 export type PlaygroundEventName = 'load' | 'error' | 'progress' | 'play' | 'pause' | 'motion';
 
 export class MotionPlaygroundElement extends HTMLElement {
-  static readonly observedAttributes = [...VIEW_KEYS, 'dance-style', ...OTHER_ATTRIBUTES];
+  static readonly observedAttributes = [...VIEW_KEYS, 'dance-style', 'motion-style', ...OTHER_ATTRIBUTES];
 
   private readonly shadow: ShadowRoot;
   private frame!: HTMLElement;
@@ -146,7 +146,7 @@ export class MotionPlaygroundElement extends HTMLElement {
       if (after !== null) void this.loadModelsAttribute();
       return;
     }
-    if ((VIEW_KEYS as readonly string[]).includes(name) || name === 'dance-style') void this.api.ready.then(() => this.applyView(this.attributeView(), false));
+    if ((VIEW_KEYS as readonly string[]).includes(name) || name === 'dance-style' || name === 'motion-style') void this.api.ready.then(() => this.applyView(this.attributeView(), false));
   }
 
   /** Builds the playground (once): its UI in the shadow root, its workers, the API, the view. */
@@ -258,17 +258,18 @@ export class MotionPlaygroundElement extends HTMLElement {
 
   /** The view the attributes ask for (bad ones fire `error` and are left out). */
   private attributeView(): ViewState {
-    const { view, errors } = parseView((k) => (k === 'style' ? this.danceStyleAttribute() : this.getAttribute(k)), this.app?.modeModels());
+    const { view, errors } = parseView((k) => (k === 'style' ? this.styleAttribute() : this.getAttribute(k)), this.app?.modeModels());
     for (const reason of errors) this.fire('error', { reason: `attribute ${reason}` });
     return view;
   }
 
   /**
-   * The dance style: `dance-style`, or `style` when it holds a bare style name (`style="salsa"`), since
-   * `style` is also HTML's inline CSS attribute (a value with a colon is CSS and left to the browser).
+   * The view's style: `motion-style` (a walking style: Random walk, Path, Steer), `dance-style` (Dance), or `style`
+   * when it holds a bare style name (`style="salsa"`), since `style` is also HTML's inline CSS attribute (a value
+   * with a colon is CSS and left to the browser). The element writes the one of its mode (styleAttribute in viewState.ts).
    */
-  private danceStyleAttribute(): string | null {
-    const named = this.getAttribute('dance-style');
+  private styleAttribute(): string | null {
+    const named = this.getAttribute('motion-style') ?? this.getAttribute('dance-style');
     if (named !== null) return named;
     const style = this.getAttribute('style');
     return style !== null && /^\s*[a-z][a-z0-9_-]*\s*$/.test(style) ? style.trim() : null;
@@ -290,7 +291,8 @@ export class MotionPlaygroundElement extends HTMLElement {
     const models = this.api!.models();
     const mode: Mode = view.mode ?? (initial ? 'clip' : app.currentMode);
     if (mode === 'walk') {
-      app.walk.preset(view);
+      const model = view.model ?? app.walk.model.value;
+      app.walk.preset({ ...view, style: this.checkedStyle(view.style, model) });
     } else if (mode === 'dance') {
       if (view.model !== undefined) app.danceMode.selectModel(view.model);
       const id = app.danceMode.choice.model;
@@ -303,6 +305,8 @@ export class MotionPlaygroundElement extends HTMLElement {
       app.danceMode.preset(style, view.seed);
     } else if (mode === 'path' || mode === 'steer') {
       if (view.model !== undefined) app.controlModel.set(view.model);
+      const style = this.checkedStyle(view.style, mode === 'path' ? app.controlModel.value : app.controlModel.steerable);
+      if (style !== undefined) app.controlStyle.set(style);
       if (mode === 'path' && view.seed !== undefined) app.pathMode.presetSeed(view.seed);
       if (mode === 'path' && view.path) app.pathMode.setPath(view.path);
     }
@@ -310,6 +314,18 @@ export class MotionPlaygroundElement extends HTMLElement {
     if (view.mode !== undefined || initial) app.setMode(mode);
     if (!this.hasAttribute('autoplay') && mode === 'clip') app.viewer.pause();
     this.linkSoon();
+  }
+
+  /**
+   * A view's walking style for model `id`: kept when the model lists it; else `error` fires with the reason (a model
+   * without styles, or a style it does not have) and the style shown stays as it was (undefined).
+   */
+  private checkedStyle(style: string | undefined, id: string): string | undefined {
+    if (style === undefined) return undefined;
+    const styles = this.app!.stylesOf(id);
+    if (styles.includes(style)) return style;
+    this.fire('error', { reason: `style=${quoteInput(style)}: ${styles.length ? `${id} walks ${styles.join(', ')}` : `${id || 'the model'} has no styles`}` });
+    return undefined;
   }
 
   private showLook(look: Look): void {
@@ -331,11 +347,14 @@ export class MotionPlaygroundElement extends HTMLElement {
       const { model, style, seed } = app.danceMode.choice;
       Object.assign(view, { model, ...(style ? { style } : {}), seed });
     } else if (mode === 'path') {
-      Object.assign(view, { model: app.controlModel.value, seed: app.pathMode.seedValue });
+      const style = app.controlStyle.for(app.stylesOf(app.controlModel.value));
+      Object.assign(view, { model: app.controlModel.value, ...(style ? { style } : {}), seed: app.pathMode.seedValue });
       const path = app.pathMode.path;
       if (path.length >= 2) view.path = path;
     } else if (mode === 'steer') {
       view.model = app.controlModel.steerable;
+      const style = app.controlStyle.for(app.stylesOf(view.model));
+      if (style) view.style = style;
     }
     if (!view.model) delete view.model; // no model chosen yet: the model list has not arrived (or listed none)
     // The look only when it is not the default (links stay as they were), or when the attribute says it.
@@ -353,7 +372,8 @@ export class MotionPlaygroundElement extends HTMLElement {
       try {
         for (const key of VIEW_KEYS) {
           if (key === 'path' && !this.hasAttribute('path')) continue; // a drawn path stays out of the attributes
-          const attribute = key === 'style' ? 'dance-style' : key; // `style` is the inline CSS attribute
+          const attribute = key === 'style' ? styleAttribute(view.mode) : key; // `style` is the inline CSS attribute
+          if (key === 'style') this.removeAttribute(styleAttribute(view.mode === 'dance' ? 'walk' : 'dance')); // the other mode's
           const v = view[key];
           if (v === undefined) this.removeAttribute(attribute);
           else this.setAttribute(attribute, formatViewValue(key, v));
@@ -601,9 +621,10 @@ export class MotionPlaygroundElement extends HTMLElement {
       const frames = 300;
       if (view.mode === 'dance' && view.model) return api.generate({ model: view.model, seed: view.seed ?? 0, frames, ...(view.style ? { style: view.style } : {}) });
       const walk: ViewState = view.mode === 'walk' ? view : {};
-      // The Random walk model (left out when none is listed: generate then says which models there are).
-      const walker = this.app?.registry.defaultFor('walk')?.info.id;
-      return api.generate({ ...(walker ? { model: walker } : {}), seed: walk.seed ?? 0, refine: walk.refine ?? false, frames, ...(walk.temperature !== undefined ? { temperature: walk.temperature } : {}) } as GenerateOptions);
+      // The Random walk model (left out when none is listed: generate then says which models there are), in its style.
+      const walker = walk.model ?? this.app?.registry.defaultFor('walk')?.info.id;
+      const style = walk.style ? { style: walk.style } : {};
+      return api.generate({ ...(walker ? { model: walker } : {}), seed: walk.seed ?? 0, refine: walk.refine ?? false, frames, ...(walk.temperature !== undefined ? { temperature: walk.temperature } : {}), ...style } as GenerateOptions);
     });
   }
 
@@ -639,7 +660,7 @@ function allowedOrigins(text: string | null): string[] {
 }
 
 /** Reflected properties: each attribute as a property of the same (camel-cased) name. */
-const STRING_PROPERTIES: Record<string, string> = { mode: 'mode', model: 'model', danceStyle: 'dance-style', src: 'src', character: 'character', controls: 'controls', poster: 'poster', loading: 'loading', path: 'path' };
+const STRING_PROPERTIES: Record<string, string> = { mode: 'mode', model: 'model', danceStyle: 'dance-style', motionStyle: 'motion-style', src: 'src', character: 'character', controls: 'controls', poster: 'poster', loading: 'loading', path: 'path' };
 const NUMBER_PROPERTIES = ['seed', 'temperature'];
 const BOOLEAN_PROPERTIES: Record<string, string> = { autoplay: 'autoplay', cameraControls: 'camera-controls', link: 'link' };
 

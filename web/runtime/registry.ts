@@ -81,10 +81,16 @@ export class Registry {
     return this.find(id)?.descriptor.capabilities.includes(capability) ?? false;
   }
 
-  /** How titles name model `id` (its descriptor's short name; the id itself if it is not registered). */
+  /**
+   * How titles name model `id`: its descriptor's short name; the id itself for a model that is not registered, a
+   * user's pack, and a second model of a kind that its descriptor's labels do not name (the style generator beside
+   * the generator), so two models of one kind are told apart.
+   */
   shortName(id: string): string {
     const m = this.find(id);
-    return m?.info.label ? id : (m?.descriptor.shortName ?? id); // a user's pack by its own name
+    if (!m || m.info.label) return id;
+    const unnamed = m.descriptor.labels !== undefined && !Object.hasOwn(m.descriptor.labels, id);
+    return unnamed && this.models.some((o) => o !== m && o.descriptor === m.descriptor) ? id : m.descriptor.shortName;
   }
 
   /** The picker's label of model `id`; a model trained on non-commercial data says so. */

@@ -29,6 +29,7 @@ import { DanceMode } from './modes/danceMode';
 import type { ModeHost } from './modes/host';
 import type { LiveChunk, LiveMode } from './modes/liveMode';
 import { ModelChoice } from './modes/modelChoice';
+import { StyleChoice } from './modes/styleChoice';
 import { PathMode } from './modes/pathMode';
 import { RandomWalk } from './modes/randomWalk';
 import { SteerMode } from './modes/steerMode';
@@ -79,6 +80,11 @@ export class App implements ModeHost {
   private readonly dropOverlay = $('drop-overlay');
   /** The model Steer and Path modes run (one choice for both, kept across mode switches). */
   readonly controlModel = new ModelChoice($<HTMLSelectElement>('path-model'), $<HTMLSelectElement>('steer-model'));
+  /** The walking style Steer and Path modes run a model with styles in (one choice for both, beside the model). */
+  readonly controlStyle = new StyleChoice([
+    { field: $('path-style-field'), select: $<HTMLSelectElement>('path-style'), styles: () => this.stylesOf(this.controlModel.value) },
+    { field: $('steer-style-field'), select: $<HTMLSelectElement>('steer-style'), styles: () => this.stylesOf(this.controlModel.steerable) },
+  ]);
   readonly walk: RandomWalk;
   readonly danceMode: DanceMode;
   readonly pathMode: PathMode;
@@ -130,6 +136,7 @@ export class App implements ModeHost {
     this.danceMode = new DanceMode(this);
     this.pathMode = new PathMode(this);
     this.steerMode = new SteerMode(this);
+    this.controlModel.onChange(() => this.controlStyle.refresh());
     this.cleanup = new CleanupPanel(this);
     for (const m of MODES) {
       this.modeButtons.get(m)!.addEventListener('click', () => this.setMode(m));
@@ -159,7 +166,13 @@ export class App implements ModeHost {
     this.walk.list(this.models);
     this.danceMode.list(this.models);
     this.pathMode.list(this.models);
+    this.controlStyle.refresh();
     this.modelsArrived(this.models);
+  }
+
+  /** The walking styles of model `id` (its manifest entry's `styles`; none for a model without, or not listed). */
+  stylesOf(id: string): readonly string[] {
+    return this.models.find(id)?.info.styles ?? [];
   }
 
   /**
@@ -190,6 +203,7 @@ export class App implements ModeHost {
     this.walk.list(this.models);
     this.danceMode.list(this.models);
     this.pathMode.list(this.models);
+    this.controlStyle.refresh();
     for (const id of ['walk-model', 'dance-model', 'path-model', 'steer-model']) this.cardButton(this.scope.root.getElementById(id) as HTMLSelectElement);
   }
 

@@ -60,7 +60,7 @@ export function parseViewValue(key: ViewKey, text: string): { value: ViewState[V
     case 'model':
       return /^[a-z0-9][a-z0-9._-]{0,63}$/.test(text) ? { value: text } : refuse('must be a model id such as generator');
     case 'style':
-      return /^[a-z][a-z0-9_-]{0,31}$/.test(text) ? { value: text } : refuse('must be a dance style name such as salsa');
+      return /^[a-z][a-z0-9_-]{0,31}$/.test(text) ? { value: text } : refuse('must be a style name such as salsa or elderly');
     case 'seed': {
       const n = Number(text);
       return text.trim() !== '' && Number.isInteger(n) && n >= 0 && n <= 0xffffffff ? { value: n } : refuse('must be a whole number from 0 to 4294967295');
@@ -128,6 +128,14 @@ export function viewQuery(view: ViewState): string {
   return q.toString();
 }
 
+/**
+ * The <motion-playground> attribute that carries a view's `style` in `mode` (the element's own `style` attribute is its
+ * inline CSS): `dance-style` in Dance mode, `motion-style` (a walking style) in the others.
+ */
+export function styleAttribute(mode: Mode | undefined): 'dance-style' | 'motion-style' {
+  return mode === 'dance' ? 'dance-style' : 'motion-style';
+}
+
 /** Escapes text for an HTML attribute value in a snippet shown to the user (shown as text, never parsed). */
 function attributeText(s: string): string {
   return s.replace(/&/g, '&amp;').replace(/"/g, '&quot;').replace(/</g, '&lt;').replace(/>/g, '&gt;');
@@ -137,7 +145,7 @@ function attributeText(s: string): string {
 export function embedSnippet(view: ViewState, moduleUrl: string): string {
   const attrs = VIEW_KEYS.flatMap((key) => {
     const v = view[key];
-    const name = key === 'style' ? 'dance-style' : key; // the element's `style` attribute is its inline CSS
+    const name = key === 'style' ? styleAttribute(view.mode) : key; // the element's `style` attribute is its inline CSS
     return v === undefined ? [] : [`${name}="${attributeText(formatViewValue(key, v))}"`];
   });
   return [

@@ -9,6 +9,7 @@ import type { ModelSkeleton } from '../../runtime/worker/workerClient';
 import type { Viewer } from '../../viewer/viewer';
 import type { ModelHost } from '../modelHost';
 import type { ModelChoice } from './modelChoice';
+import type { StyleChoice } from './styleChoice';
 
 /**
  * The parts of the viewer a mode uses: the camera rig (camera, orbit controls, framing), the scene for
@@ -36,6 +37,10 @@ export interface ModeHost {
   withModel<T>(id: string, use: (client: ModelClientBase, descriptor: ModelDescriptor) => Promise<T>): Promise<T>;
   /** Which model Steer and Path modes run (one choice for both). */
   readonly controlModel: ModelChoice;
+  /** The walking style Steer and Path modes run a model with styles in (one choice for both). */
+  readonly controlStyle: StyleChoice;
+  /** The walking styles of model `id` (its manifest entry's `styles`; empty for a model without). */
+  stylesOf(id: string): readonly string[];
   /** Shows a live mode's window of streamed frames (`dropped` < 0: a new stream); `name` names exports. */
   showLive(motion: Motion, dropped: number, name: string): void;
   /** Shows a finished motion (Path mode's walk) without leaving the mode; `name` names exports. */

@@ -135,6 +135,10 @@ export class PathMode {
       this.showState();
       if (this.follower()?.immediate && this.points.length && !this.current()) void this.go();
     });
+    // Another style for a model with styles: a walked path is walked again in it.
+    app.controlStyle.onChange(() => {
+      if (this.active && this.app.stylesOf(this.app.controlModel.value).length && this.points.length && this.current() && !this.busy) void this.go();
+    });
     this.compare.addEventListener('change', () => this.showState());
     this.varyBtn.addEventListener('click', () => this.vary());
     this.goBtn.addEventListener('click', () => void this.go());
@@ -403,7 +407,8 @@ export class PathMode {
     if (!follow) throw new Error(`model "${model}" does not follow paths`);
     // Each model reads the setting it has: the optimiser's fit tolerance, or the speed asked for.
     const own = { ...(follow.options.includes('fitTolerance') ? { fitSigma } : {}), ...(follow.options.includes('speed') ? { speed } : {}) };
-    const r = await this.app.withModel(model, (client) => follow.run(client, { points, gait, seed, ...own, stroke: true }, { signal, onProgress }));
+    const style = this.app.controlStyle.for(this.app.stylesOf(model));
+    const r = await this.app.withModel(model, (client) => follow.run(client, { points, gait, seed, ...own, stroke: true, ...(style ? { style } : {}) }, { signal, onProgress }));
     return { motion: r.motion, path: r.path, stats: r.stats, model };
   }
 

@@ -12,6 +12,7 @@ import { $, changeTo, readSeed } from '../dom';
 import { fillSelect } from './modelChoice';
 import type { ModeHost } from './host';
 import { LiveMode, type LiveStream } from './liveMode';
+import { StyleChoice } from './styleChoice';
 
 const DEFAULT_TEMPERATURE = 0.5;
 /** Seconds of motion up to the playhead the skating readout averages over. */
@@ -48,6 +49,10 @@ export class RandomWalk extends LiveMode<WalkChunk> {
   private readonly seedState = $<HTMLSelectElement>('walk-seed-state');
   private readonly seed = $<HTMLInputElement>('walk-seed');
   private readonly refine = $<HTMLInputElement>('walk-refine');
+  /** A model with styles walks in this one (shown only for such a model); a change blends the running walk into it. */
+  readonly style = new StyleChoice([{ field: $('walk-style-field'), select: $<HTMLSelectElement>('walk-style'), styles: () => this.app.stylesOf(this.model.value) }]);
+  /** The running stream's style (a model with styles), for the status line. */
+  private streamStyle: string | undefined;
   /** The user's own refine choice, kept while a model without a refiner (a pack) has refine off. */
   private refineWanted = false;
   private readonly sideBySide = $<HTMLInputElement>('walk-side-by-side');
@@ -68,9 +73,11 @@ export class RandomWalk extends LiveMode<WalkChunk> {
       // Another model has other seed states.
       this.seedState.replaceChildren(this.seedState.options[0]);
       this.seedsListed = false;
-      this.showRefinerAvailability(this.app.registry.find(this.model.value)?.info.files !== undefined);
+      this.showRefinerAvailability(this.refinerMissing(this.model.value));
+      this.style.refresh();
       this.restartIfActive();
     });
+    this.style.onChange(() => this.switchStyle());
     this.seed.addEventListener('change', () => this.restartIfActive());
     $('walk-restart').addEventListener('click', () => this.restartIfActive());
     this.refine.addEventListener('change', () => {
@@ -93,36 +100,79 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     });
   }
 
-  /** The walk's settings, as a view (link, attributes) carries them. */
-  get viewSettings(): { temperature: number; seed: number; refine: boolean } {
-    return { temperature: Number(this.temperature.value), seed: Number(this.seed.value) || 0, refine: this.refine.checked };
+  /**
+   * The walk's settings, as a view (link, attributes) carries them: the model only when it is not the default walker
+   * (links to the default walk stay as they were), the style only for a model with styles.
+   */
+  get viewSettings(): { model?: string; style?: string; temperature: number; seed: number; refine: boolean } {
+    const model = this.model.value;
+    const style = this.style.for(this.app.stylesOf(model));
+    const listedDefault = this.app.registry.defaultFor('walk')?.info.id;
+    return {
+      ...(model && model !== listedDefault ? { model } : {}),
+      ...(style ? { style } : {}),
+      temperature: Number(this.temperature.value),
+      seed: Number(this.seed.value) || 0,
+      refine: this.refine.checked,
+    };
   }
 
-  /** Sets what a view gives (left out: kept), as if the user had: the stream restarts with them. */
-  preset(view: { temperature?: number; seed?: number; refine?: boolean }): void {
+  /**
+   * Sets what a view gives (left out: kept), as if the user had: the stream restarts with them, except a style, which
+   * the running walk blends into. `model` and `style` are checked by the caller (element.ts) against the registry.
+   */
+  preset(view: { model?: string; style?: string; temperature?: number; seed?: number; refine?: boolean }): void {
     if (view.temperature !== undefined) changeTo(this.temperature, String(view.temperature));
     if (view.seed !== undefined) changeTo(this.seed, String(view.seed));
     if (view.refine !== undefined) changeTo(this.refine, view.refine);
+    // After refine: a model without a refiner then turns refine off (the wish is kept for a model with one).
+    if (view.model !== undefined && view.model !== this.model.value) changeTo(this.model, view.model);
+    if (view.style !== undefined) this.style.set(view.style);
+    this.showRefinerAvailability(this.refinerMissing(this.model.value));
+  }
+
+  /**
+   * Why model `id` has no refiner behind it, or '' when it has one: a user's pack (its files are its own), or a model
+   * with styles (the refiner learnt from the CMU-only generator's output; none is trained for it yet).
+   */
+  private refinerMissing(id: string): string {
+    const info = this.app.registry.find(id)?.info;
+    if (info?.files !== undefined) return 'Your model has no refiner';
+    if (info?.styles?.length) return 'No refiner is trained for this model yet: it walks raw';
+    return '';
+  }
+
+  /** A new style for the running walk: its stream blends into it over about a second from its next frame. */
+  private switchStyle(): void {
+    const running = this.client;
+    if (!this.running || !running || running.id !== this.model.value) return; // the next walk starts in it
+    const style = this.style.for(this.app.stylesOf(running.id));
+    if (!style || style === this.streamStyle) return;
+    this.streamStyle = style;
+    running.client.switchStyle(style).catch((e: unknown) => this.app.reportError(`Random walk: ${e instanceof Error ? e.message : String(e)}`));
+    this.updateStatus(true);
   }
 
   private showTemperature(): void {
     this.temperatureOut.textContent = Number(this.temperature.value).toFixed(2);
   }
 
-  private params(): { seed: number; temperature: number; seedIndex?: number; refine: boolean } {
+  private params(model: string): { seed: number; temperature: number; seedIndex?: number; refine: boolean; style?: string } {
     const seed = readSeed(this.seed);
     const temperature = Math.min(Math.max(Number(this.temperature.value) || 0, 0), 2);
     const idx = this.seedState.value === '' ? undefined : Number(this.seedState.value);
-    return { seed, temperature, ...(idx === undefined ? {} : { seedIndex: idx }), refine: this.refine.checked };
+    const style = this.style.for(this.app.stylesOf(model));
+    return { seed, temperature, ...(idx === undefined ? {} : { seedIndex: idx }), refine: this.refine.checked && !this.refinerMissing(model), ...(style ? { style } : {}) };
   }
 
   /**
-   * A user's pack (its files are its own) has no refiner trained for it: refine and side by side are off and disabled
-   * while it is chosen, and the user's own refine choice comes back with a model that has one.
+   * A model without a refiner trained for it (a user's pack, a model with styles; `why`): refine and side by side are
+   * off and disabled while it is chosen, and the user's own refine choice comes back with a model that has one.
    */
-  private showRefinerAvailability(noRefiner: boolean): void {
+  private showRefinerAvailability(why: string): void {
+    const noRefiner = why !== '';
     this.refine.disabled = this.sideBySide.disabled = noRefiner;
-    this.refine.title = this.sideBySide.title = noRefiner ? 'Your model has no refiner' : '';
+    this.refine.title = this.sideBySide.title = why;
     const refine = this.refineWanted && !noRefiner;
     if (this.refine.checked === refine) return;
     this.refine.checked = refine;
@@ -133,6 +183,7 @@ export class RandomWalk extends LiveMode<WalkChunk> {
   /** Lists the registry's walking models in the model picker. */
   list(registry: Registry): void {
     fillSelect(this.model, registry, registry.ids('walk'));
+    this.style.refresh();
   }
 
   protected async open(signal: AbortSignal): Promise<LiveStream<WalkChunk>> {
@@ -141,7 +192,7 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     const walker = (this.model.value && registry.can(this.model.value, 'walk') ? registry.find(this.model.value) : undefined) ?? registry.defaultFor('walk');
     if (!walker) throw new Error('no model for Random walk is listed in models/index.json');
     const id = walker.info.id;
-    this.showRefinerAvailability(walker.info.files !== undefined);
+    this.showRefinerAvailability(this.refinerMissing(id));
     const { client } = await this.app.host(id).load();
     if (!(client instanceof GeneratorClient)) throw new Error(`model "${id}" cannot stream a random walk`);
     const info = client.initResult;
@@ -150,9 +201,10 @@ export class RandomWalk extends LiveMode<WalkChunk> {
       for (const [i, name] of info.seeds.entries()) this.seedState.add(new Option(name, String(i)));
       this.seedsListed = true;
     }
-    const params = this.params();
+    const params = this.params(id);
     const stream = await client.startStream(params, { signal });
     this.seedName = stream.seedName;
+    this.streamStyle = stream.style;
     this.refining = params.refine;
     this.walkSkeleton = info;
     this.raw = null;
@@ -253,6 +305,7 @@ export class RandomWalk extends LiveMode<WalkChunk> {
   protected describe(frame: number, fps: number): string {
     this.showSkating();
     const refined = this.refining ? ` · refined${this.sideBySide.checked ? ', side by side' : ''}` : '';
-    return `frame ${frame} · ${(frame / fps).toFixed(1)} s · ${this.seedName} · τ ${this.params().temperature.toFixed(2)}${refined}`;
+    const style = this.streamStyle ? ` · style ${this.streamStyle}` : '';
+    return `frame ${frame} · ${(frame / fps).toFixed(1)} s · ${this.seedName}${style} · τ ${Number(this.temperature.value).toFixed(2)}${refined}`;
   }
 }

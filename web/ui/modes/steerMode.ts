@@ -102,6 +102,8 @@ export class SteerMode extends LiveMode<SteerChunk> {
   private history = { start: 0, speed: [] as number[], heading: [] as number[] };
   private computeMs = 0;
   private particles = PARTICLES_MAX;
+  /** The running stream's style (a model with styles). */
+  private streamStyle: string | undefined;
   /** Until when the camera is left where the user turned it. */
   private chasePausedUntil = 0;
 
@@ -122,6 +124,8 @@ export class SteerMode extends LiveMode<SteerChunk> {
     app.controlModel.onChange(() => {
       if (app.controlModel.steerable !== this.model) this.restartIfActive();
     });
+    // Another style: the running stream blends into it over about a second, where it goes on.
+    app.controlStyle.onChange(() => this.switchStyle());
     // On the document, so it runs before the page's own shortcuts (on window), which it then skips.
     const signal = currentScope().signal; // the page's listeners go with the element's playground
     document.addEventListener('keydown', (e) => this.onKey(e, true), { signal });
@@ -183,8 +187,10 @@ export class SteerMode extends LiveMode<SteerChunk> {
     this.statusLine.dataset.model = model;
     const { client, info } = await this.app.host(model).load();
     this.client = { id: model, client };
-    const stream = await live.start(client, { seed: 0, gait: this.gaitValue }, { signal });
+    const style = this.app.controlStyle.for(this.app.stylesOf(model));
+    const stream = await live.start(client, { seed: 0, gait: this.gaitValue, ...(style ? { style } : {}) }, { signal });
     this.seedName = stream.seedName;
+    this.streamStyle = style;
     // The stream starts at the origin facing +z, at the slider's speed.
     this.heading = 0;
     this.throttle = 1;
@@ -199,6 +205,17 @@ export class SteerMode extends LiveMode<SteerChunk> {
       ...(live.ahead ? { ahead: live.ahead } : {}),
       pull: (frames) => live.pull(client, frames, target(), { signal }),
     };
+  }
+
+  /** A new style for the running stream (a model with styles): it switches from its next batch, blended over a second. */
+  private switchStyle(): void {
+    const client = this.client;
+    const live = this.live;
+    if (!this.running || !client || !live?.switchStyle || client.id !== this.app.controlModel.steerable) return;
+    const style = this.app.controlStyle.for(this.app.stylesOf(client.id));
+    if (!style || style === this.streamStyle) return;
+    this.streamStyle = style;
+    live.switchStyle(client.client, style, {}).catch((e: unknown) => this.app.reportError(`Steer: ${e instanceof Error ? e.message : String(e)}`));
   }
 
   protected forget(): void {
