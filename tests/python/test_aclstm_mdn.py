@@ -53,13 +53,6 @@ def test_auto_conditioned_mixture_feeds_back_its_own_draws():
     assert not torch.allclose(a[:, 5:], c[:, 5:])
 
 
-def test_the_mdn_head_is_not_exported_as_a_mean_head():
-    from training.aclstm.graph import dance_graph
-
-    with pytest.raises(ValueError, match="mdn head has no ONNX graph"):
-        dance_graph(DanceLSTM(6, 3, hidden=8, layers=1, head="mdn", components=2))
-
-
 def mixture_of(weights, dim=2):
     logits = torch.log(torch.tensor(weights)).unsqueeze(0).repeat(2, 1)
     k = logits.shape[-1]

@@ -3,6 +3,11 @@
     python -m training.aclstm.export [--run aclstm] [--id aclstm]
     python -m training.aclstm.export --run aclstm-vanilla --id aclstm-vanilla
     python -m training.aclstm.export --id aclstm --from-shipped [--weights int8]   # no checkpoint: rewrite the shipped file
+    python -m training.aclstm.export --checkpoint runs/aclstm-mdn/last.pt --id aclstm-mdn [--out DIR] [--tune-frames 1200]
+
+An mdn head (issue 42) also gets its sampling block (phrase parameters tuned per style on held-out windows, the
+output filter per style) and its parity fixture (tests/fixtures/aclstm_mdn_reference.json when written into
+public/models, else beside the files).
 
 What the files hold: training/aclstm/exporting.py.
 """
@@ -19,10 +24,13 @@ from .exporting import export_dance_model, rewrite_dance_model
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--run", default="aclstm", help="run under runs/")
-    parser.add_argument("--checkpoint", default="best.pt", help="file in the run directory (best.pt or last.pt)")
+    parser.add_argument("--checkpoint", default="best.pt",
+                        help="file in the run directory (best.pt or last.pt), or a path to a checkpoint")
     parser.add_argument("--id", default=None, help="model id and file name (default: the run name)")
     parser.add_argument("--mocap", default=None)
     parser.add_argument("--temperature", type=float, default=0.2, help="a Gaussian head's sampling temperature (kept in the JSON)")
+    parser.add_argument("--tune-frames", type=int, default=1200,
+                        help="an mdn head: frames of each tuning rollout choosing its phrase parameters per style")
     add_export_arguments(parser, FORMATS, weights_help="how the file stores its large weights (int8 with a scale per output channel)",
                          shipped_help="no checkpoint: read the network back from DIR/<id>.onnx (default the shipped one) and keep its JSON")
     args = parser.parse_args(argv)
@@ -31,10 +39,12 @@ def main(argv: list[str] | None = None) -> None:
         onnx_path = rewrite_dance_model(args.from_shipped, model_id, args.out, args.weights)
         print(f"wrote {onnx_path} ({onnx_path.stat().st_size / 1e6:.2f} MB) and {model_id}.json")
         return
-    checkpoint = RUNS_DIR / args.run / args.checkpoint
+    checkpoint = Path(args.checkpoint)
+    if not checkpoint.is_file():
+        checkpoint = RUNS_DIR / args.run / args.checkpoint
     if not checkpoint.exists():
         raise SystemExit(f"error: no checkpoint at {checkpoint}; train first with python -m training.aclstm.train")
-    onnx_path = export_dance_model(checkpoint, model_id, args.out, args.mocap, args.weights, args.temperature)
+    onnx_path = export_dance_model(checkpoint, model_id, args.out, args.mocap, args.weights, args.temperature, args.tune_frames)
     print(f"wrote {onnx_path} ({onnx_path.stat().st_size / 1e6:.2f} MB) and {model_id}.json")
 
 

@@ -20,11 +20,13 @@ from ..onnx.compact import compact_weights, weight_format
 from ..onnx.manifest import register_model
 from ..onnx.sessions import cpu_session
 from ..paths import MODELS_DIR, REPO_ROOT
-from .graph import OUTPUTS, check_parity, dance_graph, dance_model_from_onnx, graph_inputs
+from .graph import (MDN_OUTPUTS, OUTPUTS, check_parity, dance_graph, dance_model_from_onnx, graph_inputs, graph_outputs,
+                    mdn_torch_steps)
 
 SEED_FRAMES = 10  # the paper's seed length (about 170 ms at 60 fps)
 SEEDS_PER_STYLE = 8
 FIXTURE = REPO_ROOT / "tests" / "fixtures" / "aclstm_reference.json"
+MDN_FIXTURE = REPO_ROOT / "tests" / "fixtures" / "aclstm_mdn_reference.json"
 
 
 def load_dance_model(checkpoint: Path) -> tuple[DanceLSTM, dict, dict]:
@@ -111,7 +113,7 @@ def write_dance_graph(model: DanceLSTM, onnx_path: Path, weights: str) -> tuple[
     stored = export_onnx(model, onnx_path, weights)
     parity = {**check_parity(stored, onnx_path), "reference": f"torch with the weights as stored ({weights})"}
     print(f"parity ok: max |torch - onnxruntime| = {parity['max_abs_diff']:.2e}")
-    fields = {"inputs": graph_inputs(model), "outputs": OUTPUTS, "opset": 17, "layers": model.layers, "hidden": model.hidden,
+    fields = {"inputs": graph_inputs(model), "outputs": graph_outputs(model), "opset": 17, "layers": model.layers, "hidden": model.hidden,
               "dim": model.dim, "styles": model.styles, "head": model.head, "weights": weight_format(onnx.load(str(onnx_path))),
               "style_input": "one-hot over `styles`; x and ys are normalised features",
               "steps_input": "int64 (1,): steps run in the call, each output frame fed back as the next input; "
@@ -120,6 +122,18 @@ def write_dance_graph(model: DanceLSTM, onnx_path: Path, weights: str) -> tuple[
         fields["noise_input"] = ("float32 (>= steps, batch, dim) standard normals, one row per step: each frame is "
                                  "mu + temperature * sigma * noise[step], the network's Gaussian draw")
         fields["temperature_input"] = "float32 (1,): scales sigma (0: the mean)"
+    if model.head == "mdn":
+        fields["components"] = model.components
+        fields["sampler_inputs"] = (
+            "held, age (batch,) int64: the held component (-1: none yet) and the frames it has been held; wander "
+            "(batch, dim): the AR(1) normals; temperature, rho, threshold (batch,) float32 and max_hold, min_hold "
+            "(batch,) int64: each row's phrase parameters; uniforms (>= steps, batch) in [0, 1), one per step for a "
+            "component draw by inverse CDF; normals (>= steps, batch, dim): the AR(1) innovations "
+            "(training/aclstm/phrase_sampling.py)")
+        fields["filter_inputs"] = ("filt (batch, 4, dim): x[t-1], x[t-2], y[t-1], y[t-2] of the output filter; filter_b "
+                                   "(batch, 3), filter_a (batch, 2): b0, b1, b2 and a1, a2 (training/aclstm/jitter_filter.py)")
+        fields["outputs_note"] = ("ys: the drawn frames, fed back; display: ys through the causal low-pass, what is shown; "
+                                  "the sampler's and the filter's states after the call; weights (steps, batch, K)")
     return fields, parity
 
 
@@ -128,7 +142,9 @@ def _publish(info: dict, onnx_path: Path, model_id: str, out: Path) -> None:
     browser fixture."""
     info["bytes"] = onnx_path.stat().st_size
     (out / f"{model_id}.json").write_text(json.dumps(info) + "\n")
-    if info["training_scheme"] == "auto-conditioned" and out == MODELS_DIR:
+    if info.get("head") == "mdn":  # the mdn fixture beside a development export, into tests/fixtures when shipped
+        write_mdn_reference_fixture(onnx_path, info, MDN_FIXTURE if out == MODELS_DIR else out / MDN_FIXTURE.name)
+    elif info["training_scheme"] == "auto-conditioned" and out == MODELS_DIR:
         write_reference_fixture(onnx_path, info)
     if out == MODELS_DIR:
         register_model({"id": model_id, "kind": "aclstm", "skeleton": "aclstm-standard", "fps": info["fps"],
@@ -136,9 +152,11 @@ def _publish(info: dict, onnx_path: Path, model_id: str, out: Path) -> None:
 
 
 def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | None, weights: str = "int8",
-                       temperature: float = 0.2) -> Path:
+                       temperature: float = 0.2, tune_frames: int = 1200) -> Path:
     """Writes out/<model_id>.onnx (parity checked) and out/<model_id>.json (see _publish). Returns the ONNX path.
-    `temperature`: a Gaussian head's sampling temperature, kept in the JSON for the page and the evaluation."""
+    `temperature`: a Gaussian head's sampling temperature, kept in the JSON for the page and the evaluation. An mdn
+    head's JSON gets `head`, `components` and `sampling` (mdn_sampling: the output filter per style from the training
+    clips, the phrase parameters per style tuned on held-out windows over `tune_frames` frames)."""
     model, meta, state = load_dance_model(checkpoint)
     out.mkdir(parents=True, exist_ok=True)
     onnx_path = out / f"{model_id}.onnx"
@@ -150,9 +168,13 @@ def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | 
         "description": ("Vanilla 3-layer LSTM trained with teacher forcing only (the acLSTM paper's baseline)" if vanilla else
                         "Auto-conditioned LSTM (Zhou et al.), u = v = 5")
                        + (f", Gaussian output head drawn at temperature {temperature:g} and fed back" if model.head == "gauss" else "")
+                       + (f", mixture-density head (K = {model.components}) drawn by phrase-scale sampling and fed back, "
+                          "shown through a causal low-pass" if model.head == "mdn" else "")
                        + ", one model for salsa, Indian and martial-arts dance.",
         "training_scheme": "teacher-forced" if vanilla else "auto-conditioned",
         **({"temperature": temperature} if model.head == "gauss" else {}),
+        **({"head": "mdn", "components": model.components, "sampling": mdn_sampling(checkpoint, clips, mocap, tune_frames)}
+           if model.head == "mdn" else {}),
         "styles": meta["styles"],
         "skeleton": meta["skeleton"],
         "features": {"dim": meta["dim"], "seed_frames": SEED_FRAMES,
@@ -184,3 +206,92 @@ def rewrite_dance_model(source: Path, model_id: str, out: Path, weights: str) ->
     info["file"] = onnx_path.name
     _publish(info, onnx_path, model_id, out)
     return onnx_path
+
+
+def mdn_sampling(checkpoint: Path, clips: list[DanceClip], mocap: str | None, tune_frames: int = 1200) -> dict:
+    """The JSON's `sampling` block of an mdn model: the output filter per style (jitter_filter.style_filters: the cutoff
+    below which 99% of the style's training clips' velocity power lies), then the phrase parameters per style chosen
+    by pilots.tune_phrase on held-out tuning windows (never the judged seeds), the rollouts judged through the filter
+    as the page shows them."""
+    from .jitter_filter import style_filters
+    from .pilots import tune_phrase, tuning_grid
+
+    filters = style_filters(clips)
+    tuned = tune_phrase(checkpoint, tuning_grid(), tune_frames, mocap=mocap,
+                        filters={s: (np.array(f["b"]), np.array(f["a"])) for s, f in filters.items()})
+    for style, v in tuned["styles"].items():
+        row = v["table"][0]
+        print(f"{style}: filter {filters[style]['cutoff_hz']:.2f} Hz, phrase {v['best']} (tuning: {row['passes']}/{row['runs']} pass, "
+              f"median {row['median_ratio']:.0%}, jitter {row['jitter_vs_real']:.2f}x filtered, {row['jitter_raw_vs_real']:.2f}x raw)")
+    return {"rule": "phrase", "params": {s: v["best"] for s, v in tuned["styles"].items()}, "filter": filters,
+            "tuning": {"frames": tuned["frames"], "seeds_per_style": tuned["seeds_per_style"], "fractions": list(tuned["fractions"]),
+                       "chosen": {s: {k: v["table"][0][k] for k in ("passes", "runs", "diverged", "median_ratio", "jitter_vs_real",
+                                                                   "jitter_raw_vs_real")} for s, v in tuned["styles"].items()}},
+            "notes": ("params: training/aclstm/phrase_sampling.py's rule per style; filter: a causal 2nd-order Butterworth "
+                      "(b, a with a[0] = 1) per channel on the drawn frames, shown but never fed back "
+                      "(training/aclstm/jitter_filter.py)")}
+
+
+MDN_FIXTURE_STEPS = 40
+
+
+def mdn_case_feeds(info: dict, rows: list[dict], steps: int, rng: np.random.Generator) -> dict:
+    """The mdn graph's feeds for a fixture case: each row {seed, held, age} starts from its seed's last frame with
+    its style's phrase parameters and filter (at rest on that frame), h and c random; randoms rounded to 7 digits
+    (so the fixture's numbers are the exact inputs)."""
+    o, sampling = info["onnx"], info["sampling"]
+    mean, std = np.array(info["normalisation"]["mean"]), np.array(info["normalisation"]["std"])
+    q = lambda a, dtype=np.float32: np.array([float(f"{v:.7g}") for v in np.ravel(a)]).reshape(np.shape(a)).astype(dtype)
+    b = len(rows)
+    x = q([(np.array(r["seed"]["frames"][-1]) - mean) / std for r in rows])
+    params = [sampling["params"][r["seed"]["style"]] for r in rows]
+    filters = [sampling["filter"][r["seed"]["style"]] for r in rows]
+    return {
+        "x": x, "style": np.eye(len(info["styles"]), dtype=np.float32)[[info["styles"].index(r["seed"]["style"]) for r in rows]],
+        "h": q(rng.normal(scale=0.3, size=(o["layers"], b, o["hidden"]))), "c": q(rng.normal(scale=0.3, size=(o["layers"], b, o["hidden"]))),
+        "steps": np.array([steps], np.int64),
+        "held": np.array([r["held"] for r in rows], np.int64), "age": np.array([r["age"] for r in rows], np.int64),
+        "wander": q(rng.normal(size=(b, o["dim"]))),
+        "temperature": q([p["temperature"] for p in params]), "rho": q([p["rho"] for p in params]),
+        "threshold": q([p["threshold"] for p in params]),
+        "max_hold": np.array([p["max_hold"] for p in params], np.int64), "min_hold": np.array([p["min_hold"] for p in params], np.int64),
+        "uniforms": q(rng.random((steps, b))), "normals": q(rng.normal(size=(steps, b, o["dim"]))),
+        "filt": np.repeat(x[:, None], 4, axis=1),
+        "filter_b": q([f["b"] for f in filters]), "filter_a": q([f["a"][1:] for f in filters]),
+    }
+
+
+def write_mdn_reference_fixture(onnx_path: Path, info: dict, path: Path) -> None:
+    """The mdn graph's parity fixture for the page: onnxruntime's outputs (every one of MDN_OUTPUTS, display and the
+    sampler's and filter's states included) for MDN_FIXTURE_STEPS steps at batch 1 (a row holding a component 10
+    frames short of its longest hold) and batch 2 (a fresh row, and a row 5 frames short of its longest hold), so a
+    component is redrawn inside every call; checked against torch (graph.mdn_torch_steps); inputs and outputs
+    flattened row-major, shapes beside them."""
+    session = cpu_session(onnx_path)
+    o = info["onnx"]
+    model = dance_model_from_onnx(onnx_path, o["dim"], o["styles"], o["hidden"], o["layers"])
+    rng = np.random.default_rng(5)
+    by_style = {s: [x for x in info["seeds"] if x["style"] == s] for s in info["styles"]}
+    first, second = info["styles"][0], info["styles"][-1]
+    hold = lambda style, before: max(0, info["sampling"]["params"][style]["max_hold"] - before)
+    cases = {"batch1": [{"seed": by_style[first][0], "held": 1, "age": hold(first, 10)}],
+             "batch2": [{"seed": by_style[first][1], "held": -1, "age": 0},
+                        {"seed": by_style[second][0], "held": 0, "age": hold(second, 5)}]}
+    out = {"model": info["file"], "outputs_order": MDN_OUTPUTS, "cases": {}}
+    for name, rows in cases.items():
+        feeds = mdn_case_feeds(info, rows, MDN_FIXTURE_STEPS, rng)
+        got = dict(zip(MDN_OUTPUTS, session.run(MDN_OUTPUTS, feeds)))
+        ref = mdn_torch_steps(model, feeds)
+        worst = max(float(np.abs(ref[n].astype(np.float64) - got[n]).max()) for n in MDN_OUTPUTS)
+        redraws = (ref["redraws"] - (feeds["held"] < 0)).tolist()
+        if worst > 1e-4 or redraws[-1] < 1:
+            raise SystemExit(f"error: mdn fixture case {name}: torch - onnxruntime {worst:.2e}, redraws {redraws}")
+        flat = lambda a: np.asarray(a).ravel().tolist()
+        out["cases"][name] = {
+            "batch": len(rows), "steps": MDN_FIXTURE_STEPS, "seeds": [r["seed"]["name"] for r in rows],
+            "inputs": {k: flat(v) for k, v in feeds.items()}, "input_shapes": {k: list(np.shape(v)) for k, v in feeds.items()},
+            "outputs": {k: [float(f"{x:.7g}") for x in flat(v)] if v.dtype.kind == "f" else flat(v) for k, v in got.items()},
+            "output_shapes": {k: list(v.shape) for k, v in got.items()},
+            "redraws_after_the_first": redraws, "torch_max_abs_diff": worst}
+    path.write_text(json.dumps(out) + "\n")
+    print(f"wrote {path} (torch against onnxruntime: " + ", ".join(f"{n} {c['torch_max_abs_diff']:.1e}" for n, c in out["cases"].items()) + ")")

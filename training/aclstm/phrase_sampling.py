@@ -11,13 +11,19 @@ Each rollout row holds one mixture component for a phrase and draws its frames f
     (w ← ρ·w + √(1-ρ²)·n, each w still N(0, 1)), so the draws wander smoothly instead of shaking; w runs on
     across a redraw.
 Temperature and max_hold may differ per row (per style, `PhraseParams`). Everything is seeded by one
-torch.Generator, so a rollout is reproducible.
+torch.Generator, so a rollout is reproducible: each step takes one uniform per row (torch.rand), used when the row
+redraws, then one standard normal per row and channel (torch.randn), the AR(1) innovations; `step` also takes them
+as arguments, which is how the ONNX graph is checked against it.
 
-ONNX, for the page (a later step): the step graph would output the mixture (weights after softmax (B, K), means and
-σ (B, K, D)) or take the held component as input (B,) and return its mean and σ with the weights; the hold, the
-redraw rule and the AR(1) normals would run in the page's seeded sampler, one step per call (a redraw depends on the
-weights of the step before), or in the graph with uniform randoms as inputs (cumulative weights against a uniform:
-CumSum, Less, ArgMin) and the AR(1) normals passed in as the Gaussian head's normals are today.
+The draw is by inverse CDF: with `allowed` the weights at or above the threshold (the largest weight's one-hot when
+none is), the component is the first k whose cumulative allowed weight exceeds the uniform times the total, i.e.
+the number of k whose cumulative sum is at most u · total (u in [0, 1), so some k always exceeds it). The same
+uniforms give the same draws in torch, in the ONNX graph (training/aclstm/graph.py, mdn_graph: CumSum, LessOrEqual,
+ReduceSum) and in the page.
+
+ONNX, for the page: the mdn graph runs this rule inside its Loop with the uniforms and normals as inputs, the
+sampler's state (held, age, wander) in and out, and the output filter of training/aclstm/jitter_filter.py after it
+(the filtered frames are shown, the raw draws fed back); the interface is the graph module's docstring.
 """
 from __future__ import annotations
 
@@ -42,7 +48,9 @@ class PhraseParams:
 class PhraseSampler:
     """The phrase rule over a batch of rollouts; `step` turns one frame's mixture into one frame per row."""
 
-    def __init__(self, params: list[PhraseParams], dim: int, generator: torch.Generator):
+    def __init__(self, params: list[PhraseParams], dim: int, generator: torch.Generator | None = None,
+                 wander: torch.Tensor | None = None):
+        """`wander`: the AR(1) state to start from (B, dim); default one standard normal draw per row and channel."""
         self.params = params
         self.generator = generator
         batch = len(params)
@@ -53,30 +61,46 @@ class PhraseSampler:
         self.min_hold = torch.tensor([p.min_hold for p in params])
         self.held = torch.full((batch,), -1, dtype=torch.long)
         self.age = torch.zeros(batch, dtype=torch.long)
-        self.wander = torch.randn((batch, dim), generator=generator)
+        self.wander = torch.randn((batch, dim), generator=generator) if wander is None else torch.as_tensor(wander).clone()
         self.redraws = torch.zeros(batch, dtype=torch.long)  # how many times each row drew a component
 
-    def draw_components(self, weights: torch.Tensor) -> torch.Tensor:
-        """One component per row from `weights` (B, K), among those at or above the row's threshold."""
-        allowed = weights * (weights >= self.threshold.unsqueeze(-1))
-        none = allowed.sum(-1) <= 0
-        allowed[none] = torch.nn.functional.one_hot(weights[none].argmax(-1), weights.shape[-1]).to(weights.dtype)
-        return torch.multinomial(allowed, 1, generator=self.generator)[:, 0]
+    def draw_components(self, weights: torch.Tensor, uniforms: torch.Tensor) -> torch.Tensor:
+        """One component per row from `weights` (B, K), among those at or above the row's threshold, by inverse CDF
+        of `uniforms` (B,) in [0, 1)."""
+        return inverse_cdf_draw(weights, self.threshold, uniforms)
 
-    def step(self, logits: torch.Tensor, mu: torch.Tensor, log_sigma: torch.Tensor) -> torch.Tensor:
-        """logits (B, K), mu and log_sigma (B, K, D) -> one frame per row (B, D)."""
+    def step(self, logits: torch.Tensor, mu: torch.Tensor, log_sigma: torch.Tensor,
+             uniforms: torch.Tensor | None = None, normals: torch.Tensor | None = None) -> torch.Tensor:
+        """logits (B, K), mu and log_sigma (B, K, D) -> one frame per row (B, D). `uniforms` (B,) and `normals`
+        (B, D): this step's randoms (default drawn from the generator, the uniforms first)."""
+        if uniforms is None:
+            uniforms = torch.rand(len(logits), generator=self.generator)
+        if normals is None:
+            normals = torch.randn(self.wander.shape, generator=self.generator)
         weights = torch.softmax(logits, -1)
         rows = torch.arange(len(weights))
         fresh = self.held < 0
         held_weight = weights[rows, self.held.clamp(min=0)]
         redraw = fresh | (self.age >= self.max_hold) | ((self.age >= self.min_hold) & (held_weight < self.threshold))
         if redraw.any():
-            self.held = torch.where(redraw, self.draw_components(weights), self.held)
+            self.held = torch.where(redraw, self.draw_components(weights, uniforms), self.held)
             self.age = torch.where(redraw, torch.zeros_like(self.age), self.age)
             self.redraws += redraw.long()
-        self.wander = self.rho * self.wander + torch.sqrt(1 - self.rho ** 2) * torch.randn(self.wander.shape, generator=self.generator)
+        self.wander = self.rho * self.wander + torch.sqrt(1 - self.rho ** 2) * normals
         self.age += 1
         return mu[rows, self.held] + self.temperature * torch.exp(log_sigma[rows, self.held]) * self.wander
+
+
+def inverse_cdf_draw(weights: torch.Tensor, threshold: torch.Tensor, uniforms: torch.Tensor) -> torch.Tensor:
+    """weights (B, K), threshold (B,), uniforms (B,) -> component (B,): the number of k whose cumulative allowed
+    weight is at most u · total (the first k whose cumulative share exceeds u), allowed = the weights at or above
+    the threshold, or the largest weight's one-hot where none is."""
+    allowed = weights * (weights >= threshold.unsqueeze(-1))
+    none = allowed.sum(-1, keepdim=True) <= 0
+    top = torch.nn.functional.one_hot(weights.argmax(-1), weights.shape[-1]).to(weights.dtype)
+    allowed = torch.where(none, top, allowed)
+    cumulative = torch.cumsum(allowed, -1)
+    return (cumulative <= uniforms.unsqueeze(-1) * cumulative[:, -1:]).sum(-1)
 
 
 def phrase_rollout(model, meta: dict, seed_frames: np.ndarray, styles: list[str], frames: int,

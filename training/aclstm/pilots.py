@@ -19,6 +19,7 @@ from ..models.aclstm import draw
 from ..data.dance import encode, resample_positions
 from .exporting import SEED_FRAMES, load_dance_model, pick_seeds
 from .freeze_rule import jitter_cm, judge, real_jitter_cm, real_reference
+from .jitter_filter import lowpass_rows
 from .phrase_sampling import PhraseParams, phrase_rollout
 from .report import BONE_ERROR_LIMIT, HEIGHT_BAND, per_second
 
@@ -138,27 +139,35 @@ def tuning_score(runs: list[dict], jitter_limit: float = 1.3) -> tuple:
 
 
 def tune_phrase(checkpoint: Path, grid: list[PhraseParams], frames: int = 1200, per_style: int = 3,
-                mocap: str | None = None) -> dict:
+                mocap: str | None = None, filters: dict[str, tuple[np.ndarray, np.ndarray]] | None = None) -> dict:
     """Every setting of `grid` rolled out `frames` frames from each style's tuning seeds (held-out clips, not the
-    judged windows), in one batch; per style the settings ranked by tuning_score and the best one."""
+    judged windows), in one batch; per style the settings ranked by tuning_score and the best one. With `filters`
+    (per style the output filter's b, a: training/aclstm/jitter_filter.py) each rollout is judged as shown, through
+    its style's filter (started at rest on the seed's last frame); the raw jitter is kept beside it."""
     skel, clips = load_clips(mocap)
     model, meta, _ = load_dance_model(checkpoint)
     ref, real_jitter = real_reference(clips), real_jitter_cm(clips)
     rows = [(style, p, seed) for style in STYLES for p in grid for seed in tuning_seeds(clips, style, per_style)]
     feats, _ = phrase_rollout(model, meta, np.array([r[2] for r in rows]), [r[0] for r in rows], frames, [r[1] for r in rows])
+    raw_jitter = [jitter_cm(decode(f.astype(np.float64))) / real_jitter[st] for (st, _, _), f in zip(rows, feats)]
+    if filters:
+        feats = lowpass_rows(feats, np.array([filters[st][0] for st, _, _ in rows]), np.array([filters[st][1] for st, _, _ in rows]),
+                             np.array([seed[-1] for _, _, seed in rows]))
     out = {}
     for style in STYLES:
         table = []
         for p in grid:
-            runs = [judge_rollout(f, st, skel, ref, real_jitter) for (st, q, _), f in zip(rows, feats) if st == style and q == p]
+            mine = [k for k, (st, q, _) in enumerate(rows) if st == style and q == p]
+            runs = [judge_rollout(feats[k], style, skel, ref, real_jitter) for k in mine]
             table.append({"params": p.to_json(), "score": list(tuning_score(runs)),
                           "passes": sum(r["passes"] and not r["diverged"] for r in runs), "runs": len(runs),
                           "diverged": sum(r["diverged"] for r in runs),
                           "median_ratio": float(np.median([r["median_ratio"] for r in runs])),
-                          "jitter_vs_real": max(r["jitter_vs_real"] for r in runs)})
+                          "jitter_vs_real": max(r["jitter_vs_real"] for r in runs),
+                          "jitter_raw_vs_real": max(raw_jitter[k] for k in mine)})
         table.sort(key=lambda t: tuple(t["score"]))
         out[style] = {"best": table[0]["params"], "table": table}
-    return {"frames": frames, "seeds_per_style": per_style, "fractions": TUNING_FRACTIONS, "styles": out}
+    return {"frames": frames, "seeds_per_style": per_style, "fractions": TUNING_FRACTIONS, "filtered": bool(filters), "styles": out}
 
 
 def summary_line(name: str, m: dict) -> str:
