@@ -148,16 +148,49 @@ def test_the_mdn_graph_reads_back_into_the_same_network(tiny_mdn):
     assert max(float(np.abs(a[n] - b[n]).max()) for n in MDN_OUTPUTS) < 1e-5
 
 
-def test_the_exported_mdn_model_runs_as_the_page_runs_it(tiny_mdn, tmp_path):
-    model, path = tiny_mdn
-    filters = {s: butterworth_lowpass(f, 30.0) for s, f in (("salsa", 8.0), ("indian", 6.0), ("martial", 10.0))}
+FILTERS = {s: butterworth_lowpass(f, 30.0) for s, f in (("salsa", 8.0), ("indian", 6.0), ("martial", 10.0))}
+
+
+def tiny_export(path, folder):
+    """The tiny graph with the JSON fields the mdn export writes that the runner and the fixture read."""
+    rng = np.random.default_rng(1)
     info = {"file": path.name, "styles": ["salsa", "indian", "martial"], "head": "mdn", "components": 4,
             "normalisation": {"mean": [0.1] * 6, "std": [2.0] * 6},
-            "onnx": {"layers": 2, "hidden": 16, "inputs": [i.name for i in onnx.load(str(path)).graph.input], "outputs": MDN_OUTPUTS},
-            "sampling": {"params": {s: PhraseParams(0.5, 10, 0.9, 0.05, 2).to_json() for s in filters},
-                         "filter": {s: {"cutoff_hz": 0, "b": b.tolist(), "a": a.tolist()} for s, (b, a) in filters.items()}}}
-    (tmp_path / path.name).write_bytes(path.read_bytes())
-    (tmp_path / "tiny-mdn.json").write_text(json.dumps(info))
+            "onnx": {"layers": 2, "hidden": 16, "dim": 6, "styles": 3, "inputs": [i.name for i in onnx.load(str(path)).graph.input],
+                     "outputs": MDN_OUTPUTS},
+            "seeds": [{"style": s, "name": f"{s} {k}", "frames": rng.normal(size=(10, 6)).tolist()}
+                      for s in ("salsa", "indian", "martial") for k in range(2)],
+            "sampling": {"params": {s: PhraseParams(0.5, 10 + 5 * k, 0.9, 0.05, 2).to_json() for k, s in enumerate(FILTERS)},
+                         "filter": {s: {"cutoff_hz": 0, "b": b.tolist(), "a": a.tolist()} for s, (b, a) in FILTERS.items()}}}
+    (folder / path.name).write_bytes(path.read_bytes())
+    (folder / "tiny-mdn.json").write_text(json.dumps(info))
+    return info
+
+
+def test_the_mdn_fixture_holds_a_redraw_in_every_call(tiny_mdn, tmp_path):
+    from training.aclstm.exporting import MDN_FIXTURE_STEPS, write_mdn_reference_fixture
+
+    _, path = tiny_mdn
+    info = tiny_export(path, tmp_path)
+    write_mdn_reference_fixture(tmp_path / path.name, info, tmp_path / "fixture.json")
+    fixture = json.loads((tmp_path / "fixture.json").read_text())
+    session = cpu_session(tmp_path / path.name)
+    for name, batch in (("batch1", 1), ("batch2", 2)):
+        case = fixture["cases"][name]
+        assert case["batch"] == batch and case["steps"] == MDN_FIXTURE_STEPS >= 40 and case["redraws_after_the_first"][-1] >= 1
+        feeds = {k: np.array(v, np.int64 if k in ("steps", "held", "age", "max_hold", "min_hold") else np.float32).reshape(case["input_shapes"][k])
+                 for k, v in case["inputs"].items()}
+        got = dict(zip(MDN_OUTPUTS, session.run(MDN_OUTPUTS, feeds)))  # the listed inputs are exactly what gave the outputs
+        for k in MDN_OUTPUTS:
+            assert list(got[k].shape) == case["output_shapes"][k]
+            assert np.abs(got[k].ravel() - np.array(case["outputs"][k])).max() < 1e-5
+    assert fixture["cases"]["batch2"]["inputs"]["held"] == [-1, 0]
+
+
+def test_the_exported_mdn_model_runs_as_the_page_runs_it(tiny_mdn, tmp_path):
+    model, path = tiny_mdn
+    filters = FILTERS
+    tiny_export(path, tmp_path)
     dance = ShippedDance(tmp_path, "tiny-mdn")
     seeds = np.random.default_rng(0).normal(size=(3, 10, 6)).astype(np.float32)
     styles = ["salsa", "indian", "martial"]
@@ -171,3 +204,24 @@ def test_the_exported_mdn_model_runs_as_the_page_runs_it(tiny_mdn, tmp_path):
         assert np.abs(lowpass(drawn[r], *filters[s], initial=seeds[r, -1]) - shown[r]).max() < 1e-4
     # generate() of an mdn model gives the shown frames
     assert np.abs(dance.generate(seeds, styles, 70, seed=5) - shown9).max() < 1e-6
+
+
+def test_the_mdn_reports_deterministic_prediction_is_the_most_likely_components_mean(tiny_mdn, tmp_path):
+    from training.aclstm.report import MDN_MODE
+
+    model, path = tiny_mdn
+    tiny_export(path, tmp_path)
+    dance = ShippedDance(tmp_path, "tiny-mdn")
+    seeds = np.random.default_rng(2).normal(size=(2, 10, 6)).astype(np.float32)
+    a = dance.generate_mdn(seeds, ["salsa", "martial"], 20, seed=1, override=MDN_MODE)[1]
+    b = dance.generate_mdn(seeds, ["salsa", "martial"], 20, seed=2, override=MDN_MODE)[1]
+    assert np.array_equal(a, b)
+    # torch: each frame the argmax component's mean, fed back
+    style = torch.eye(3)[[0, 2]]
+    x = torch.from_numpy((seeds - 0.1) / 2.0)
+    with torch.no_grad():
+        logits, mu, _, state = model.mixture(x, style)
+        for t in range(20):
+            y = mu[torch.arange(2), -1, logits[:, -1].argmax(-1)]
+            assert np.abs(y.numpy() * 2.0 + 0.1 - a[:, t]).max() < 1e-4
+            logits, mu, _, state = model.mixture(y[:, None], style, state)
