@@ -225,3 +225,15 @@ def test_the_mdn_reports_deterministic_prediction_is_the_most_likely_components_
             y = mu[torch.arange(2), -1, logits[:, -1].argmax(-1)]
             assert np.abs(y.numpy() * 2.0 + 0.1 - a[:, t]).max() < 1e-4
             logits, mu, _, state = model.mixture(y[:, None], style, state)
+
+
+def test_evaluate_adds_a_row_only_when_measured_as_the_stored_report():
+    import subprocess
+    import sys
+
+    from training.paths import REPO_ROOT
+
+    stored = json.loads((REPO_ROOT / "docs" / "models" / "aclstm.json").read_text())
+    done = subprocess.run([sys.executable, "-m", "training.aclstm.evaluate", "--add", "x=/nonexistent/aclstm-mdn.json",
+                           "--frames", str(stored["frames_per_seed"] + 1)], cwd=REPO_ROOT, capture_output=True, text=True, timeout=120)
+    assert done.returncode != 0 and f"--frames {stored['frames_per_seed']}" in done.stderr

@@ -139,21 +139,46 @@ def evaluate_dance(models_dir: Path, frames: int, n_seeds: int, mocap: str | Non
         if not json_path.exists():
             print(f"skipping {label}: no {json_path}")
             continue
-        model_id = json_path.stem
-        model = ShippedDance(json_path.parent, model_id)
-        runs = long_runs(model, skel, frames, n_seeds, real_change, real_ref, real_jitter)
-        report["models"][label] = {
-            "id": model_id, "file": model.info["file"], "bytes": model.info["bytes"], "fps": model.info["fps"],
-            "shipped": json_path.parent.resolve() == models_dir.resolve(),
-            "training": {k: model.info["training"][k] for k in ("iterations", "valid")},
-            "scheme": model.info["training"]["args"],
-            "minutes": model.info["training"].get("minutes"), "temperature": model.info.get("temperature"),
-            **({"head": "mdn", "components": model.info["components"],
-                "sampling": {k: model.info["sampling"][k] for k in ("params", "filter")}} if model.mdn else {}),
-            "runs": runs, "all_stable": all(r["stable"] for r in runs),
-            "all_pass_rule": all(r["rule"]["passes"] and not r["diverged"] for r in runs),
-            "prediction_error_cm": prediction_errors(model, clips),
-        }
+        report["models"][label] = measure_model(json_path, models_dir, skel, clips, frames, n_seeds, real_change, real_ref, real_jitter)
+    return report
+
+
+def measure_model(json_path: Path, models_dir: Path, skel, clips, frames: int, n_seeds: int, real_change: dict,
+                  real_ref: dict, real_jitter: dict) -> dict:
+    """One exported model's row: its long runs and prediction errors, and what the report says of its training."""
+    model_id = json_path.stem
+    model = ShippedDance(json_path.parent, model_id)
+    runs = long_runs(model, skel, frames, n_seeds, real_change, real_ref, real_jitter)
+    return {
+        "id": model_id, "file": model.info["file"], "bytes": model.info["bytes"], "fps": model.info["fps"],
+        "shipped": json_path.parent.resolve() == models_dir.resolve(),
+        "training": {k: model.info["training"][k] for k in ("iterations", "valid")},
+        "scheme": model.info["training"]["args"],
+        "minutes": model.info["training"].get("minutes"), "temperature": model.info.get("temperature"),
+        **({"head": "mdn", "components": model.info["components"],
+            "sampling": {k: model.info["sampling"][k] for k in ("params", "filter")}} if model.mdn else {}),
+        "runs": runs, "all_stable": all(r["stable"] for r in runs),
+        "all_pass_rule": all(r["rule"]["passes"] and not r["diverged"] for r in runs),
+        "prediction_error_cm": prediction_errors(model, clips),
+    }
+
+
+def add_to_dance_report(frames: int, n_seeds: int, mocap: str | None, models_dir: Path, rows: list[tuple[str, Path]]) -> dict:
+    """Measures only `rows` (label, path/to/model.json) and adds them to the stored aclstm.json (a row of the same
+    label replaced), every other row kept as stored; aclstm.md written again. The stored runs keep no pose-change
+    curves, so aclstm.png is left as it is. Refuses another run length or seed count than the stored report's."""
+    report = read_report()
+    if (frames, n_seeds) != (report["frames_per_seed"], report["seeds_per_style"]):
+        raise SystemExit(f"error: the stored report has {report['frames_per_seed']} frames x {report['seeds_per_style']} seeds "
+                         f"per style; add rows measured the same way (--frames {report['frames_per_seed']} --seeds "
+                         f"{report['seeds_per_style']})")
+    skel, clips = load_clips(mocap)
+    real_change, real_ref, real_jitter = real_pose_change(clips), real_reference(clips), real_jitter_cm(clips)
+    for label, json_path in rows:
+        if not json_path.exists():
+            raise SystemExit(f"error: no {json_path}")
+        report["models"][label] = measure_model(json_path, models_dir, skel, clips, frames, n_seeds, real_change, real_ref, real_jitter)
+    _write_report(report, figure=False)
     return report
 
 
@@ -215,7 +240,7 @@ def fair_rule_section(report: dict) -> list[str]:
                          + ", ".join(f"{r['rule']['low_share']:.1%}" for r in rs) + " | "
                          + ", ".join(str(r["rule"]["longest_low_s"]) for r in rs) + " | "
                          + ", ".join(f"{r['rule']['median_ratio']:.0%}" for r in rs) + " | "
-                         + ", ".join(f"{r['jitter_vs_real']:.1f}×" + (f" ({r['jitter_raw_vs_real']:.1f}× raw)" if "jitter_raw_vs_real" in r else "")
+                         + ", ".join(f"{r['jitter_vs_real']:.2f}×" + (f" ({r['jitter_raw_vs_real']:.2f}× raw)" if "jitter_raw_vs_real" in r else "")
                                      for r in rs) + " |")
     if any("before int8" in label for label in report["models"]):
         lines += ["", "**Weights stored as int8** (issue 19, [weights.md](weights.md)): the shipped files store the weights as int8 "
@@ -397,11 +422,17 @@ def write_dance_report(frames: int, n_seeds: int, mocap: str | None, models_dir:
     but not shipped."""
     REPORTS_DIR.mkdir(parents=True, exist_ok=True)
     report = evaluate_dance(models_dir, frames, n_seeds, mocap, extra)
-    plot(report)
+    _write_report(report)
+    return report
+
+
+def _write_report(report: dict, figure: bool = True) -> None:
+    """aclstm.json (the runs without their curves), aclstm.md and, with `figure`, aclstm.png."""
+    if figure:
+        plot(report)
     slim = json.loads(json.dumps(report))
     for m in slim["models"].values():
         for r in m["runs"]:
-            r.pop("pose_change_curve")
+            r.pop("pose_change_curve", None)
     REPORT_JSON.write_text(json.dumps(slim, indent=1) + "\n")
     REPORT_MD.write_text(aclstm_markdown(report))
-    return report
