@@ -587,8 +587,10 @@ export function createPlayground(app: App): Playground {
         await ready;
         const { info, descriptor } = controlModel(app.registry, 'followPath', (options as { model?: unknown }).model);
         const follow = descriptor.followPath!;
-        const o = checkKeys(options, [...FOLLOW_PATH_COMMON.slice(0, 5), ...follow.options, ...FOLLOW_PATH_COMMON.slice(5)], FOLLOW_PATH_SHAPE);
-        const style = checkStyleOption(o.style, info);
+        // style: refused with its reason for a model without styles, and known only to a model with them.
+        const style = checkStyleOption((options as { style?: unknown }).style, info);
+        const common = info.styles?.length ? FOLLOW_PATH_COMMON : FOLLOW_PATH_COMMON.filter((k) => k !== 'style');
+        const o = checkKeys(options, [...common.slice(0, common.indexOf('footLock')), ...follow.options, ...common.slice(common.indexOf('footLock'))], FOLLOW_PATH_SHAPE);
         // Checked here too (the worker checks again), so bad input fails fast and without a worker prefix.
         const points = checkPathPoints(o.points);
         GroundPath.fromPoints(points);
