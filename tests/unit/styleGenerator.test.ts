@@ -63,6 +63,16 @@ describe('a style generator', () => {
     expect(bad((j) => (j.seeds[0].style = 'jazzy'))).toThrow(/seeds\[0\]\.style must be one of the styles/);
     expect(bad((j) => (j.seeds = j.seeds.filter((s: { style: string }) => s.style !== 'elderly')))).toThrow(/no seed state of style "elderly"/);
     expect(bad((j) => (j.licence = 3))).toThrow(/licence must be a non-empty string/);
+    expect(bad((j) => (j.held_out_sliding = { cmu: 0.26, jazzy: 0.5 }))).toThrow(/held_out_sliding names "jazzy", which is not one of styles/);
+    expect(bad((j) => (j.held_out_sliding = { cmu: -1 }))).toThrow(/held_out_sliding\.cmu must be a finite number ≥ 0/);
+  });
+
+  it("gives each style's held-out sliding to the page's readout when the JSON has it", async () => {
+    const withSliding = parseGeneratorInfo({ ...structuredClone(raw), held_out_sliding: { cmu: 0.26, elderly: 0.63 } }, 'style-tiny.json');
+    const other = new GeneratorCore(await ort.InferenceSession.create(readFileSync(`${REPO_ROOT}${DIR}${info.file}`)), withSliding, ort.Tensor);
+    expect(other.describe(0).heldOutSlidingByStyle).toEqual({ cmu: 0.26, elderly: 0.63 });
+    expect(core.describe(0).heldOutSlidingByStyle).toBeUndefined();
+    await other.release();
   });
 
   it('makes style vectors: one-hots by name, the first by default, checked blends', () => {

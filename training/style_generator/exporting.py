@@ -12,8 +12,10 @@ import numpy as np
 import onnx
 import torch
 
+from .. import metrics
 from ..data.bandai import CONTENTS
 from ..data.features import FIXED_JOINTS, FeatureCodec, feature_names
+from ..data.locomotion import is_validation
 from ..data.style_locomotion import CMU_STYLE, StyledClip
 from ..generator.exporting import estimate_initial_state, pick_seeds, sampling_info
 from ..mocap.rotations import matrix_to_quat
@@ -156,6 +158,18 @@ def reference_step(onnx_path: Path, info: dict) -> dict:
             "outputs": {name: np.asarray(o).ravel().tolist() for name, o in zip(OUTPUTS, outs)}}
 
 
+def held_out_sliding(clips: list[StyledClip], styles: list[str], codec: FeatureCodec) -> dict[str, float]:
+    """Per style, the foot sliding of its real held-out clips (m/s): the speed of the lowest foot point within 4 cm of
+    the floor (metrics.low_foot_sliding_clips), each clip measured on its own: the page's readout reference."""
+    skel = canonical_skeleton()
+    out = {}
+    for style in styles:
+        positions = [codec.positions(codec.encode(c.clip.root, c.clip.rotations, c.clip.contacts))
+                     for c in clips if c.style == style and is_validation(c.clip)]
+        out[style] = round(metrics.low_foot_sliding_clips(positions, 30.0, skel), 4)
+    return out
+
+
 def export_style_generator(model: MixtureLSTM, meta: dict, state: dict, clips: list[StyledClip], out: Path,
                            model_id: str = "style-generator", weights: str = "int8") -> tuple[Path, dict]:
     """Writes out/<id>.onnx and out/<id>.json, and into MODELS_DIR the manifest entry; returns the ONNX path and the JSON."""
@@ -166,6 +180,7 @@ def export_style_generator(model: MixtureLSTM, meta: dict, state: dict, clips: l
     styles = list(meta["styles"])
     frames = style_seed_frames(clips, styles, set(meta["valid_files"]), codec, np.array(meta["mean"]), np.array(meta["std"]))
     info = style_info(model_id, model, meta, state, onnx_path, estimated_style_seeds(model, frames, styles), parity)
+    info["held_out_sliding"] = held_out_sliding(clips, styles, codec)
     (out / f"{model_id}.json").write_text(json.dumps(info) + "\n")
     if out.resolve() == MODELS_DIR.resolve():  # shipping: the page lists it (non-commercial, labelled so in the pickers)
         register_model({"id": model_id, "kind": info["kind"], "skeleton": "cmu-canonical", "fps": info["fps"],

@@ -21,6 +21,8 @@ export interface GeneratorInfo {
   styles?: string[];
   /** The terms the model comes under (a style generator: CC BY-NC 4.0, non-commercial) and what it was trained on. */
   licence?: string;
+  /** With `styles`: each style's real held-out foot sliding (lowest foot point, m/s), the readout's reference. */
+  held_out_sliding?: Record<string, number>;
   data?: string;
   description?: string;
   skeleton: {
@@ -159,6 +161,14 @@ const format = modelInfoFormat<GeneratorInfo>('GeneratorInfoError', 'generator.j
     if (styles.length === 0) fail('styles must name at least one style');
     if (new Set(styles).size !== styles.length) fail(`styles has a name twice: [${styles}]`);
     styleCount = styles.length;
+  }
+  if (root.held_out_sliding !== undefined) {
+    const sliding = obj(root.held_out_sliding, 'held_out_sliding');
+    const styles = (root.styles as string[] | undefined) ?? [];
+    for (const [style, v] of Object.entries(sliding)) {
+      if (!styles.includes(style)) fail(`held_out_sliding names "${style}", which is not one of styles`);
+      if (typeof v !== 'number' || !Number.isFinite(v) || v < 0) fail(`held_out_sliding.${style} must be a finite number ≥ 0, got ${String(v)}`);
+    }
   }
   for (const key of ['licence', 'data'] as const) {
     if (root[key] !== undefined && (typeof root[key] !== 'string' || !(root[key] as string).trim())) fail(`${key} must be a non-empty string`);

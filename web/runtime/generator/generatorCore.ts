@@ -95,6 +95,7 @@ export class GeneratorCore extends SessionCore<GeneratorInfo> {
       seeds: info.seeds.map((s) => s.name),
       ...(info.styles ? { styles: [...info.styles] } : {}),
       ...(info.licence ? { licence: info.licence } : {}),
+      ...(info.held_out_sliding ? { heldOutSlidingByStyle: { ...info.held_out_sliding } } : {}),
       ...(typeof info.pack?.measures?.real?.sliding_low_foot === 'number' ? { heldOutSliding: info.pack.measures.real.sliding_low_foot } : {}),
     };
   }

@@ -24,6 +24,8 @@ export interface InitResult extends ModelInit {
   seeds: string[];
   /** The real held-out clips' foot sliding (lowest foot point, m/s) a user's pack measured on its card; absent for shipped models. */
   heldOutSliding?: number;
+  /** A style generator's real held-out foot sliding per style (m/s), where its JSON gives it. */
+  heldOutSlidingByStyle?: Record<string, number>;
   /** A style generator's style names (the first is the default) and its licence; absent for a generator without styles. */
   styles?: string[];
   licence?: string;

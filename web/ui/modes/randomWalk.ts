@@ -6,6 +6,7 @@
 import { lowFootSample } from '../../motion/footSkating';
 import type { Motion } from '../../motion/types';
 import { GeneratorClient, type GeneratedMotion } from '../../runtime/generator/generatorClient';
+import type { InitResult } from '../../runtime/generator/protocol';
 import { CompanionAligner } from '../../viewer/sideBySide';
 import type { Registry } from '../../runtime/registry';
 import { $, changeTo, readSeed } from '../dom';
@@ -39,6 +40,8 @@ export class RandomWalk extends LiveMode<WalkChunk> {
   /** The running stream refines (fixed per stream, like the other settings). */
   private refining = false;
   private raw: RawWindow | null = null;
+  /** The running model's sliding references (InitResult's), for the readout. */
+  private slidingReference: Pick<InitResult, 'heldOutSliding' | 'heldOutSlidingByStyle'> | null = null;
   private aligner: CompanionAligner | null = null;
   private walkSkeleton: { fps: number; joints: string[]; parents: number[] } | null = null;
 
@@ -142,6 +145,20 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     return '';
   }
 
+  /**
+   * The readout's reference: the CMU held-out walks for the shipped models, a style generator's held-out walks of the
+   * running style, a pack's own held-out clips (its card).
+   */
+  private showSlidingReference(): void {
+    const info = this.slidingReference;
+    if (!info) return;
+    const styled = this.streamStyle ? info.heldOutSlidingByStyle?.[this.streamStyle] : undefined;
+    this.skatingReference.textContent =
+      info.heldOutSliding !== undefined ? `your held-out clips: ${info.heldOutSliding.toFixed(2)} m/s`
+      : styled !== undefined ? `real held-out ${this.streamStyle} walks: ${styled.toFixed(2)} m/s`
+      : CMU_HELD_OUT_SLIDING;
+  }
+
   /** A new style for the running walk: its stream blends into it over about a second from its next frame. */
   private switchStyle(): void {
     const running = this.client;
@@ -149,6 +166,7 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     const style = this.style.for(this.app.stylesOf(running.id));
     if (!style || style === this.streamStyle) return;
     this.streamStyle = style;
+    this.showSlidingReference();
     running.client.switchStyle(style).catch((e: unknown) => this.app.reportError(`Random walk: ${e instanceof Error ? e.message : String(e)}`));
     this.updateStatus(true);
   }
@@ -210,8 +228,8 @@ export class RandomWalk extends LiveMode<WalkChunk> {
     this.raw = null;
     this.aligner = params.refine ? new CompanionAligner(info.joints.length, info.fps) : null;
     const name = registry.shortName(id);
-    // The readout's reference: the CMU held-out walks for the shipped models, a pack's own held-out clips (its card).
-    this.skatingReference.textContent = info.heldOutSliding === undefined ? CMU_HELD_OUT_SLIDING : `your held-out clips: ${info.heldOutSliding.toFixed(2)} m/s`;
+    this.slidingReference = info;
+    this.showSlidingReference();
     this.app.setLiveLabel('Random walk', params.refine ? `${name} + refiner · 30 fps · live` : `${name} · 30 fps · live`);
     const pull = async (frames: number): Promise<WalkChunk> => {
       const m = await client.pull(frames, { signal });
