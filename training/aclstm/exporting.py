@@ -211,13 +211,13 @@ def rewrite_dance_model(source: Path, model_id: str, out: Path, weights: str) ->
 def mdn_sampling(checkpoint: Path, clips: list[DanceClip], mocap: str | None, tune_frames: int = 1200) -> dict:
     """The JSON's `sampling` block of an mdn model: the output filter per style (jitter_filter.style_filters: the cutoff
     below which 99% of the style's training clips' velocity power lies), then the phrase parameters per style chosen
-    by pilots.tune_phrase on held-out tuning windows (never the judged seeds), the rollouts judged through the filter
-    as the page shows them."""
+    by pilots.tune_phrase on held-out tuning windows (never the judged seeds) from tuning_grid with the AR(1)
+    coefficients EXPORT_RHOS, the rollouts judged through the filter as the page shows them."""
     from .jitter_filter import style_filters
-    from .pilots import tune_phrase, tuning_grid
+    from .pilots import EXPORT_RHOS, tune_phrase, tuning_grid
 
     filters = style_filters(clips)
-    tuned = tune_phrase(checkpoint, tuning_grid(), tune_frames, mocap=mocap,
+    tuned = tune_phrase(checkpoint, tuning_grid(rhos=EXPORT_RHOS), tune_frames, mocap=mocap,
                         filters={s: (np.array(f["b"]), np.array(f["a"])) for s, f in filters.items()})
     for style, v in tuned["styles"].items():
         row = v["table"][0]
