@@ -6,7 +6,8 @@
 
 The shipped models (report.MODELS: acLSTM, vanilla and, once exported into public/models, the mdn model `aclstm-mdn`)
 are measured on every run; --also adds a model that is not shipped. --add measures only the models it names and adds
-them to the stored aclstm.json beside its other rows (same --frames and --seeds; aclstm.png is not redrawn).
+them to the stored aclstm.json beside its other rows (same --frames and --seeds; aclstm.png is not redrawn, and each
+added model gets its own figure, aclstm-<id>.png: its runs against the real held-out seconds' band).
 
 What is measured: training/aclstm/report.py.
 """

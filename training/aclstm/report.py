@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import metrics
-from ..data.dance import (LIMB_MIN_LENGTH, MODEL_FPS, STYLES, DanceClip, bone_length_error, decode, encode, load_clips,
-                          real_pose_change, resample_positions)
+from ..data.dance import (LIMB_MIN_LENGTH, MODEL_FPS, STYLES, DanceClip, bone_length_error, decode, encode,
+                          held_out_pose_change, load_clips, real_pose_change, resample_positions)
 from ..paths import REPORTS_DIR
 from .freeze_rule import LONGEST_LOW_S, MEDIAN_FRACTION, SHARE_FACTOR, jitter_cm, judge, real_jitter_cm, real_reference
 from .shipped import ShippedDance
@@ -178,8 +178,35 @@ def add_to_dance_report(frames: int, n_seeds: int, mocap: str | None, models_dir
         if not json_path.exists():
             raise SystemExit(f"error: no {json_path}")
         report["models"][label] = measure_model(json_path, models_dir, skel, clips, frames, n_seeds, real_change, real_ref, real_jitter)
+        plot_against_real(report["models"][label], label, clips, REPORTS_DIR / f"aclstm-{report['models'][label]['id']}.png")
     _write_report(report, figure=False)
     return report
+
+
+def plot_against_real(model: dict, label: str, clips: list[DanceClip], path: Path) -> None:
+    """One model's long runs, pose change per second for each style, against the band the real held-out clips' seconds
+    span (10th to 90th percentile, and their median) and the freeze line."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(STYLES), figsize=(16, 4))
+    for ax, style in zip(axes, STYLES):
+        real = np.concatenate(held_out_pose_change(clips, style))
+        lo, mid, hi = np.percentile(real, [10, 50, 90])
+        runs = [r for r in model["runs"] if r["style"] == style]
+        seconds = max((len(r.get("pose_change_curve", [])) for r in runs), default=1)
+        ax.fill_between([0, seconds], lo, hi, color="0.85", label="real held-out seconds, 10-90%")
+        ax.axhline(mid, color="k", lw=1, label="real median")
+        ax.axhline(FREEZE_FRACTION * mid, color="k", ls="--", lw=1, label="freeze line (20% of the median)")
+        for k, run in enumerate(runs):
+            ax.plot(run.get("pose_change_curve", []), lw=0.5, alpha=0.8, color=f"C{k}", label=f"seed {run['seed']}")
+        ax.set(title=f"{label}, {style}: pose change per second", xlabel="second of generation", ylabel="m/s",
+               ylim=(0, 1.5 * max(hi, max((max(r.get('pose_change_curve', [0])) for r in runs), default=hi))))
+        ax.legend(fontsize=6, loc="upper right")
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
 
 
 NOTES = REPORTS_DIR / "aclstm-notes.json"
