@@ -1,0 +1,94 @@
+// A dance model judged through the page (issue 42): `generate` of --frames frames per style and seed in headless
+// Chromium through the public API, each run judged by the fair freeze rule of training/aclstm/freeze_rule.py against
+// the real held-out clips' reference stored in docs/models/aclstm.json (real_reference: median, share of low seconds),
+// with jitter against the real clips' (real_jitter_cm there), all on what the page gives: the drawn frames (for a
+// sampled model, through its output filter), fitted to the skeleton, feet planted.
+//
+//   node scripts/evaluate-dance.mjs [--model aclstm-mdn] [--frames 20000] [--seeds 5] [--out FILE.json]
+//
+// Rule, as freeze_rule.py states it: a second is low below 20% of the style's real median pose change; a run passes
+// when (a) its share of low seconds is at most twice the real share, (b) no low stretch lasts 5 s, and (c) its median
+// is at least half the real median. Jitter: mean |second difference| of the joints relative to the root (cm).
+// Seeds 0..N-1 (not chosen by result); a link with the same model, style and seed shows the same dance.
+import { readFileSync, writeFileSync } from 'node:fs';
+import path from 'node:path';
+import { launchBrowser, openPlayground, ROOT, startServer } from '../tests/support/browser.mjs';
+
+const args = process.argv.slice(2);
+const option = (name, fallback) => (args.includes(name) ? args[args.indexOf(name) + 1] : fallback);
+const MODEL = option('--model', 'aclstm-mdn');
+const FRAMES = Number(option('--frames', 20000));
+const SEEDS = Number(option('--seeds', 5));
+const OUT = option('--out', null);
+const LOW_FRACTION = 0.2, SHARE_FACTOR = 2, LONGEST_LOW_S = 5, MEDIAN_FRACTION = 0.5;
+
+const stored = JSON.parse(readFileSync(path.join(ROOT, 'docs/models/aclstm.json'), 'utf8'));
+const fmt = (v, d = 2) => (Number.isFinite(v) ? v.toFixed(d) : String(v));
+
+function judge(seconds, ref) {
+  const low = seconds.map((v) => v < LOW_FRACTION * ref.median);
+  let longest = 0;
+  for (let k = 0, run = 0; k < low.length; k++) longest = Math.max(longest, (run = low[k] ? run + 1 : 0));
+  const share = low.filter(Boolean).length / low.length;
+  const sorted = [...seconds].sort((a, b) => a - b);
+  const ratio = sorted[Math.floor(sorted.length / 2)] / ref.median;
+  const verdict = { a: share <= SHARE_FACTOR * ref.low_share, b: longest < LONGEST_LOW_S, c: ratio >= MEDIAN_FRACTION };
+  return { lowShare: share, longestLowS: longest, medianRatio: ratio, ...verdict, passes: verdict.a && verdict.b && verdict.c };
+}
+
+async function main() {
+  const report = { date: new Date().toISOString().slice(0, 10), model: MODEL, frames: FRAMES, seeds: SEEDS, runs: [] };
+  const { server, url } = await startServer();
+  const browser = await launchBrowser();
+  try {
+    const { page } = await openPlayground(browser, url);
+    const info = await page.evaluate((id) => window.playground.models().find((m) => m.id === id), MODEL);
+    if (!info) throw new Error(`${MODEL} is not listed in public/models/index.json`);
+    for (const style of info.styles) {
+      const ref = stored.real_reference[style];
+      const realJitter = stored.real_jitter_cm[style];
+      for (let seed = 0; seed < SEEDS; seed++) {
+        const r = await page.evaluate(async ({ model, style, frames, seed }) => {
+          const t = performance.now();
+          const m = await window.playground.generate({ model, style, frames, seed });
+          const ms = performance.now() - t;
+          const { poseChangePerSecond } = await import('/motion/poseChange.ts');
+          const J = m.joints.length, p = m.positions;
+          let jitter = 0, n = 0, rootMin = Infinity, rootMax = -Infinity;
+          for (let f = 0; f < m.frames; f++) {
+            rootMin = Math.min(rootMin, p[f * J * 3 + 1]);
+            rootMax = Math.max(rootMax, p[f * J * 3 + 1]);
+          }
+          for (let f = 2; f < m.frames; f++) {
+            for (let j = 0; j < J; j++) {
+              let sq = 0;
+              for (let a = 0; a < 3; a++) {
+                const local = (g) => p[(g * J + j) * 3 + a] - p[g * J * 3 + a];
+                const d = local(f) - 2 * local(f - 1) + local(f - 2);
+                sq += d * d;
+              }
+              jitter += Math.sqrt(sq);
+              n++;
+            }
+          }
+          return { ms, frames: m.frames, finite: p.every(Number.isFinite), seconds: poseChangePerSecond(p, J, m.fps), jitterCm: (100 * jitter) / n, rootHeight: [rootMin, rootMax] };
+        }, { model: MODEL, style, frames: FRAMES, seed });
+        const verdict = judge(r.seconds, ref);
+        const row = { style, seed, frames: r.frames, finite: r.finite, generateSeconds: r.ms / 1000, rootHeight: r.rootHeight, jitterVsReal: r.jitterCm / realJitter, ...verdict };
+        report.runs.push(row);
+        console.log(`${MODEL} ${style} seed ${seed}: ${r.frames} frames in ${fmt(row.generateSeconds, 0)} s, finite ${r.finite}, root ${fmt(r.rootHeight[0])}-${fmt(r.rootHeight[1])} m; low seconds ${fmt(100 * verdict.lowShare, 1)}% (real ${fmt(100 * ref.low_share, 1)}%), longest low ${verdict.longestLowS} s, median ${fmt(verdict.medianRatio)}x real; jitter ${fmt(row.jitterVsReal)}x real; ${verdict.passes ? 'passes' : `FAILS (${['a', 'b', 'c'].filter((k) => !verdict[k]).join(', ')})`}`);
+      }
+    }
+    const passed = report.runs.filter((r) => r.passes && r.finite).length;
+    console.log(`${MODEL}: ${passed}/${report.runs.length} runs pass the fair rule through the page; jitter ${fmt(Math.min(...report.runs.map((r) => r.jitterVsReal)))}-${fmt(Math.max(...report.runs.map((r) => r.jitterVsReal)))}x real`);
+  } finally {
+    await browser.close();
+    await server.close();
+    if (OUT) writeFileSync(OUT, JSON.stringify(report, null, 1) + '\n');
+  }
+}
+
+main().catch((err) => {
+  console.error(err);
+  process.exit(1);
+});
