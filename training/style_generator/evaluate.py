@@ -27,6 +27,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--frames", type=int, default=10_000, help="frames per long run")
     parser.add_argument("--pilot-frames", type=int, default=3000, help="frames per seed and stream set of the two-sample test")
     parser.add_argument("--classifier-seeds", type=int, default=3)
+    parser.add_argument("--steps", type=int, default=None, help="two-sample classifier training steps (default the report's 1,500)")
+    parser.add_argument("--styles", default=",".join(STYLES), help="styles of the two-sample test (all by default)")
     parser.add_argument("--out", type=Path, default=REPORTS_DIR / "style-generator-full.json")
     parser.add_argument("--mocap", default=None)
     parser.add_argument("--threads", type=int, default=1)
@@ -37,11 +39,15 @@ def main(argv: list[str] | None = None) -> None:
     shipped, style = shipped_candidate(), style_candidate(args.checkpoint)
     clips = load_styled_clips(args.mocap)
     result = {"checkpoint": str(args.checkpoint), "date": datetime.date.today().isoformat()}
+    save = lambda: args.out.write_text(json.dumps(result, indent=1) + "\n")  # after each part: nothing measured is lost
     result["long_runs"] = long_runs(style, clips, list(STYLES), args.frames)
+    save()
     result["style_check"] = style_check(style, clips)
-    result["pilot"] = measure([shipped, style], {shipped.name: ["cmu"], style.name: list(STYLES)}, args.pilot_frames,
-                              mocap=args.mocap, classifier_seeds=args.classifier_seeds)
-    args.out.write_text(json.dumps(result, indent=1) + "\n")
+    save()
+    styles = [s for s in args.styles.split(",") if s]
+    result["pilot"] = measure([shipped, style], {shipped.name: ["cmu"], style.name: styles}, args.pilot_frames,
+                              steps=args.steps, mocap=args.mocap, classifier_seeds=args.classifier_seeds)
+    save()
     args.out.with_suffix(".md").write_text(report_markdown(result))
     print(f"wrote {args.out} and {args.out.with_suffix('.md')}")
 
