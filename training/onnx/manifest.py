@@ -24,9 +24,13 @@ TRAINED_ON = {
 
 def register_model(entry: dict, trained_on: str, manifest: Path = MANIFEST) -> None:
     """Add or replace the entry with the same id: {id, kind, skeleton, fps, styles?, bytes, file}, with the data and
-    licence of TRAINED_ON[trained_on]."""
+    licence of TRAINED_ON[trained_on]. The manifest's order is the page's (the first model listed with a capability is
+    its default, web/runtime/registry.ts): a replaced entry keeps its place, a new one goes last."""
     entry = {**entry, **TRAINED_ON[trained_on]}
     data = json.loads(manifest.read_text()) if manifest.exists() else {"models": []}
-    models = [m for m in data["models"] if m["id"] != entry["id"]] + [entry]
-    data["models"] = sorted(models, key=lambda m: m["id"])
+    ids = [m["id"] for m in data["models"]]
+    if entry["id"] in ids:
+        data["models"][ids.index(entry["id"])] = entry
+    else:
+        data["models"].append(entry)
     manifest.write_text(json.dumps(data, indent=1) + "\n")
