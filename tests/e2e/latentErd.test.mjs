@@ -81,7 +81,7 @@ describe('the model choice of Steer and Path modes', { timeout: 400_000 }, () =>
     const page = suite.page;
     await page.click('#mode-steer');
     const labels = await page.evaluate(() => [...$ui('steer-model').options].map((o) => [o.value, o.textContent]));
-    assert.deepEqual(labels, [['generator', 'Generator + MAP optimiser'], ['latent-erd', 'Latent ERD']]);
+    assert.deepEqual(labels, [['generator', 'Generator + MAP optimiser'], ['style-generator', 'style-generator (non-commercial)'], ['latent-erd', 'Latent ERD']]);
     assert.deepEqual(await choices(page), ['generator', 'generator'], 'the generator by default');
     await steerStreams(page, 'generator');
     assert.match((await steerStatus(page)).text, /particles/, 'the MAP controller runs');
@@ -281,12 +281,12 @@ describe('latent ERD in the page', { timeout: 300_000 }, () => {
       ['generate', { model: 'latent-erd', frames: 2, seed: 0, temperature: 0.5 }, /^generate: unknown option "temperature" for model "latent-erd" \(known: model, frames, seed, control, signal\)$/],
       ['generate', { model: 'manifold', frames: 2, seed: 0 }, /^generate: unknown model "manifold" \(available: .*latent-erd/],
       ['generate', { model: 'generator', frames: 2, seed: 0, control: [[1, 0, 0], [1, 0, 0]] }, /^generate: unknown option "control" for model "generator"/],
-      ['followPath', { model: 'walker', points: BEND }, /^followPath: unknown model "walker" \(available: generator, latent-erd, vae-lstm\)$/],
+      ['followPath', { model: 'walker', points: BEND }, /^followPath: unknown model "walker" \(available: generator, style-generator, latent-erd, vae-lstm\)$/],
       ['followPath', { model: 'latent-erd', points: BEND, fitTolerance: 0.2 }, /^followPath: unknown option "fitTolerance" \(known: model, points, gait, seed, speed, footLock, signal\)$/],
       ['followPath', { model: 'latent-erd', points: BEND, speed: 12 }, /^followPath: speed must be a number above 0 and at most 4 m\/s, got 12$/],
       ['followPath', { points: BEND, speed: 1 }, /^followPath: unknown option "speed" \(known: model, points, gait, seed, fitTolerance, footLock, signal\)$/],
       ['followPath', { model: 'latent-erd', points: [[0, 0], [0, 0.2]] }, /^followPath: the path is 0\.20 m long; it must be at least 0\.5 m$/],
-      ['simulateControl', { model: 7, seconds: 1, schedule: [{ t: 0, speed: 1, heading: 0 }] }, /^simulateControl: model must be "generator" or "latent-erd", got 7$/],
+      ['simulateControl', { model: 7, seconds: 1, schedule: [{ t: 0, speed: 1, heading: 0 }] }, /^simulateControl: model must be one of "generator", "style-generator", "latent-erd", got 7$/],
       ['simulateControl', { model: 'latent-erd', seconds: 1, schedule: [{ t: 0, speed: 9, heading: 0 }] }, /speed must be a number from 0 to 4/],
     ];
     for (const [method, options, expected] of cases) {

@@ -50,7 +50,7 @@ describe('the VAE-LSTM in Path mode', { timeout: 400_000 }, () => {
     const page = suite.page;
     await page.click('#mode-path');
     const options = await page.evaluate(() => [...$ui('path-model').options].map((o) => o.value));
-    assert.deepEqual(options, ['generator', 'latent-erd', 'vae-lstm']);
+    assert.deepEqual(options, ['generator', 'style-generator', 'latent-erd', 'vae-lstm']);
     assert.equal(await page.locator('#path-vary').isHidden(), true, 'Vary is the VAE-LSTM\'s');
     await page.selectOption('#path-model', 'vae-lstm');
     assert.deepEqual(await choices(page), ['generator', 'vae-lstm'], 'Steer cannot run the VAE-LSTM and keeps the generator');

@@ -89,11 +89,14 @@ describe('the model registry', () => {
 
   it('offers each shipped model where its descriptor says, in manifest order', () => {
     const registry = new Registry(MANIFEST);
-    expect(registry.ids('generate')).toEqual(['aclstm', 'aclstm-vanilla', 'generator', 'latent-erd', 'vae-lstm']);
-    expect(registry.ids('dance')).toEqual(['aclstm', 'aclstm-vanilla']);
-    expect(registry.ids('followPath')).toEqual(['generator', 'latent-erd', 'vae-lstm']);
-    expect(registry.ids('liveControl')).toEqual(['generator', 'latent-erd']);
-    expect(registry.defaultFor('walk')?.info.id).toBe('generator');
+    expect(registry.ids('generate')).toEqual(['aclstm-mdn', 'aclstm', 'aclstm-vanilla', 'generator', 'style-generator', 'latent-erd', 'vae-lstm']);
+    expect(registry.ids('dance')).toEqual(['aclstm-mdn', 'aclstm', 'aclstm-vanilla']);
+    expect(registry.defaultFor('dance')?.info.id).toBe('aclstm-mdn'); // issue 42: Dance starts with the sampled model
+    expect(registry.ids('followPath')).toEqual(['generator', 'style-generator', 'latent-erd', 'vae-lstm']);
+    expect(registry.ids('liveControl')).toEqual(['generator', 'style-generator', 'latent-erd']);
+    expect(registry.defaultFor('walk')?.info.id).toBe('generator'); // the CMU-only model stays the default
+    expect(registry.defaultFor('followPath')?.info.id).toBe('generator');
+    expect(registry.defaultFor('liveControl')?.info.id).toBe('generator');
     // The refiner and the autoencoder are parts of other models: listed in the manifest, offered nowhere.
     expect(registry.find('refiner')).toBeUndefined();
     expect(registry.shortName('latent-erd')).toBe('latent ERD');
@@ -104,14 +107,22 @@ describe('the model registry', () => {
     const registry = new Registry(MANIFEST);
     for (const m of MANIFEST) {
       expect(m.data, m.id).toMatch(/CMU/);
-      expect(m.licence, m.id).toMatch(/free for research and commercial use/);
-      expect(m.commercial, m.id).toBe(true);
+      if (m.commercial === false) {
+        // Trained on the Bandai Namco set (CC BY-NC 4.0): says so, and is labelled so in every picker.
+        expect(m.data, m.id).toMatch(/Bandai Namco/);
+        expect(m.licence, m.id).toMatch(/CC BY-NC 4\.0.*non-commercial/);
+        expect(registry.label(m.id)).toMatch(/\(non-commercial\)$/);
+      } else {
+        expect(m.licence, m.id).toMatch(/free for research and commercial use/);
+        expect(m.commercial, m.id).toBe(true);
+      }
     }
+    expect(MANIFEST.filter((m) => m.commercial === false).map((m) => m.id)).toEqual(['style-generator']);
     expect(registry.provenance('generator')).toMatch(/^Trained on CMU motion capture .*\. Licence: CMU .*commercial use\.$/);
     const styled: ModelInfo = { ...MANIFEST.find((m) => m.id === 'generator')!, id: 'styled', data: 'CMU and Bandai Namco', licence: 'CC BY-NC 4.0', commercial: false };
     const withStyled = new Registry([...MANIFEST, styled]);
     expect(withStyled.label('styled')).toBe('styled (non-commercial)');
-    expect(withStyled.ids('walk')).toEqual(['generator', 'styled']); // the CMU-only model stays the default
+    expect(withStyled.ids('walk')).toEqual(['generator', 'style-generator', 'styled']); // the CMU-only model stays the default
     expect(() => parseManifest({ models: [{ ...styled, commercial: 'no' }] })).toThrow(/commercial must be true or false/);
     expect(() => parseManifest({ models: [{ ...styled, licence: 4 }] })).toThrow(/licence must be a string/);
   });
@@ -121,8 +132,8 @@ describe('the model registry', () => {
     const kinds = descriptorsByKind({ './test_dancer/descriptor.ts': { descriptor: dancer }, ...Object.fromEntries([...descriptorsByKind()].map(([k, d]) => [`./${k}/descriptor.ts`, { descriptor: d }])) });
     const entry: ModelInfo = { id: 'my-dancer', kind: 'test-dancer', skeleton: 'aclstm-standard', fps: 30, styles: ['salsa'], bytes: 1 };
     const registry = new Registry([...MANIFEST, entry], kinds);
-    expect(registry.ids('dance')).toEqual(['aclstm', 'aclstm-vanilla', 'my-dancer']);
-    expect(new Registry(MANIFEST, kinds).ids('dance')).toEqual(['aclstm', 'aclstm-vanilla']); // not listed: not offered
+    expect(registry.ids('dance')).toEqual(['aclstm-mdn', 'aclstm', 'aclstm-vanilla', 'my-dancer']);
+    expect(new Registry(MANIFEST, kinds).ids('dance')).toEqual(['aclstm-mdn', 'aclstm', 'aclstm-vanilla']); // not listed: not offered
     expect(() => descriptorsByKind({ './a/descriptor.ts': { descriptor: dancer }, './b/descriptor.ts': { descriptor: dancer } })).toThrow(/two descriptors of kind "test-dancer"/);
   });
 });

@@ -42,10 +42,10 @@ describe('view state (attributes and links)', () => {
   test('a model the mode does not have is refused (the shipped models, by what their descriptors say they do)', () => {
     const manifest = parseManifest(JSON.parse(readFileSync(resolve(__dirname, '../../public/models/index.json'), 'utf8')));
     const models = modeModels(new Registry(manifest));
-    expect(models).toEqual({ clip: [], walk: ['generator'], dance: ['aclstm', 'aclstm-vanilla'], path: ['generator', 'latent-erd', 'vae-lstm'], steer: ['generator', 'latent-erd'] });
+    expect(models).toEqual({ clip: [], walk: ['generator', 'style-generator'], dance: ['aclstm-mdn', 'aclstm', 'aclstm-vanilla'], path: ['generator', 'style-generator', 'latent-erd', 'vae-lstm'], steer: ['generator', 'style-generator', 'latent-erd'] });
     const { view, errors } = parseView((k) => ({ mode: 'steer', model: 'vae-lstm' })[k as 'mode'] ?? null, models);
     expect(view).toEqual({ mode: 'steer' });
-    expect(errors).toEqual(['model="vae-lstm": steer mode shows generator, latent-erd']);
+    expect(errors).toEqual(['model="vae-lstm": steer mode shows generator, style-generator, latent-erd']);
   });
 
   test('a path too short or too far is refused by the path rules', () => {

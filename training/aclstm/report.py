@@ -305,8 +305,10 @@ def summary_lines(report: dict) -> list[str]:
         "- **What it does:** dances: an LSTM continues a few frames of real salsa, Indian or martial-arts capture for "
         "as long as asked, one network for the three styles; acLSTM is trained feeding on its own output "
         "(auto-conditioning), the vanilla baseline on real frames only.",
-        "- **In the page:** Dance mode plays either model (`model=\"aclstm\"` or `\"aclstm-vanilla\"`) for the chosen "
-        "style and seed; the page fits the predicted points to the skeleton.",
+        "- **In the page:** Dance mode starts with the sampled model `aclstm-mdn` (issue 42: a mixture output drawn a "
+        "phrase at a time, seeded, shown through a low-pass; see \"Issue 42\" below) and also plays the deterministic "
+        "`aclstm` and the baseline `aclstm-vanilla`, for the chosen style and seed; the page fits the predicted points to "
+        "the skeleton.",
         f"- **Long runs of {report['frames_per_seed']:,} frames, against the real clips' motion:** stable (never below "
         f"{report['freeze_fraction']:.0%} of the real median pose change, never diverging) {counts(stable)}; passing the "
         f"fairer rule (each style against its own real clips) {counts(fair_rule_passes)}.",

@@ -9,7 +9,7 @@ import { DanceClient } from './danceClient';
 export const descriptor: ModelDescriptor<DanceClient> = {
   kind: 'aclstm',
   shortName: 'acLSTM',
-  labels: { aclstm: 'acLSTM', 'aclstm-vanilla': 'vanilla LSTM (baseline)' },
+  labels: { 'aclstm-mdn': 'acLSTM, phrase sampling', aclstm: 'acLSTM (deterministic)', 'aclstm-vanilla': 'vanilla LSTM (baseline)' },
   capabilities: ['generate', 'dance'],
   createClient: (entry, threads) => new DanceClient({ ...clientFiles(entry, threads), model: entry.id }),
 
