@@ -51,8 +51,8 @@ def estimate_initial_state(model: MixtureLSTM, x: torch.Tensor, iterations: int 
     for _ in range(iterations):
         opt.zero_grad()
         loss = nll(h, c)
-        if float(loss) < best[0]:
-            best = (float(loss), h.detach().clone(), c.detach().clone())
+        if loss.item() < best[0]:
+            best = (loss.item(), h.detach().clone(), c.detach().clone())
         loss.backward()
         opt.step()
     with torch.no_grad():
