@@ -77,7 +77,7 @@ async function main() {
     const { page } = await openPlayground(browser, url);
     const listed = await page.evaluate(() => window.playground.models().map((m) => m.id));
     const asked = option('--models', 'generator,latent-erd,vae-lstm').split(',');
-    const unknown = asked.filter((m) => !listed.includes(m));
+    const unknown = [...asked, ...option('--steer', '').split(',').filter(Boolean)].filter((m) => !listed.includes(m.split(':')[0]));
     if (unknown.length) throw new Error(`not listed in models/index.json: ${unknown.join(', ')} (listed: ${listed.join(', ')})`);
     const lowest = (swing) => Math.min(...swing) / real.run.median;
     for (const entry of asked) {
