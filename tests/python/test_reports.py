@@ -23,7 +23,8 @@ FIGURES = {"generator": "generator.png", "refiner": "refiner.png", "aclstm": "ac
 # every model's weights are stored (linked from the generator and acLSTM reports); retarget.md measures retargeting onto
 # characters' own rigs (web/motion/retarget.ts, no model; written by npm run evaluate:retarget); style-generator.md is
 # the style-conditioned generator's pilots (issue 39, not shipped; from python -m training.style_generator.pilot's JSON).
-NOT_REPORTS = ["refiner-notes", "refiner-browser", "aclstm-pilots", "weights", "retarget", "style-generator"]
+NOT_REPORTS = ["refiner-notes", "refiner-browser", "aclstm-pilots", "weights", "retarget", "style-generator",
+               "style-generator-shipped", "style-generator-full-c"]  # the style generator's measured tables, linked from it
 SUMMARY_LABELS = ["What it does", "In the page", None, None, "Not met"]
 LONGEST_CELL = 200
 
