@@ -283,7 +283,7 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
       meta: $ui('clip-meta').textContent,
     }));
     assert.deepEqual(switched.seeds, INFO.seeds.filter((s) => s.style === style).map((s) => s.name));
-    assert.match(switched.meta, new RegExp(`acLSTM · ${style}`));
+    assert.match(switched.meta, new RegExp(`acLSTM, phrase sampling · ${style}`)); // Dance starts with the sampled model (issue 42)
     // Restarted: the plot holds no more seconds than the new stream has run (read together, so no race).
     const restarted = await suite.page.evaluate(() => ({ seconds: Number($ui('dance-plot').dataset.seconds), frame: Number($ui('dance-status').dataset.frame) }));
     assert.ok(restarted.seconds <= restarted.frame / INFO.fps + 1, `the plot restarted (${restarted.seconds} s plotted at frame ${restarted.frame})`);
