@@ -246,6 +246,9 @@ export class RandomWalk extends LiveMode<WalkChunk> {
 
   /** Keeps the raw window in step with the shown (refined) one and draws it beside it when asked. */
   protected received(chunk: WalkChunk, first: boolean): void {
+    // The walk follows the selector: a style chosen while a walk was (re)starting with another is blended in here,
+    // at its next chunk (switchStyle does nothing when they already agree).
+    this.switchStyle();
     if (!this.refining || !chunk.raw || !chunk.refined || !this.aligner || !this.walkSkeleton) return;
     const shown = this.app.viewer.current;
     if (!shown) return;
