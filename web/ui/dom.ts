@@ -91,10 +91,18 @@ export function downloadBlob(fileName: string, blob: Blob): void {
   setTimeout(() => URL.revokeObjectURL(url), 10_000);
 }
 
-/** Sets a form field as the user would: its value (a checkbox: checked), then its input and change events. */
+/**
+ * Sets a form field as the user would: its value (a checkbox: checked), then its input and change events. A value the
+ * field already holds fires nothing, as when a user picks it again (a view that repeats the settings restarts nothing).
+ */
 export function changeTo(field: HTMLInputElement | HTMLSelectElement, value: string | boolean): void {
-  if (field instanceof HTMLInputElement && field.type === 'checkbox') field.checked = value as boolean;
-  else field.value = String(value);
+  if (field instanceof HTMLInputElement && field.type === 'checkbox') {
+    if (field.checked === value) return;
+    field.checked = value as boolean;
+  } else {
+    if (field.value === String(value)) return;
+    field.value = String(value);
+  }
   field.dispatchEvent(new Event('input', { bubbles: true }));
   field.dispatchEvent(new Event('change', { bubbles: true }));
 }

@@ -96,9 +96,11 @@ export class DanceMode extends LiveMode<DanceMotion> {
 
   protected async open(signal: AbortSignal): Promise<LiveStream<DanceMotion>> {
     await this.app.whenModels(); // the picker lists the dance models once they are known
+    signal.throwIfAborted();
     const id = this.model.value;
     if (!id) throw new Error('no dance model is listed in models/index.json');
     const { client } = await this.app.host(id).load();
+    signal.throwIfAborted();
     if (!(client instanceof DanceClient)) throw new Error(`model "${id}" cannot dance`);
     const info = client.initResult;
     this.client = { id, client };

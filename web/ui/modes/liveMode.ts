@@ -92,7 +92,10 @@ export abstract class LiveMode<Chunk extends LiveChunk> {
 
   /**
    * Loads the model (first time) and starts a new stream with the current settings; the stream's requests
-   * (its start and every pull) carry `signal`, which aborts when the stream is replaced or stopped.
+   * (its start and every pull) carry `signal`, which aborts when the stream is replaced or stopped. Once it has
+   * aborted, a newer stream owns the mode's state: after an await that takes no signal (the model list, a model's
+   * load), call `signal.throwIfAborted()` before touching it (a replaced start that went on had set the running
+   * model back to the one it was loading).
    */
   protected abstract open(signal: AbortSignal): Promise<LiveStream<Chunk>>;
   /** Forgets the model after its worker failed, so the next start loads it afresh. */

@@ -207,11 +207,13 @@ export class RandomWalk extends LiveMode<WalkChunk> {
   protected async open(signal: AbortSignal): Promise<LiveStream<WalkChunk>> {
     // The first listed model that walks (the generator: a stream with the refiner behind it on request).
     const registry = await this.app.whenModels();
+    signal.throwIfAborted();
     const walker = (this.model.value && registry.can(this.model.value, 'walk') ? registry.find(this.model.value) : undefined) ?? registry.defaultFor('walk');
     if (!walker) throw new Error('no model for Random walk is listed in models/index.json');
     const id = walker.info.id;
     this.showRefinerAvailability(this.refinerMissing(id));
     const { client } = await this.app.host(id).load();
+    signal.throwIfAborted();
     if (!(client instanceof GeneratorClient)) throw new Error(`model "${id}" cannot stream a random walk`);
     const info = client.initResult;
     this.client = { id, client };

@@ -181,11 +181,13 @@ export class SteerMode extends LiveMode<SteerChunk> {
 
   protected async open(signal: AbortSignal): Promise<LiveStream<SteerChunk>> {
     await this.app.whenModels();
+    signal.throwIfAborted();
     const model = (this.model = this.app.controlModel.steerable);
     const live = (this.live = this.app.registry.find(model)?.descriptor.liveControl);
     if (!live) throw new Error('no model that takes live control is listed in models/index.json');
     this.statusLine.dataset.model = model;
     const { client, info } = await this.app.host(model).load();
+    signal.throwIfAborted();
     this.client = { id: model, client };
     const style = this.app.controlStyle.for(this.app.stylesOf(model));
     const stream = await live.start(client, { seed: 0, gait: this.gaitValue, ...(style ? { style } : {}) }, { signal });
