@@ -34,6 +34,16 @@ def test_every_style_loads_on_one_skeleton_with_held_out_clips(dance):
         assert bone_length_error(c.positions[::50], skel).max() < 1e-5  # real FK keeps bone lengths
 
 
+def test_clips_start_after_the_files_t_pose_lead_in(dance):
+    """Every file starts with a T-pose frame and a few frames blending out of it (joint speeds of 37-189 m/s); the
+    clips start after it, so no clip's first 0.2 s moves a joint faster than its own 99.9th percentile of speed."""
+    _, clips = dance
+    for c in clips:
+        speed = np.linalg.norm(np.diff(c.positions, axis=0), axis=-1).max(axis=1) * c.fps
+        assert c.lead_in_s == pytest.approx(0.1)
+        assert speed[: int(0.2 * c.fps)].max() <= np.percentile(speed, 99.9), c.file
+
+
 def test_features_round_trip_and_rotation(dance):
     _, clips = dance
     pos = resample_positions(clips[0].positions, clips[0].fps, 2.0, 30)

@@ -52,9 +52,9 @@ def pick_seeds(clips: list[DanceClip], styles: tuple[str, ...] | list[str] = STY
         held = [c for c in clips if c.style == style and c.held_out]
         for k in range(SEEDS_PER_STYLE):
             c = held[k % len(held)]
-            secs = c.seconds
+            secs = c.seconds + c.lead_in_s  # in the file's time, as the seeds' names and start_seconds say
             start = (k // len(held) + 1) / (SEEDS_PER_STYLE // len(held) + 2) * secs
-            pos = resample_positions(c.positions, c.fps, start, SEED_FRAMES + 1)
+            pos = resample_positions(c.positions, c.fps, start - c.lead_in_s, SEED_FRAMES + 1)
             pos[..., [0, 2]] -= pos[-1:, :1, [0, 2]]  # the seed ends with the root over the origin
             seeds.append({"style": style, "name": f"{style} {Path(c.file).name.split('.')[0]} @{start:.1f}s",
                           "file": c.file, "start_seconds": round(start, 2),

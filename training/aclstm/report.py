@@ -174,6 +174,9 @@ def add_to_dance_report(frames: int, n_seeds: int, mocap: str | None, models_dir
                          f"{report['seeds_per_style']})")
     skel, clips = load_clips(mocap)
     real_change, real_ref, real_jitter = real_pose_change(clips), real_reference(clips), real_jitter_cm(clips)
+    if (report["real_reference"], report["real_jitter_cm"]) != (real_ref, real_jitter):
+        raise SystemExit("error: the stored report's rows were judged against another real reference than the clips give "
+                         "now (the clips changed); measure every row again with python -m training.aclstm.evaluate")
     for label, json_path in rows:
         if not json_path.exists():
             raise SystemExit(f"error: no {json_path}")

@@ -40,6 +40,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--decay", type=float, default=0.95, help="learning-rate factor per epoch")
     parser.add_argument("--iters-per-epoch", type=int, default=250)
     parser.add_argument("--no-mirror", action="store_true", help="no left/right mirroring of training windows")
+    parser.add_argument("--extra", action="store_true",
+                        help="also train on ../shared/mocap/aclstm-extra (Indian 01, martial 02 on the standard skeleton: "
+                             "training/data/dance_extra.py)")
     args = parser.parse_args(argv)
     result = train_dance_model(args)
     print(f"done: {result.stopped}; best validation loss {result.best:.4f}; checkpoints in {result.run_dir}")

@@ -127,7 +127,7 @@ def train_dance_model(args: argparse.Namespace,
     loop = TrainingLoop(args)
     run = loop.run
     rng = loop.seed()
-    skel, clips = load_clips(args.mocap) if data is None else data[:2]
+    skel, clips = load_clips(args.mocap, extra=getattr(args, "extra", False)) if data is None else data[:2]
     styles = STYLES if data is None else data[2]
     corpus = DanceCorpus(clips, args.window, np.random.default_rng(12345), skel.names, not args.no_mirror, styles)
     dim = corpus.mean.shape[0]

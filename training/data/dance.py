@@ -36,6 +36,11 @@ CM = 0.01  # the set's BVH units are centimetres
 CACHE = DEFAULT_CACHE / "aclstm_positions.npz"
 EXTRA_CACHE = DEFAULT_CACHE / "aclstm_positions_extra.npz"  # the set and the two converted trials (extra=True)
 EXTRA_DIR = "aclstm-extra/"  # the converted trials' files start so; they are never held out
+# Every file of the acLSTM set starts with a T-pose frame and 2-5 frames blending out of it (joint speeds of
+# 37-189 m/s; the first ordinary frame is at most 0.083 s in, measured 2026-12-05). load_clips drops this lead-in,
+# so training windows, the real references (pose change and jitter: the lead-in had raised real jitter by 4-12%) and
+# the jitter filter's spectrum see only the dance. The converted extra trials lose the same 0.1 s.
+LEAD_IN_S = 0.1
 # Held out per style for validation, the evaluation report and the browser's seed motions.
 HELD_OUT = {"salsa": ("10", "20", "30"), "indian": ("15",), "martial": ("10",)}
 
@@ -61,6 +66,7 @@ class DanceClip:
     fps: float  # the source rate (SOURCE_FPS of its style)
     positions: np.ndarray  # (frames, 57, 3) world metres, feet on the floor
     held_out: bool
+    lead_in_s: float = 0.0  # seconds dropped from the file's start (LEAD_IN_S): positions[0] is the file's time lead_in_s
 
     @property
     def seconds(self) -> float:
@@ -130,8 +136,8 @@ def build_cache(mocap: Path, out: Path | None = None, extra: bool = False) -> Pa
 
 
 def load_clips(mocap_flag: str | None = None, extra: bool = False) -> tuple[DanceSkeleton, list[DanceClip]]:
-    """The skeleton and every clip, from the cache (built first when missing); with `extra`, the two converted CMU
-    trials too (training clips), from EXTRA_CACHE."""
+    """The skeleton and every clip without its lead-in (LEAD_IN_S), from the cache (built first when missing); with
+    `extra`, the two converted CMU trials too (training clips), from EXTRA_CACHE."""
     cache = EXTRA_CACHE if extra else CACHE
     if not cache.exists():
         build_cache(resolve_mocap_dir(mocap_flag), extra=extra)
@@ -140,8 +146,10 @@ def load_clips(mocap_flag: str | None = None, extra: bool = False) -> tuple[Danc
     clips = []
     for style, file, start, frames in zip(d["style"], d["files"], d["start"], d["frames"]):
         style = str(style)
-        clips.append(DanceClip(style, str(file), SOURCE_FPS[style], d["positions"][start:start + frames].astype(np.float64),
-                               not str(file).startswith(EXTRA_DIR) and is_held_out(style, str(file))))
+        fps = SOURCE_FPS[style]
+        lead_in = int(round(LEAD_IN_S * fps))
+        clips.append(DanceClip(style, str(file), fps, d["positions"][start + lead_in:start + frames].astype(np.float64),
+                               not str(file).startswith(EXTRA_DIR) and is_held_out(style, str(file)), lead_in / fps))
     return skel, clips
 
 
