@@ -8,7 +8,8 @@
 //
 // Rule, as freeze_rule.py states it: a second is low below 20% of the style's real median pose change; a run passes
 // when (a) its share of low seconds is at most twice the real share, (b) no low stretch lasts 5 s, and (c) its median
-// is at least half the real median. Jitter: mean |second difference| of the joints relative to the root (cm).
+// is at least half the real median. Jitter: mean |second difference| of the joints relative to the root (cm). Both
+// are web/motion/freezeRule.ts, run in the page (its parity with Python: tests/unit/measuresParity.test.ts).
 // Seeds 0..N-1 (not chosen by result); a link with the same model, style and seed shows the same dance.
 import { readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
@@ -20,21 +21,9 @@ const MODEL = option('--model', 'aclstm-mdn');
 const FRAMES = Number(option('--frames', 20000));
 const SEEDS = Number(option('--seeds', 5));
 const OUT = option('--out', null);
-const LOW_FRACTION = 0.2, SHARE_FACTOR = 2, LONGEST_LOW_S = 5, MEDIAN_FRACTION = 0.5;
 
 const stored = JSON.parse(readFileSync(path.join(ROOT, 'docs/models/aclstm.json'), 'utf8'));
 const fmt = (v, d = 2) => (Number.isFinite(v) ? v.toFixed(d) : String(v));
-
-function judge(seconds, ref) {
-  const low = seconds.map((v) => v < LOW_FRACTION * ref.median);
-  let longest = 0;
-  for (let k = 0, run = 0; k < low.length; k++) longest = Math.max(longest, (run = low[k] ? run + 1 : 0));
-  const share = low.filter(Boolean).length / low.length;
-  const sorted = [...seconds].sort((a, b) => a - b);
-  const ratio = sorted[Math.floor(sorted.length / 2)] / ref.median;
-  const verdict = { a: share <= SHARE_FACTOR * ref.low_share, b: longest < LONGEST_LOW_S, c: ratio >= MEDIAN_FRACTION };
-  return { lowShare: share, longestLowS: longest, medianRatio: ratio, ...verdict, passes: verdict.a && verdict.b && verdict.c };
-}
 
 async function main() {
   const report = { date: new Date().toISOString().slice(0, 10), model: MODEL, frames: FRAMES, seeds: SEEDS, runs: [] };
@@ -48,32 +37,22 @@ async function main() {
       const ref = stored.real_reference[style];
       const realJitter = stored.real_jitter_cm[style];
       for (let seed = 0; seed < SEEDS; seed++) {
-        const r = await page.evaluate(async ({ model, style, frames, seed }) => {
+        const r = await page.evaluate(async ({ model, style, frames, seed, ref }) => {
           const t = performance.now();
           const m = await window.playground.generate({ model, style, frames, seed });
           const ms = performance.now() - t;
           const { poseChangePerSecond } = await import('/motion/poseChange.ts');
+          const { jitterCm, judgeFreeze } = await import('/motion/freezeRule.ts');
           const J = m.joints.length, p = m.positions;
-          let jitter = 0, n = 0, rootMin = Infinity, rootMax = -Infinity;
+          let rootMin = Infinity, rootMax = -Infinity;
           for (let f = 0; f < m.frames; f++) {
             rootMin = Math.min(rootMin, p[f * J * 3 + 1]);
             rootMax = Math.max(rootMax, p[f * J * 3 + 1]);
           }
-          for (let f = 2; f < m.frames; f++) {
-            for (let j = 0; j < J; j++) {
-              let sq = 0;
-              for (let a = 0; a < 3; a++) {
-                const local = (g) => p[(g * J + j) * 3 + a] - p[g * J * 3 + a];
-                const d = local(f) - 2 * local(f - 1) + local(f - 2);
-                sq += d * d;
-              }
-              jitter += Math.sqrt(sq);
-              n++;
-            }
-          }
-          return { ms, frames: m.frames, finite: p.every(Number.isFinite), seconds: poseChangePerSecond(p, J, m.fps), jitterCm: (100 * jitter) / n, rootHeight: [rootMin, rootMax] };
-        }, { model: MODEL, style, frames: FRAMES, seed });
-        const verdict = judge(r.seconds, ref);
+          const verdict = judgeFreeze(poseChangePerSecond(p, J, m.fps), ref);
+          return { ms, frames: m.frames, finite: p.every(Number.isFinite), verdict, jitterCm: jitterCm(p, J), rootHeight: [rootMin, rootMax] };
+        }, { model: MODEL, style, frames: FRAMES, seed, ref });
+        const verdict = r.verdict;
         const row = { style, seed, frames: r.frames, finite: r.finite, generateSeconds: r.ms / 1000, rootHeight: r.rootHeight, jitterVsReal: r.jitterCm / realJitter, ...verdict };
         report.runs.push(row);
         console.log(`${MODEL} ${style} seed ${seed}: ${r.frames} frames in ${fmt(row.generateSeconds, 0)} s, finite ${r.finite}, root ${fmt(r.rootHeight[0])}-${fmt(r.rootHeight[1])} m; low seconds ${fmt(100 * verdict.lowShare, 1)}% (real ${fmt(100 * ref.low_share, 1)}%), longest low ${verdict.longestLowS} s, median ${fmt(verdict.medianRatio)}x real; jitter ${fmt(row.jitterVsReal)}x real; ${verdict.passes ? 'passes' : `FAILS (${['a', 'b', 'c'].filter((k) => !verdict[k]).join(', ')})`}`);

@@ -1,6 +1,7 @@
 // Parity of the rules that exist on both sides: foot contacts (web/motion/contacts.ts vs
 // training/mocap/contacts.py), foot skating (web/motion/footSkating.ts vs training/metrics.py foot_skating)
-// and per-second pose change (web/motion/poseChange.ts vs training/metrics.py pose_change_per_second).
+// per-second pose change (web/motion/poseChange.ts vs training/metrics.py pose_change_per_second), and the dance
+// reports' freeze rule and jitter (web/motion/freezeRule.ts vs training/aclstm/freeze_rule.py judge, jitter_cm).
 // tests/fixtures/measures_parity.json (python -m training.fixtures.measures) holds real clips as the
 // Python loader gives them plus synthetic threshold cases, and what the Python rules make of them.
 // Positions are stored as whole multiples of 1/8192 m, exact in float32, so the Float32Array the page would
@@ -11,6 +12,7 @@
 import { describe, expect, it } from 'vitest';
 import { CONTACT_THRESHOLDS, detectContacts } from '../../web/motion/contacts';
 import { footSkating, skatingSample } from '../../web/motion/footSkating';
+import { FREEZE_RULE, jitterCm, judgeFreeze, type RealDanceReference } from '../../web/motion/freezeRule';
 import { PoseChangeMeter, poseChangePerSecond } from '../../web/motion/poseChange';
 import type { Motion } from '../../web/motion/types';
 import { readRepoFile } from './corpus';
@@ -41,6 +43,13 @@ interface SkatingCase extends Clip {
 }
 interface PoseChangeCase extends Clip {
   per_second: number[];
+  jitter_cm: number;
+}
+interface FreezeCase {
+  name: string;
+  seconds: number[];
+  reference: RealDanceReference;
+  verdict: { low_share: number; longest_low_s: number; median_ratio: number; pass_a: boolean; pass_b: boolean; pass_c: boolean; passes: boolean };
 }
 interface Fixture {
   contact_thresholds: Record<string, number>;
@@ -48,6 +57,7 @@ interface Fixture {
   skating: SkatingCase[];
   skating_pooled: { cases: string[]; skating: number; pairs: number };
   pose_change: PoseChangeCase[];
+  freeze_rule: { constants: { low_fraction: number; share_factor: number; longest_low_s: number; median_fraction: number }; cases: FreezeCase[] };
 }
 
 const fixture = JSON.parse(readRepoFile('tests/fixtures/measures_parity.json')) as Fixture;
@@ -146,6 +156,28 @@ describe('per-second pose change: web/motion/poseChange.ts = training/metrics.py
       const streamed: number[] = [];
       for (let f = 0; f < c.frames; f += 7) streamed.push(...meter.push(positions.subarray(f * J * 3, Math.min(f + 7, c.frames) * J * 3)));
       expect(streamed).toEqual(whole);
+    });
+  }
+});
+
+describe('the dance freeze rule and jitter: web/motion/freezeRule.ts = training/aclstm/freeze_rule.py', () => {
+  it('uses the same constants', () => {
+    const py = fixture.freeze_rule.constants;
+    expect({ low_fraction: FREEZE_RULE.lowFraction, share_factor: FREEZE_RULE.shareFactor, longest_low_s: FREEZE_RULE.longestLowS, median_fraction: FREEZE_RULE.medianFraction }).toEqual(py);
+  });
+  for (const c of fixture.freeze_rule.cases) {
+    it(`judges: ${c.name}`, () => {
+      const v = judgeFreeze(c.seconds, c.reference);
+      expect({ a: v.a, b: v.b, c: v.c, passes: v.passes, longest: v.longestLowS }).toEqual({
+        a: c.verdict.pass_a, b: c.verdict.pass_b, c: c.verdict.pass_c, passes: c.verdict.passes, longest: c.verdict.longest_low_s,
+      });
+      expect(Math.abs(v.lowShare - c.verdict.low_share)).toBeLessThan(1e-12);
+      expect(Math.abs(v.medianRatio - c.verdict.median_ratio)).toBeLessThan(1e-12);
+    });
+  }
+  for (const c of fixture.pose_change) {
+    it(`jitter of ${c.name}`, () => {
+      expect(Math.abs(jitterCm(positionsOf(c), c.joints.length) - c.jitter_cm)).toBeLessThan(1e-9);
     });
   }
 });

@@ -1,0 +1,68 @@
+// The fair freeze rule of the dance reports (training/aclstm/freeze_rule.py), for judging what the page gives
+// (scripts/evaluate-dance.mjs): a second is low when its pose change (poseChange.ts) is below 20% of the style's real
+// median; a run passes when (a) its share of low seconds is at most twice the real clips' share, (b) no low stretch
+// lasts 5 s or more, and (c) its median is at least half the real median. Jitter, reported beside every verdict: the
+// mean |second difference| of the joints relative to the root, in cm per frame² (freeze_rule.jitter_cm).
+// Parity with Python: tests/fixtures/measures_parity.json (tests/unit/measuresParity.test.ts).
+
+export const FREEZE_RULE = { lowFraction: 0.2, shareFactor: 2, longestLowS: 5, medianFraction: 0.5 } as const;
+
+/** A style's real held-out clips, as docs/models/aclstm.json stores them (real_reference). */
+export interface RealDanceReference {
+  /** Median per-second pose change (m/s). */
+  median: number;
+  /** Share of the real seconds that are low. */
+  low_share: number;
+}
+
+export interface FreezeVerdict {
+  lowShare: number;
+  longestLowS: number;
+  medianRatio: number;
+  a: boolean;
+  b: boolean;
+  c: boolean;
+  passes: boolean;
+}
+
+/** The median as numpy's: the mean of the two middle values of an even count. */
+export function median(values: readonly number[]): number {
+  if (!values.length) return NaN;
+  const sorted = [...values].sort((x, y) => x - y);
+  const mid = sorted.length >> 1;
+  return sorted.length % 2 ? sorted[mid] : (sorted[mid - 1] + sorted[mid]) / 2;
+}
+
+/** One run's per-second pose change against its style's real reference: the three measures and the verdicts. */
+export function judgeFreeze(seconds: readonly number[], ref: RealDanceReference): FreezeVerdict {
+  const low = seconds.map((v) => v < FREEZE_RULE.lowFraction * ref.median);
+  let longest = 0;
+  for (let k = 0, run = 0; k < low.length; k++) longest = Math.max(longest, (run = low[k] ? run + 1 : 0));
+  const lowShare = low.filter(Boolean).length / low.length;
+  const medianRatio = median(seconds) / ref.median;
+  const a = lowShare <= FREEZE_RULE.shareFactor * ref.low_share;
+  const b = longest < FREEZE_RULE.longestLowS;
+  const c = medianRatio >= FREEZE_RULE.medianFraction;
+  return { lowShare, longestLowS: longest, medianRatio, a, b, c, passes: a && b && c };
+}
+
+/** Mean |second difference| of the joints relative to the root (cm per frame²) of frames × joints × 3 positions (m). */
+export function jitterCm(positions: ArrayLike<number>, joints: number): number {
+  const stride = joints * 3;
+  const frames = Math.floor(positions.length / stride);
+  const local = (f: number, j: number, a: number) => positions[f * stride + j * 3 + a] - positions[f * stride + a];
+  let sum = 0;
+  let count = 0;
+  for (let f = 2; f < frames; f++) {
+    for (let j = 0; j < joints; j++) {
+      let sq = 0;
+      for (let a = 0; a < 3; a++) {
+        const d = local(f, j, a) - 2 * local(f - 1, j, a) + local(f - 2, j, a);
+        sq += d * d;
+      }
+      sum += Math.sqrt(sq);
+      count++;
+    }
+  }
+  return count ? (100 * sum) / count : NaN;
+}
