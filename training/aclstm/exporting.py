@@ -208,28 +208,43 @@ def rewrite_dance_model(source: Path, model_id: str, out: Path, weights: str) ->
     return onnx_path
 
 
-def mdn_sampling(checkpoint: Path, clips: list[DanceClip], mocap: str | None, tune_frames: int = 1200) -> dict:
-    """The JSON's `sampling` block of an mdn model: the output filter per style (jitter_filter.style_filters: the cutoff
-    below which 99% of the style's training clips' velocity power lies), then the phrase parameters per style chosen
-    by pilots.tune_phrase on held-out tuning windows (never the judged seeds) from tuning_grid with the AR(1)
-    coefficients EXPORT_RHOS, the rollouts judged through the filter as the page shows them."""
+# The output filter's cutoffs tried per style at export: where this share of the style's training clips' velocity
+# power lies below (jitter_filter.choose_cutoff). Each style takes the share whose best phrase setting scores best on
+# the tuning windows (pilots.tuning_score: all passing within the jitter budget first); 0.99 alone until 2026-12-05.
+CUTOFF_SHARES = (0.99, 0.98, 0.97, 0.95)
+
+
+def mdn_sampling(checkpoint: Path, clips: list[DanceClip], mocap: str | None, tune_frames: int = 1200,
+                 shares: tuple[float, ...] = CUTOFF_SHARES) -> dict:
+    """The JSON's `sampling` block of an mdn model: per style, the output filter (jitter_filter.style_filters: the
+    cutoff below which a share of the style's training clips' velocity power lies, the share one of `shares`) and the
+    phrase parameters, chosen together by pilots.tune_phrase on held-out tuning windows (never the judged seeds) from
+    tuning_grid with the AR(1) coefficients EXPORT_RHOS, the rollouts judged through the filter as the page shows them."""
     from .jitter_filter import style_filters
     from .pilots import EXPORT_RHOS, tune_phrase, tuning_grid
 
-    filters = style_filters(clips)
-    tuned = tune_phrase(checkpoint, tuning_grid(rhos=EXPORT_RHOS), tune_frames, mocap=mocap,
-                        filters={s: (np.array(f["b"]), np.array(f["a"])) for s, f in filters.items()})
-    for style, v in tuned["styles"].items():
+    chosen = {}  # style -> (share, filter, tuned style block)
+    for share in shares:
+        filters = style_filters(clips, share=share)
+        tuned = tune_phrase(checkpoint, tuning_grid(rhos=EXPORT_RHOS), tune_frames, mocap=mocap,
+                            filters={s: (np.array(f["b"]), np.array(f["a"])) for s, f in filters.items()})
+        for style, v in tuned["styles"].items():
+            if style not in chosen or tuple(v["table"][0]["score"]) < tuple(chosen[style][2]["table"][0]["score"]):
+                chosen[style] = (share, filters[style], v)
+    for style, (share, f, v) in chosen.items():
         row = v["table"][0]
-        print(f"{style}: filter {filters[style]['cutoff_hz']:.2f} Hz, phrase {v['best']} (tuning: {row['passes']}/{row['runs']} pass, "
-              f"median {row['median_ratio']:.0%}, jitter {row['jitter_vs_real']:.2f}x filtered, {row['jitter_raw_vs_real']:.2f}x raw)")
-    return {"rule": "phrase", "params": {s: v["best"] for s, v in tuned["styles"].items()}, "filter": filters,
+        print(f"{style}: filter {f['cutoff_hz']:.2f} Hz ({share:.0%} of the power), phrase {v['best']} (tuning: {row['passes']}/"
+              f"{row['runs']} pass, median {row['median_ratio']:.0%}, jitter {row['jitter_vs_real']:.2f}x filtered, "
+              f"{row['jitter_raw_vs_real']:.2f}x raw)")
+    return {"rule": "phrase", "params": {s: v["best"] for s, (_, _, v) in chosen.items()},
+            "filter": {s: {**f, "power_share": share} for s, (share, f, _) in chosen.items()},
             "tuning": {"frames": tuned["frames"], "seeds_per_style": tuned["seeds_per_style"], "fractions": list(tuned["fractions"]),
+                       "power_shares": list(shares),
                        "chosen": {s: {k: v["table"][0][k] for k in ("passes", "runs", "diverged", "median_ratio", "jitter_vs_real",
-                                                                   "jitter_raw_vs_real")} for s, v in tuned["styles"].items()}},
+                                                                   "jitter_raw_vs_real")} for s, (_, _, v) in chosen.items()}},
             "notes": ("params: training/aclstm/phrase_sampling.py's rule per style; filter: a causal 2nd-order Butterworth "
                       "(b, a with a[0] = 1) per channel on the drawn frames, shown but never fed back "
-                      "(training/aclstm/jitter_filter.py)")}
+                      "(training/aclstm/jitter_filter.py), its cutoff chosen per style with the params")}
 
 
 MDN_FIXTURE_STEPS = 40
