@@ -450,10 +450,14 @@ def rewrite_aclstm_markdown() -> None:
 
 def write_dance_report(frames: int, n_seeds: int, mocap: str | None, models_dir: Path,
                        extra: list[tuple[str, Path]] = ()) -> dict:
-    """docs/models/aclstm.{md,json,png}; extra: (label, path/to/model.json) of exported models that are compared
-    but not shipped."""
+    """docs/models/aclstm.{md,json,png} and each shipped model's figure, aclstm-<id>.png; extra: (label,
+    path/to/model.json) of exported models that are compared but not shipped."""
     REPORTS_DIR.mkdir(parents=True, exist_ok=True)
     report = evaluate_dance(models_dir, frames, n_seeds, mocap, extra)
+    _, clips = load_clips(mocap)
+    for label, m in report["models"].items():  # each shipped model's runs against the real band: aclstm-<id>.png
+        if m["shipped"]:
+            plot_against_real(m, label, clips, REPORTS_DIR / f"aclstm-{m['id']}.png")
     _write_report(report)
     return report
 
