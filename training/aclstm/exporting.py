@@ -218,16 +218,17 @@ def mdn_sampling(checkpoint: Path, clips: list[DanceClip], mocap: str | None, tu
                  shares: tuple[float, ...] = CUTOFF_SHARES) -> dict:
     """The JSON's `sampling` block of an mdn model: per style, the output filter (jitter_filter.style_filters: the
     cutoff below which a share of the style's training clips' velocity power lies, the share one of `shares`) and the
-    phrase parameters, chosen together by pilots.tune_phrase on held-out tuning windows (never the judged seeds) from
+    phrase parameters, chosen together by pilots.tune_phrase_filtered (one set of rollouts) on held-out tuning windows (never the judged seeds) from
     tuning_grid with the AR(1) coefficients EXPORT_RHOS, the rollouts judged through the filter as the page shows them."""
     from .jitter_filter import style_filters
-    from .pilots import EXPORT_RHOS, tune_phrase, tuning_grid
+    from .pilots import EXPORT_RHOS, tune_phrase_filtered, tuning_grid
 
+    filters_by_share = [style_filters(clips, share=share) for share in shares]
+    tunings = tune_phrase_filtered(checkpoint, tuning_grid(rhos=EXPORT_RHOS),
+                                   [{s: (np.array(f["b"]), np.array(f["a"])) for s, f in filters.items()} for filters in filters_by_share],
+                                   tune_frames, mocap=mocap)
     chosen = {}  # style -> (share, filter, tuned style block)
-    for share in shares:
-        filters = style_filters(clips, share=share)
-        tuned = tune_phrase(checkpoint, tuning_grid(rhos=EXPORT_RHOS), tune_frames, mocap=mocap,
-                            filters={s: (np.array(f["b"]), np.array(f["a"])) for s, f in filters.items()})
+    for share, filters, tuned in zip(shares, filters_by_share, tunings):
         for style, v in tuned["styles"].items():
             if style not in chosen or tuple(v["table"][0]["score"]) < tuple(chosen[style][2]["table"][0]["score"]):
                 chosen[style] = (share, filters[style], v)

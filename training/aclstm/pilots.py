@@ -150,30 +150,42 @@ def tune_phrase(checkpoint: Path, grid: list[PhraseParams], frames: int = 1200, 
     judged windows), in one batch; per style the settings ranked by tuning_score and the best one. With `filters`
     (per style the output filter's b, a: training/aclstm/jitter_filter.py) each rollout is judged as shown, through
     its style's filter (started at rest on the seed's last frame); the raw jitter is kept beside it."""
+    return tune_phrase_filtered(checkpoint, grid, [filters], frames, per_style, mocap)[0]
+
+
+def tune_phrase_filtered(checkpoint: Path, grid: list[PhraseParams], filter_sets: list[dict | None], frames: int = 1200,
+                         per_style: int = 3, mocap: str | None = None) -> list[dict]:
+    """tune_phrase once per entry of `filter_sets` (None: unfiltered), on one set of rollouts: the filter is applied
+    after the rollout and never fed back, so the rollouts are the same whatever it is."""
     skel, clips = load_clips(mocap)
     model, meta, _ = load_dance_model(checkpoint)
     ref, real_jitter = real_reference(clips), real_jitter_cm(clips)
     rows = [(style, p, seed) for style in STYLES for p in grid for seed in tuning_seeds(clips, style, per_style)]
-    feats, _ = phrase_rollout(model, meta, np.array([r[2] for r in rows]), [r[0] for r in rows], frames, [r[1] for r in rows])
-    raw_jitter = [jitter_cm(decode(f.astype(np.float64))) / real_jitter[st] for (st, _, _), f in zip(rows, feats)]
-    if filters:
-        feats = lowpass_rows(feats, np.array([filters[st][0] for st, _, _ in rows]), np.array([filters[st][1] for st, _, _ in rows]),
-                             np.array([seed[-1] for _, _, seed in rows]))
-    out = {}
-    for style in STYLES:
-        table = []
-        for p in grid:
-            mine = [k for k, (st, q, _) in enumerate(rows) if st == style and q == p]
-            runs = [judge_rollout(feats[k], style, skel, ref, real_jitter) for k in mine]
-            table.append({"params": p.to_json(), "score": list(tuning_score(runs)),
-                          "passes": sum(r["passes"] and not r["diverged"] for r in runs), "runs": len(runs),
-                          "diverged": sum(r["diverged"] for r in runs),
-                          "median_ratio": float(np.median([r["median_ratio"] for r in runs])),
-                          "jitter_vs_real": max(r["jitter_vs_real"] for r in runs),
-                          "jitter_raw_vs_real": max(raw_jitter[k] for k in mine)})
-        table.sort(key=lambda t: tuple(t["score"]))
-        out[style] = {"best": table[0]["params"], "table": table}
-    return {"frames": frames, "seeds_per_style": per_style, "fractions": TUNING_FRACTIONS, "filtered": bool(filters), "styles": out}
+    drawn, _ = phrase_rollout(model, meta, np.array([r[2] for r in rows]), [r[0] for r in rows], frames, [r[1] for r in rows])
+    raw_jitter = [jitter_cm(decode(f.astype(np.float64))) / real_jitter[st] for (st, _, _), f in zip(rows, drawn)]
+    results = []
+    for filters in filter_sets:
+        feats = drawn
+        if filters:
+            feats = lowpass_rows(drawn, np.array([filters[st][0] for st, _, _ in rows]), np.array([filters[st][1] for st, _, _ in rows]),
+                                 np.array([seed[-1] for _, _, seed in rows]))
+        out = {}
+        for style in STYLES:
+            table = []
+            for p in grid:
+                mine = [k for k, (st, q, _) in enumerate(rows) if st == style and q == p]
+                runs = [judge_rollout(feats[k], style, skel, ref, real_jitter) for k in mine]
+                table.append({"params": p.to_json(), "score": list(tuning_score(runs)),
+                              "passes": sum(r["passes"] and not r["diverged"] for r in runs), "runs": len(runs),
+                              "diverged": sum(r["diverged"] for r in runs),
+                              "median_ratio": float(np.median([r["median_ratio"] for r in runs])),
+                              "jitter_vs_real": max(r["jitter_vs_real"] for r in runs),
+                              "jitter_raw_vs_real": max(raw_jitter[k] for k in mine)})
+            table.sort(key=lambda t: tuple(t["score"]))
+            out[style] = {"best": table[0]["params"], "table": table}
+        results.append({"frames": frames, "seeds_per_style": per_style, "fractions": TUNING_FRACTIONS,
+                        "filtered": bool(filters), "styles": out})
+    return results
 
 
 def summary_line(name: str, m: dict) -> str:

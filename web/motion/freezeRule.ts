@@ -5,6 +5,8 @@
 // mean |second difference| of the joints relative to the root, in cm per frame² (freeze_rule.jitter_cm).
 // Parity with Python: tests/fixtures/measures_parity.json (tests/unit/measuresParity.test.ts).
 
+import { percentile } from './contacts';
+
 export const FREEZE_RULE = { lowFraction: 0.2, shareFactor: 2, longestLowS: 5, medianFraction: 0.5 } as const;
 
 /** A style's real held-out clips, as docs/models/aclstm.json stores them (real_reference). */
@@ -25,21 +27,13 @@ export interface FreezeVerdict {
   passes: boolean;
 }
 
-/** The median as numpy's: the mean of the two middle values of an even count. */
-export function median(values: readonly number[]): number {
-  if (!values.length) return NaN;
-  const sorted = [...values].sort((x, y) => x - y);
-  const mid = sorted.length >> 1;
-  return sorted.length % 2 ? sorted[mid] : (sorted[mid - 1] + sorted[mid]) / 2;
-}
-
 /** One run's per-second pose change against its style's real reference: the three measures and the verdicts. */
 export function judgeFreeze(seconds: readonly number[], ref: RealDanceReference): FreezeVerdict {
   const low = seconds.map((v) => v < FREEZE_RULE.lowFraction * ref.median);
   let longest = 0;
   for (let k = 0, run = 0; k < low.length; k++) longest = Math.max(longest, (run = low[k] ? run + 1 : 0));
   const lowShare = low.filter(Boolean).length / low.length;
-  const medianRatio = median(seconds) / ref.median;
+  const medianRatio = percentile(seconds, 50) / ref.median; // numpy's median: an even count takes the middle two's mean
   const a = lowShare <= FREEZE_RULE.shareFactor * ref.low_share;
   const b = longest < FREEZE_RULE.longestLowS;
   const c = medianRatio >= FREEZE_RULE.medianFraction;
