@@ -357,6 +357,43 @@ describe('your own character', { timeout: 600_000 }, () => {
       el.setAttribute('mode', 'clip');
     });
   });
+  test('a live stream whose first window does not map (a foot held high) draws the character from the next window that does', async () => {
+    const r = await suite.page.evaluate(async () => {
+      const { Viewer } = await import('/viewer/viewer.ts');
+      const { parseCharacter, UserCharacterDriver } = await import('/viewer/userCharacter.ts');
+      const asset = await parseCharacter(await (await fetch('characters/quaternius-human-male.glb')).arrayBuffer(), 'q.glb');
+      const m = window.walk;
+      const J = m.joints.length;
+      // The walk's first 20 frames with the right leg below the hip lifted 0.6 m: no second foot near the floor.
+      const raised = new Set();
+      m.parents.forEach((p, j) => { if ((p >= 0 && m.joints[p] === 'RightUpLeg') || raised.has(p)) raised.add(j); });
+      const positions = m.positions.slice(0, 120 * J * 3);
+      for (let f = 0; f < 20; f++) for (const j of raised) positions[(f * J + j) * 3 + 1] += 0.6;
+      const window_ = (n) => ({ ...m, frames: n, positions: positions.slice(0, n * J * 3), contacts: undefined });
+      const host = document.createElement('div');
+      host.style.cssText = 'position:fixed;left:0;top:0;width:320px;height:240px';
+      document.body.appendChild(host);
+      const viewer = new Viewer(host);
+      try {
+        viewer.setCharacterSource((motion) => {
+          const driver = new UserCharacterDriver(asset, { lit: false });
+          if (driver.setMotion(motion)) return driver;
+          driver.dispose();
+          return null;
+        });
+        viewer.setLive(window_(20), undefined, -1);
+        const first = viewer.stats().characterVertices;
+        viewer.setLive(window_(120), undefined, 0);
+        return { raised: raised.size, first, next: viewer.stats().characterVertices };
+      } finally {
+        viewer.dispose();
+        host.remove();
+      }
+    });
+    assert.ok(r.raised >= 3, `the right leg's joints found (${r.raised})`);
+    assert.notEqual(r.first, 7399, 'the first window does not retarget onto the character');
+    assert.equal(r.next, 7399, 'the next window draws the character');
+  });
   test('live chunks are joined smoothly: steps at chunk boundaries no larger than elsewhere, close to one retargeting of the window', async () => {
     const r = await suite.page.evaluate(async () => {
       const { parseCharacter, UserCharacterDriver } = await import('/viewer/userCharacter.ts');

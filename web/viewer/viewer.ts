@@ -99,6 +99,8 @@ export class Viewer {
   private character: CharacterView | null = null;
   /** A user's own character (userCharacter.ts) drawn instead of the mannequin: set by setCharacterSource. */
   private characterSource: ((motion: Motion, companion: boolean) => CharacterView | null) | null = null;
+  /** The views characterSource made (a user's character), as against the mannequin drawn when it made none. */
+  private readonly ownCharacters = new WeakSet<CharacterView>();
   private look: Look = DEFAULT_LOOK;
   private readonly lights: CharacterLights;
   /**
@@ -418,6 +420,7 @@ export class Viewer {
       this.character = null;
       this.showLook();
     }
+    this.retryOwnCharacter(motion);
     this.marks.build(motion, contacts, this.root);
     this.playback.frames = motion.frames;
     this.playback.fps = motion.fps;
@@ -548,8 +551,30 @@ export class Viewer {
   /** The character drawn for a motion: the user's own when one is set (and it retargets), else the mannequin. */
   private characterFor(motion: Motion, companion: boolean): CharacterView | null {
     const own = this.characterSource?.(motion, companion) ?? null;
-    if (own) return own;
+    if (own) {
+      this.ownCharacters.add(own);
+      return own;
+    }
     return companion ? CharacterDriver.for(motion, { colors: COMPANION_MANNEQUIN_COLORS, lit: this.lit }) : CharacterDriver.for(motion, { lit: this.lit });
+  }
+
+  /**
+   * A live stream whose earlier window did not retarget onto the user's character (the mannequin or nothing drawn in
+   * its place) tries it again on each new window: a dance's first second with a foot held high may not map as a
+   * humanoid, a longer window does, and the user's character should not be lost for the rest of the stream.
+   */
+  private retryOwnCharacter(motion: Motion): void {
+    if (!this.characterSource || (this.character && this.ownCharacters.has(this.character))) return;
+    const own = this.characterSource(motion, false);
+    if (!own) return;
+    if (this.character) {
+      this.scene.remove(this.character.mannequin.mesh);
+      this.character.dispose();
+    }
+    this.ownCharacters.add(own);
+    this.character = own;
+    this.scene.add(own.mannequin.mesh);
+    this.showLook();
   }
 
   /**
