@@ -8,8 +8,10 @@
 //
 // Rule, as freeze_rule.py states it: a second is low below 20% of the style's real median pose change; a run passes
 // when (a) its share of low seconds is at most twice the real share, (b) no low stretch lasts 5 s, and (c) its median
-// is at least half the real median. Jitter: mean |second difference| of the joints relative to the root (cm). Both
-// are web/motion/freezeRule.ts, run in the page (its parity with Python: tests/unit/measuresParity.test.ts).
+// is at least half the real median. Jitter: mean |second difference| of the joints relative to the root (cm). The
+// raised-foot share (training/aclstm/raised_foot.py): frames with the higher ankle over 0.3 m above the lowest point,
+// against real_raised_foot there. All three are web/motion/freezeRule.ts, run in the page (its parity with Python:
+// tests/unit/measuresParity.test.ts).
 // Seeds 0..N-1 (not chosen by result); a link with the same model, style and seed shows the same dance.
 import { readFileSync, writeFileSync } from 'node:fs';
 import path from 'node:path';
@@ -36,13 +38,14 @@ async function main() {
     for (const style of info.styles) {
       const ref = stored.real_reference[style];
       const realJitter = stored.real_jitter_cm[style];
+      const realRaised = stored.real_raised_foot?.[style];
       for (let seed = 0; seed < SEEDS; seed++) {
         const r = await page.evaluate(async ({ model, style, frames, seed, ref }) => {
           const t = performance.now();
           const m = await window.playground.generate({ model, style, frames, seed });
           const ms = performance.now() - t;
           const { poseChangePerSecond } = await import('/motion/poseChange.ts');
-          const { jitterCm, judgeFreeze } = await import('/motion/freezeRule.ts');
+          const { jitterCm, judgeFreeze, raisedFootShare } = await import('/motion/freezeRule.ts');
           const J = m.joints.length, p = m.positions;
           let rootMin = Infinity, rootMax = -Infinity;
           for (let f = 0; f < m.frames; f++) {
@@ -50,16 +53,17 @@ async function main() {
             rootMax = Math.max(rootMax, p[f * J * 3 + 1]);
           }
           const verdict = judgeFreeze(poseChangePerSecond(p, J, m.fps), ref);
-          return { ms, frames: m.frames, finite: p.every(Number.isFinite), verdict, jitterCm: jitterCm(p, J), rootHeight: [rootMin, rootMax] };
+          return { ms, frames: m.frames, finite: p.every(Number.isFinite), verdict, jitterCm: jitterCm(p, J), raisedFoot: raisedFootShare(p, m.joints), rootHeight: [rootMin, rootMax] };
         }, { model: MODEL, style, frames: FRAMES, seed, ref });
         const verdict = r.verdict;
-        const row = { style, seed, frames: r.frames, finite: r.finite, generateSeconds: r.ms / 1000, rootHeight: r.rootHeight, jitterVsReal: r.jitterCm / realJitter, ...verdict };
+        const row = { style, seed, frames: r.frames, finite: r.finite, generateSeconds: r.ms / 1000, rootHeight: r.rootHeight, jitterVsReal: r.jitterCm / realJitter, raisedFoot: r.raisedFoot, ...verdict };
         report.runs.push(row);
-        console.log(`${MODEL} ${style} seed ${seed}: ${r.frames} frames in ${fmt(row.generateSeconds, 0)} s, finite ${r.finite}, root ${fmt(r.rootHeight[0])}-${fmt(r.rootHeight[1])} m; low seconds ${fmt(100 * verdict.lowShare, 1)}% (real ${fmt(100 * ref.low_share, 1)}%), longest low ${verdict.longestLowS} s, median ${fmt(verdict.medianRatio)}x real; jitter ${fmt(row.jitterVsReal)}x real; ${verdict.passes ? 'passes' : `FAILS (${['a', 'b', 'c'].filter((k) => !verdict[k]).join(', ')})`}`);
+        console.log(`${MODEL} ${style} seed ${seed}: ${r.frames} frames in ${fmt(row.generateSeconds, 0)} s, finite ${r.finite}, root ${fmt(r.rootHeight[0])}-${fmt(r.rootHeight[1])} m; low seconds ${fmt(100 * verdict.lowShare, 1)}% (real ${fmt(100 * ref.low_share, 1)}%), longest low ${verdict.longestLowS} s, median ${fmt(verdict.medianRatio)}x real; jitter ${fmt(row.jitterVsReal)}x real; a foot raised in ${fmt(100 * r.raisedFoot, 0)}% of frames${realRaised === undefined ? '' : ` (real ${fmt(100 * realRaised, 1)}%)`}; ${verdict.passes ? 'passes' : `FAILS (${['a', 'b', 'c'].filter((k) => !verdict[k]).join(', ')})`}`);
       }
     }
     const passed = report.runs.filter((r) => r.passes && r.finite).length;
-    console.log(`${MODEL}: ${passed}/${report.runs.length} runs pass the fair rule through the page; jitter ${fmt(Math.min(...report.runs.map((r) => r.jitterVsReal)))}-${fmt(Math.max(...report.runs.map((r) => r.jitterVsReal)))}x real`);
+    const range = (key, scale = 1, d = 2) => `${fmt(scale * Math.min(...report.runs.map((r) => r[key])), d)}-${fmt(scale * Math.max(...report.runs.map((r) => r[key])), d)}`;
+    console.log(`${MODEL}: ${passed}/${report.runs.length} runs pass the fair rule through the page; jitter ${range('jitterVsReal')}x real; a foot raised in ${range('raisedFoot', 100, 0)}% of frames`);
   } finally {
     await browser.close();
     await server.close();

@@ -186,3 +186,25 @@ def test_freeze_rule_judges_against_the_real_clips():
     assert (r["low_share"], r["pass_a"], r["pass_b"], r["pass_c"]) == (0.0, True, True, False)
     frozen = np.full(100, 0.01)
     assert not judge(frozen, ref)["pass_a"]
+
+
+def test_raised_foot_share_counts_frames_with_the_higher_ankle_over_the_line(dance):
+    """The pose check beside the freeze rule (issue 42): real salsa almost never holds a foot 0.3 m up, Indian dance
+    and martial arts sometimes; a standing dancer never; one with a foot lifted 0.5 m always; and a tuning setting
+    that lifts a foot too often ranks below one that passes everything else the same."""
+    from training.aclstm.pilots import tuning_score
+    from training.aclstm.raised_foot import raised_foot_share, real_raised_foot
+
+    skel, clips = dance
+    real = real_raised_foot(clips, skel.names)
+    assert real["salsa"] < 0.01 and 0.05 < real["indian"] < 0.3 and 0.02 < real["martial"] < 0.2, real
+    standing = np.stack([c.positions[:1] for c in clips if c.style == "salsa"][:1] * 30)[:, 0]
+    lowest_foot = np.argmin(standing[0, [skel.names.index("lFoot"), skel.names.index("rFoot")], 1])
+    assert raised_foot_share(standing, skel.names) == 0.0
+    lifted = standing.copy()
+    foot = skel.names.index(("rFoot", "lFoot")[lowest_foot])  # the other foot, with its toe
+    lifted[:, [foot, foot + 1], 1] += 0.5
+    assert raised_foot_share(lifted, skel.names) == 1.0
+    run = {"diverged": False, "passes": True, "median_ratio": 1.0, "jitter_vs_real": 1.0, "raised_foot_real": real["salsa"]}
+    assert tuning_score([{**run, "raised_foot_share": 0.05}]) < tuning_score([{**run, "raised_foot_share": 0.6}])
+    assert tuning_score([{**run, "raised_foot_share": 0.6}])[0] == 1  # not feasible

@@ -12,7 +12,7 @@
 import { describe, expect, it } from 'vitest';
 import { CONTACT_THRESHOLDS, detectContacts } from '../../web/motion/contacts';
 import { footSkating, skatingSample } from '../../web/motion/footSkating';
-import { FREEZE_RULE, jitterCm, judgeFreeze, type RealDanceReference } from '../../web/motion/freezeRule';
+import { FREEZE_RULE, jitterCm, judgeFreeze, RAISED_FOOT, raisedFootShare, type RealDanceReference } from '../../web/motion/freezeRule';
 import { PoseChangeMeter, poseChangePerSecond } from '../../web/motion/poseChange';
 import type { Motion } from '../../web/motion/types';
 import { readRepoFile } from './corpus';
@@ -44,6 +44,8 @@ interface SkatingCase extends Clip {
 interface PoseChangeCase extends Clip {
   per_second: number[];
   jitter_cm: number;
+  /** Where the clip has both ankles (lFoot, rFoot). */
+  raised_foot_share?: number;
 }
 interface FreezeCase {
   name: string;
@@ -57,7 +59,10 @@ interface Fixture {
   skating: SkatingCase[];
   skating_pooled: { cases: string[]; skating: number; pairs: number };
   pose_change: PoseChangeCase[];
-  freeze_rule: { constants: { low_fraction: number; share_factor: number; longest_low_s: number; median_fraction: number }; cases: FreezeCase[] };
+  freeze_rule: {
+    constants: { low_fraction: number; share_factor: number; longest_low_s: number; median_fraction: number; raised_foot_m: number; raised_margin: number };
+    cases: FreezeCase[];
+  };
 }
 
 const fixture = JSON.parse(readRepoFile('tests/fixtures/measures_parity.json')) as Fixture;
@@ -163,7 +168,10 @@ describe('per-second pose change: web/motion/poseChange.ts = training/metrics.py
 describe('the dance freeze rule and jitter: web/motion/freezeRule.ts = training/aclstm/freeze_rule.py', () => {
   it('uses the same constants', () => {
     const py = fixture.freeze_rule.constants;
-    expect({ low_fraction: FREEZE_RULE.lowFraction, share_factor: FREEZE_RULE.shareFactor, longest_low_s: FREEZE_RULE.longestLowS, median_fraction: FREEZE_RULE.medianFraction }).toEqual(py);
+    expect({
+      low_fraction: FREEZE_RULE.lowFraction, share_factor: FREEZE_RULE.shareFactor, longest_low_s: FREEZE_RULE.longestLowS, median_fraction: FREEZE_RULE.medianFraction,
+      raised_foot_m: RAISED_FOOT.metres, raised_margin: RAISED_FOOT.margin,
+    }).toEqual(py);
   });
   for (const c of fixture.freeze_rule.cases) {
     it(`judges: ${c.name}`, () => {
@@ -178,6 +186,16 @@ describe('the dance freeze rule and jitter: web/motion/freezeRule.ts = training/
   for (const c of fixture.pose_change) {
     it(`jitter of ${c.name}`, () => {
       expect(Math.abs(jitterCm(positionsOf(c), c.joints.length) - c.jitter_cm)).toBeLessThan(1e-9);
+    });
+  }
+  const withAnkles = fixture.pose_change.filter((c) => c.raised_foot_share !== undefined);
+  it('has raised-foot cases: a real dance clip and one strictly between never and always', () => {
+    expect(withAnkles.length).toBeGreaterThanOrEqual(2);
+    expect(withAnkles.some((c) => c.raised_foot_share! > 0 && c.raised_foot_share! < 1)).toBe(true);
+  });
+  for (const c of withAnkles) {
+    it(`raised-foot share of ${c.name}`, () => {
+      expect(raisedFootShare(positionsOf(c), c.joints)).toBe(c.raised_foot_share);
     });
   }
 });

@@ -21,6 +21,7 @@ from .exporting import SEED_FRAMES, load_dance_model, pick_seeds
 from .freeze_rule import jitter_cm, judge, real_jitter_cm, real_reference
 from .jitter_filter import lowpass_rows
 from .phrase_sampling import PhraseParams, phrase_rollout
+from .raised_foot import raised_foot_limit, raised_foot_share, real_raised_foot
 from .report import BONE_ERROR_LIMIT, HEIGHT_BAND, per_second
 
 
@@ -52,9 +53,10 @@ def rollout(model, meta: dict, seed_frames: np.ndarray, styles: list[str], frame
     return out * std + mean
 
 
-def judge_rollout(f: np.ndarray, style: str, skel, ref: dict, real_jitter: dict) -> dict:
+def judge_rollout(f: np.ndarray, style: str, skel, ref: dict, real_jitter: dict, real_raised: dict | None = None) -> dict:
     """One rollout's features (frames, dim; physical units): divergence (NaN, a root outside HEIGHT_BAND, a second
-    over the limb-length limit), jitter against the style's real clips and the freeze rule's verdicts."""
+    over the limb-length limit), jitter against the style's real clips and the freeze rule's verdicts; with
+    `real_raised` (raised_foot.real_raised_foot) its raised-foot share beside the real one."""
     finite = bool(np.isfinite(f).all())
     pos = decode(np.nan_to_num(f.astype(np.float64)))
     curve = metrics.pose_change_per_second(pos, MODEL_FPS)
@@ -62,7 +64,10 @@ def judge_rollout(f: np.ndarray, style: str, skel, ref: dict, real_jitter: dict)
     height = pos[:, 0, 1]
     diverged = (not finite or float(limb.max()) > BONE_ERROR_LIMIT
                 or not (HEIGHT_BAND[0] <= height.min() and height.max() <= HEIGHT_BAND[1]))
-    return {"style": style, "diverged": diverged, "jitter_vs_real": jitter_cm(pos) / real_jitter[style], **judge(curve, ref[style])}
+    raised = ({"raised_foot_share": raised_foot_share(pos, skel.names), "raised_foot_real": real_raised[style]}
+              if real_raised is not None else {})
+    return {"style": style, "diverged": diverged, "jitter_vs_real": jitter_cm(pos) / real_jitter[style], **raised,
+            **judge(curve, ref[style])}
 
 
 def measure_run(checkpoint: Path, frames: int = 3000, seeds_per_style: int = 3, mocap: str | None = None,
@@ -108,15 +113,21 @@ def measure_run(checkpoint: Path, frames: int = 3000, seeds_per_style: int = 3, 
 TUNING_FRACTIONS = (0.55, 0.7, 0.85)  # of each held-out clip: seed windows apart from pick_seeds' (at most 0.34 of a clip)
 
 
-def tuning_grid(threshold: float = 0.05, rhos: tuple[float, ...] = (0.0, 0.9)) -> list[PhraseParams]:
-    """The phrase sampler's settings tried per style: temperature, longest hold (0.5, 1, 2 s) and AR(1) coefficient
-    (the pilot's grid: white and 0.9; the export's: EXPORT_RHOS)."""
-    return [PhraseParams(t, h, r, threshold) for t in (0.2, 0.35, 0.5, 0.7) for h in (15, 30, 60) for r in rhos]
+def tuning_grid(threshold: float = 0.05, rhos: tuple[float, ...] = (0.0, 0.9),
+                thresholds: tuple[float, ...] | None = None) -> list[PhraseParams]:
+    """The phrase sampler's settings tried per style: temperature, longest hold (0.5, 1, 2 s), AR(1) coefficient
+    (the pilot's grid: white and 0.9; the export's: EXPORT_RHOS) and the weight below which a held component is
+    redrawn (`threshold`, or each of `thresholds`; the export's: EXPORT_THRESHOLDS)."""
+    return [PhraseParams(t, h, r, th) for th in (thresholds or (threshold,))
+            for t in (0.2, 0.35, 0.5, 0.7) for h in (15, 30, 60) for r in rhos]
 
 
 # The export's AR(1) coefficients: white noise never came near the jitter budget in the pilot (3-16x, row 7c), and on
 # the pilot's tuning windows through the output filter rho 0.95-0.98 brought martial's jitter from 1.54x to 1.42x.
 EXPORT_RHOS = (0.9, 0.95, 0.98)
+# The export's redraw thresholds: components drawn with a weight under 0.3 are the ones that lift a foot (salsa's
+# tuning windows: 64-78% of frames with a raised foot at 0.05, 2-14% at 0.3; the real clips 0.2%).
+EXPORT_THRESHOLDS = (0.05, 0.3)
 
 
 def tuning_seeds(clips, style: str, per_style: int = 3) -> np.ndarray:
@@ -134,13 +145,16 @@ def tuning_seeds(clips, style: str, per_style: int = 3) -> np.ndarray:
 
 
 def tuning_score(runs: list[dict], jitter_limit: float = 1.3) -> tuple:
-    """Lower is better: settings whose tuning rollouts all pass (a)–(c) without divergence and with jitter within
-    `jitter_limit` × real come first, closest median to the real one among them; then the fewest failures."""
+    """Lower is better: settings whose tuning rollouts all pass (a)–(c) without divergence, with jitter within
+    `jitter_limit` × real and (where measured) a raised foot no more often than raised_foot_limit allows come first,
+    closest median to the real one among them; then the fewest failures."""
     median = float(np.median([r["median_ratio"] for r in runs]))
     jitter = max(r["jitter_vs_real"] for r in runs)
     fails = sum(r["diverged"] or not r["passes"] for r in runs)
-    feasible = fails == 0 and jitter <= jitter_limit
-    penalty = 10 * sum(r["diverged"] for r in runs) + fails + max(0.0, jitter - jitter_limit)
+    raised_excess = max((max(0.0, r["raised_foot_share"] - raised_foot_limit(r["raised_foot_real"]))
+                         for r in runs if "raised_foot_share" in r), default=0.0)
+    feasible = fails == 0 and jitter <= jitter_limit and raised_excess == 0
+    penalty = 10 * sum(r["diverged"] for r in runs) + fails + max(0.0, jitter - jitter_limit) + 10 * raised_excess
     return (0 if feasible else 1, 0.0 if feasible else penalty, abs(np.log(max(median, 1e-6))))
 
 
@@ -159,7 +173,7 @@ def tune_phrase_filtered(checkpoint: Path, grid: list[PhraseParams], filter_sets
     after the rollout and never fed back, so the rollouts are the same whatever it is."""
     skel, clips = load_clips(mocap)
     model, meta, _ = load_dance_model(checkpoint)
-    ref, real_jitter = real_reference(clips), real_jitter_cm(clips)
+    ref, real_jitter, real_raised = real_reference(clips), real_jitter_cm(clips), real_raised_foot(clips, skel.names)
     rows = [(style, p, seed) for style in STYLES for p in grid for seed in tuning_seeds(clips, style, per_style)]
     drawn, _ = phrase_rollout(model, meta, np.array([r[2] for r in rows]), [r[0] for r in rows], frames, [r[1] for r in rows])
     raw_jitter = [jitter_cm(decode(f.astype(np.float64))) / real_jitter[st] for (st, _, _), f in zip(rows, drawn)]
@@ -174,13 +188,15 @@ def tune_phrase_filtered(checkpoint: Path, grid: list[PhraseParams], filter_sets
             table = []
             for p in grid:
                 mine = [k for k, (st, q, _) in enumerate(rows) if st == style and q == p]
-                runs = [judge_rollout(feats[k], style, skel, ref, real_jitter) for k in mine]
+                runs = [judge_rollout(feats[k], style, skel, ref, real_jitter, real_raised) for k in mine]
                 table.append({"params": p.to_json(), "score": list(tuning_score(runs)),
                               "passes": sum(r["passes"] and not r["diverged"] for r in runs), "runs": len(runs),
                               "diverged": sum(r["diverged"] for r in runs),
                               "median_ratio": float(np.median([r["median_ratio"] for r in runs])),
                               "jitter_vs_real": max(r["jitter_vs_real"] for r in runs),
-                              "jitter_raw_vs_real": max(raw_jitter[k] for k in mine)})
+                              "jitter_raw_vs_real": max(raw_jitter[k] for k in mine),
+                              "raised_foot_share": max(r["raised_foot_share"] for r in runs),
+                              "raised_foot_real": real_raised[style]})
             table.sort(key=lambda t: tuple(t["score"]))
             out[style] = {"best": table[0]["params"], "table": table}
         results.append({"frames": frames, "seeds_per_style": per_style, "fractions": TUNING_FRACTIONS,

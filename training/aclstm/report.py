@@ -23,6 +23,7 @@ from ..data.dance import (LIMB_MIN_LENGTH, MODEL_FPS, STYLES, DanceClip, bone_le
                           held_out_pose_change, load_clips, real_pose_change, resample_positions)
 from ..paths import REPORTS_DIR
 from .freeze_rule import LONGEST_LOW_S, MEDIAN_FRACTION, SHARE_FACTOR, jitter_cm, judge, real_jitter_cm, real_reference
+from .raised_foot import RAISED_FOOT_M, RAISED_MARGIN, raised_foot_share, real_raised_foot
 from .shipped import ShippedDance
 
 FREEZE_FRACTION = 0.2
@@ -76,6 +77,7 @@ def long_runs(model: ShippedDance, skel, frames: int, n_seeds: int, real_change:
                "all_bones_error_mean": float(all_bones.mean()),
                "root_height_min": float(height.min()), "root_height_max": float(height.max()),
                "jitter_vs_real": jitter_cm(pos) / real_jitter[style],
+               "raised_foot_share": raised_foot_share(pos, skel.names),
                **({"jitter_raw_vs_real": jitter_cm(decode(np.nan_to_num(raw[k].astype(np.float64)))) / real_jitter[style]}
                   if raw is not None else {}),
                "pose_change_curve": change.round(4).tolist()}
@@ -131,7 +133,8 @@ def evaluate_dance(models_dir: Path, frames: int, n_seeds: int, mocap: str | Non
     real_change = real_pose_change(clips)
     real_ref = real_reference(clips)
     real_jitter = real_jitter_cm(clips)
-    report = {"real_reference": real_ref, "real_jitter_cm": real_jitter, "frames_per_seed": frames, "fps": MODEL_FPS, "seeds_per_style": n_seeds, "freeze_fraction": FREEZE_FRACTION,
+    report = {"real_reference": real_ref, "real_jitter_cm": real_jitter, "real_raised_foot": real_raised_foot(clips, skel.names),
+              "frames_per_seed": frames, "fps": MODEL_FPS, "seeds_per_style": n_seeds, "freeze_fraction": FREEZE_FRACTION,
               "bone_error_limit": BONE_ERROR_LIMIT, "height_band": HEIGHT_BAND, "real_median_pose_change": real_change,
               "models": {}}
     candidates = [(label, models_dir / f"{model_id}.json") for label, model_id in MODELS.items()] + list(extra)
@@ -177,6 +180,7 @@ def add_to_dance_report(frames: int, n_seeds: int, mocap: str | None, models_dir
     if (report["real_reference"], report["real_jitter_cm"]) != (real_ref, real_jitter):
         raise SystemExit("error: the stored report's rows were judged against another real reference than the clips give "
                          "now (the clips changed); measure every row again with python -m training.aclstm.evaluate")
+    report["real_raised_foot"] = real_raised_foot(clips, skel.names)  # rows measured before it was kept show none
     for label, json_path in rows:
         if not json_path.exists():
             raise SystemExit(f"error: no {json_path}")
@@ -259,9 +263,17 @@ def fair_rule_section(report: dict) -> list[str]:
              + "; ".join(f"{s}: low share {r['low_share']:.1%}, longest low stretch {r['longest_low_s']} s, over "
                          f"{r['seconds']} s" for s, r in ref.items()) + ". A model shown through an output filter (the mdn "
              "head's causal low-pass, `training/aclstm/jitter_filter.py`) is judged on the frames shown; its drawn frames' "
-             "jitter (what the network reads back) is given in brackets.", "",
-             "| model | style | passes | low share per seed | longest low stretch (s) | median / real median | jitter / real |",
-             "|---|---|---|---|---|---|---|"]
+             "jitter (what the network reads back) is given in brackets.", ""]
+    raised = report.get("real_raised_foot")
+    if raised:
+        lines += [f"*Raised foot* (`training/aclstm/raised_foot.py`, since 2026-12-05): the share of frames in which the higher "
+                  f"ankle is more than {RAISED_FOOT_M:g} m above the frame's lowest point. A dancer standing on one leg and "
+                  "waving the other passes (a)–(c) and the jitter budget, so this is the check on the pose itself. Real clips "
+                  "(all of a style's, each alone): " + ", ".join(f"{s} {v:.1%}" for s, v in raised.items())
+                  + f"; a run is judged at most {RAISED_MARGIN:.0%} points above its style's share. \"—\": a row measured "
+                  "before the check existed.", ""]
+    lines += ["| model | style | passes | low share per seed | longest low stretch (s) | median / real median | jitter / real | raised foot |",
+              "|---|---|---|---|---|---|---|---|"]
     for label, m in report["models"].items():
         for style in STYLES:
             rs = [r for r in m["runs"] if r["style"] == style]
@@ -271,7 +283,9 @@ def fair_rule_section(report: dict) -> list[str]:
                          + ", ".join(str(r["rule"]["longest_low_s"]) for r in rs) + " | "
                          + ", ".join(f"{r['rule']['median_ratio']:.0%}" for r in rs) + " | "
                          + ", ".join(f"{r['jitter_vs_real']:.2f}×" + (f" ({r['jitter_raw_vs_real']:.2f}× raw)" if "jitter_raw_vs_real" in r else "")
-                                     for r in rs) + " |")
+                                     for r in rs) + " | "
+                         + (", ".join(f"{r['raised_foot_share']:.0%}" for r in rs) if all("raised_foot_share" in r for r in rs) else "—")
+                         + " |")
     if any("before int8" in label for label in report["models"]):
         lines += ["", "**Weights stored as int8** (issue 19, [weights.md](weights.md)): the shipped files store the weights as int8 "
                   "with a scale per output channel, computed in float32. The rows marked *float32 (before int8)* are the same "
