@@ -191,7 +191,7 @@ def test_freeze_rule_judges_against_the_real_clips():
 def test_raised_foot_share_counts_frames_with_the_higher_ankle_over_the_line(dance):
     """The pose check beside the freeze rule (issue 42): real salsa almost never holds a foot 0.3 m up, Indian dance
     and martial arts sometimes; a standing dancer never; one with a foot lifted 0.5 m always; and a tuning setting
-    that lifts a foot too often ranks below one that passes everything else the same."""
+    that lifts a foot too often, or whose limbs or median come near their limits, ranks below one that passes everything else the same."""
     from training.aclstm.pilots import tuning_score
     from training.aclstm.raised_foot import raised_foot_share, real_raised_foot
 
@@ -208,3 +208,8 @@ def test_raised_foot_share_counts_frames_with_the_higher_ankle_over_the_line(dan
     run = {"diverged": False, "passes": True, "median_ratio": 1.0, "jitter_vs_real": 1.0, "raised_foot_real": real["salsa"]}
     assert tuning_score([{**run, "raised_foot_share": 0.05}]) < tuning_score([{**run, "raised_foot_share": 0.6}])
     assert tuning_score([{**run, "raised_foot_share": 0.6}])[0] == 1  # not feasible
+    # Limbs: a tuning run's worst second must keep a margin below the report's limit (long runs have worse seconds).
+    assert tuning_score([{**run, "raised_foot_share": 0.0, "limb_worst_second": 0.20}])[0] == 0
+    assert tuning_score([{**run, "raised_foot_share": 0.0, "limb_worst_second": 0.24}])[0] == 1
+    # Energy: a median just over rule (c)'s floor in Python falls under it through the page's skeleton fit.
+    assert tuning_score([{**run, "raised_foot_share": 0.0, "median_ratio": 0.52}])[0] == 1

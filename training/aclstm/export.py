@@ -3,7 +3,7 @@
     python -m training.aclstm.export [--run aclstm] [--id aclstm]
     python -m training.aclstm.export --run aclstm-vanilla --id aclstm-vanilla
     python -m training.aclstm.export --id aclstm --from-shipped [--weights int8]   # no checkpoint: rewrite the shipped file
-    python -m training.aclstm.export --checkpoint runs/aclstm-mdn/last.pt --id aclstm-mdn [--out DIR] [--tune-frames 1200]
+    python -m training.aclstm.export --checkpoint runs/aclstm-mdn-dt35-s1/last.pt --id aclstm-mdn [--out DIR] [--tune-frames 3000]
 
 An mdn head (issue 42) also gets its sampling block (phrase parameters tuned per style on held-out windows, the
 output filter per style) and its parity fixture (tests/fixtures/aclstm_mdn_reference.json when written into
