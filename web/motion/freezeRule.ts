@@ -71,16 +71,16 @@ export const RAISED_FOOT = { metres: 0.3, margin: 0.15, ankles: ['lFoot', 'rFoot
 
 /** Share of frames of frames × joints × 3 positions (m, y up) with the higher ankle above RAISED_FOOT.metres. */
 export function raisedFootShare(positions: ArrayLike<number>, joints: readonly string[]): number {
-  const ankles = RAISED_FOOT.ankles.map((name) => joints.indexOf(name));
-  if (ankles.some((j) => j < 0)) throw new Error(`raisedFootShare: no ${RAISED_FOOT.ankles.filter((_, k) => ankles[k] < 0).join(' or ')} joint`);
+  const [left, right] = RAISED_FOOT.ankles.map((name) => joints.indexOf(name));
+  if (left < 0 || right < 0) throw new Error(`raisedFootShare: no ${left < 0 ? RAISED_FOOT.ankles[0] : RAISED_FOOT.ankles[1]} joint`);
   const J = joints.length;
   const frames = Math.floor(positions.length / (J * 3));
+  const height = (f: number, j: number) => positions[(f * J + j) * 3 + 1];
   let raised = 0;
   for (let f = 0; f < frames; f++) {
     let lowest = Infinity;
-    for (let j = 0; j < J; j++) lowest = Math.min(lowest, positions[(f * J + j) * 3 + 1]);
-    const higher = Math.max(...ankles.map((j) => positions[(f * J + j) * 3 + 1]));
-    if (higher - lowest > RAISED_FOOT.metres) raised++;
+    for (let j = 0; j < J; j++) lowest = Math.min(lowest, height(f, j));
+    if (Math.max(height(f, left), height(f, right)) - lowest > RAISED_FOOT.metres) raised++;
   }
   return raised / frames;
 }
