@@ -1,5 +1,5 @@
-"""Lighter model files (training/onnx/compact.py): weights stored as float16 or int8 come back as the float32 values
-the graph computes with, and a dance model reads back from its file whatever the format."""
+"""Lighter model files (training/onnx/compact.py): weights stored as float16, int8 or int4 come back as the float32
+values the graph computes with, and a dance model reads back from its file whatever the format."""
 import numpy as np
 import onnx
 import pytest
@@ -9,7 +9,8 @@ from onnx import TensorProto, helper, numpy_helper
 from training.aclstm.exporting import export_onnx
 from training.aclstm.graph import check_parity, dance_model_from_onnx
 from training.models.aclstm import DanceLSTM, DanceStep
-from training.onnx.compact import compact_weights, quantise_int8, stored_float_weights, weight_format
+from training.onnx.compact import (INT4_BLOCK, compact_weights, dequantise_int4, quantise_int4, quantise_int8,
+                                   stored_float_weights, weight_format)
 from training.onnx.sessions import cpu_session
 
 
@@ -56,7 +57,42 @@ def test_int8_scales_per_channel():
     assert q[0, 0] == 127 and q[0, 1] == -127
 
 
-@pytest.mark.parametrize("fmt", ["float32", "float16", "int8"])
+def test_int4_packs_two_levels_a_byte_and_the_graph_unpacks_them(tmp_path):
+    rng = np.random.default_rng(1)
+    w = rng.normal(size=(171, 40)).astype(np.float32)  # 171 rows: the last block is padded
+    w[:, 5] *= 30
+    packed, scale = quantise_int4(w)
+    blocks = -(-171 // INT4_BLOCK)
+    assert packed.dtype == np.uint8 and packed.shape == (blocks * INT4_BLOCK // 2, 40)
+    assert scale.dtype == np.float16 and scale.shape == (blocks, 1, 40)
+    stored = dequantise_int4(packed, scale, 171)
+    step = np.repeat(scale[:, 0].astype(np.float32), INT4_BLOCK, axis=0)[:171]
+    assert np.all(np.abs(stored - w) <= step / 2 + 1e-6)  # each weight at its nearest level of its block
+    assert np.allclose(stored[:, 5] / step[:, 5], np.rint(stored[:, 5] / step[:, 5]))
+    compact = compact_weights(matmul_model(w), "int4")
+    assert weight_format(compact) == "int4" and np.array_equal(stored_float_weights(compact)["w"], stored)
+    path = tmp_path / "m.onnx"
+    onnx.save(compact, path)
+    assert path.stat().st_size < w.size * 0.6 + 3000
+    x = rng.normal(size=(5, 171)).astype(np.float32)
+    assert np.abs(cpu_session(path).run(None, {"x": x})[0] - x @ stored).max() < 1e-4
+
+
+def test_int4_gptq_keeps_the_output_on_the_given_inputs_closer_than_plain_rounding():
+    rng = np.random.default_rng(2)
+    w = rng.normal(size=(64, 32)).astype(np.float32)
+    mix = np.eye(64) + 0.4 * rng.normal(size=(64, 64))  # correlated inputs, as hidden states are
+    x = rng.normal(size=(4000, 64)) @ mix
+    held = rng.normal(size=(1000, 64)) @ mix
+    error = lambda stored: np.sqrt(np.mean((held @ stored - held @ w) ** 2))
+    plain = dequantise_int4(*quantise_int4(w), 64)
+    gptq = dequantise_int4(*quantise_int4(w, x.T @ x / len(x)), 64)
+    assert error(gptq) < 0.85 * error(plain)
+    with pytest.raises(ValueError, match="int4 stores 2-D weights"):
+        compact_weights(matmul_model(np.ones((1, 64, 64), np.float32)), "int4")
+
+
+@pytest.mark.parametrize("fmt", ["float32", "float16", "int8", "int4"])
 def test_dance_graph_parity_and_read_back(tmp_path, fmt):
     torch.manual_seed(2)
     model = DanceLSTM(9, 3, hidden=64, layers=3).eval()
@@ -68,7 +104,7 @@ def test_dance_graph_parity_and_read_back(tmp_path, fmt):
     h, c = model.zero_state(2)
     with torch.no_grad():
         a, b = DanceStep(model)(x, style, h, c)[0], DanceStep(stored)(x, style, h, c)[0]
-    assert (a - b).abs().max() < {"float32": 1e-6, "float16": 1e-2, "int8": 5e-2}[fmt]
+    assert (a - b).abs().max() < {"float32": 1e-6, "float16": 1e-2, "int8": 5e-2, "int4": 0.5}[fmt]
 
 
 def test_gaussian_head_dance_graph_draws_from_the_given_normals(tmp_path):
@@ -128,3 +164,24 @@ def test_generator_int8_keeps_its_mixture_head_float16(tmp_path):
     assert {"fc3_mu.weight_t.f16", "fc3_log_sigma.weight_t.f16", "lstm0_ih.weight_t.i8"} <= names
     assert "fc3_logits.weight_t" in HEAD_WEIGHTS
     assert check_parity(model_from_onnx(path, 40, 64, 3), path)["max_abs_diff"] < 1e-4
+
+
+def test_dance_input_moments_cover_every_large_weight_of_the_step_graph():
+    """calibration.input_moments gives the second moment of what each large weight of the dance graph multiplies
+    (training clips only), by the graph's names and with the weights' row counts."""
+    from training.aclstm.calibration import input_moments
+    from training.aclstm.graph import dance_graph
+    from training.data.dance import DanceClip
+
+    torch.manual_seed(3)
+    model = DanceLSTM(171, 3, hidden=16, layers=3).eval()
+    rng = np.random.default_rng(4)
+    walk = lambda n: np.cumsum(rng.normal(scale=0.01, size=(n, 57, 3)), axis=0) + [0, 0.9, 0]
+    clips = [DanceClip(style, f"{style}/{k}.bvh", 60.0, walk(700), held_out=(k == 1)) for style in ("salsa", "indian", "martial") for k in range(2)]
+    moments = input_moments(model, clips, np.zeros(171), np.ones(171))
+    inits = {t.name: t for t in dance_graph(model).graph.initializer}
+    large = {n for n, t in inits.items() if np.prod(t.dims) >= 16 * 16 * 4 and n != "lstm0.w_style_t"}
+    assert set(moments) == large
+    for name, m in moments.items():
+        assert m.shape == (inits[name].dims[0],) * 2, name
+        assert np.allclose(m, m.T) and np.linalg.eigvalsh(m).min() > -1e-9, name

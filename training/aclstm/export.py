@@ -36,7 +36,7 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     model_id = args.id or args.run
     if args.from_shipped is not None:
-        onnx_path = rewrite_dance_model(args.from_shipped, model_id, args.out, args.weights)
+        onnx_path = rewrite_dance_model(args.from_shipped, model_id, args.out, args.weights, args.mocap)
         print(f"wrote {onnx_path} ({onnx_path.stat().st_size / 1e6:.2f} MB) and {model_id}.json")
         return
     checkpoint = Path(args.checkpoint)

@@ -20,6 +20,7 @@ from ..onnx.compact import compact_weights, weight_format
 from ..onnx.manifest import register_model
 from ..onnx.sessions import cpu_session
 from ..paths import MODELS_DIR, REPO_ROOT
+from .calibration import input_moments
 from .graph import (MDN_OUTPUTS, OUTPUTS, check_parity, dance_graph, dance_model_from_onnx, graph_inputs, graph_outputs,
                     mdn_torch_steps)
 
@@ -38,10 +39,11 @@ def load_dance_model(checkpoint: Path) -> tuple[DanceLSTM, dict, dict]:
     return model.eval(), meta, state
 
 
-def export_onnx(model: DanceLSTM, path: Path, weights: str = "float32") -> DanceLSTM:
-    """Writes the step graph with its large weights stored as `weights`; returns the network the file computes
-    (the weights as stored), the reference for the parity check."""
-    onnx.save(compact_weights(dance_graph(model), weights), str(path))
+def export_onnx(model: DanceLSTM, path: Path, weights: str = "float32", hessians: dict | None = None) -> DanceLSTM:
+    """Writes the step graph with its large weights stored as `weights` (int4: rounded by `hessians`, the input
+    moments of calibration.input_moments, when given); returns the network the file computes (the weights as
+    stored), the reference for the parity check."""
+    onnx.save(compact_weights(dance_graph(model), weights, hessians=hessians), str(path))
     return dance_model_from_onnx(path, model.dim, model.styles, model.hidden, model.layers)
 
 
@@ -108,13 +110,24 @@ def training_minutes(checkpoint: Path, iteration: int | None) -> float | None:
     return None if minutes is None else round(minutes, 1)
 
 
-def write_dance_graph(model: DanceLSTM, onnx_path: Path, weights: str) -> tuple[dict, dict]:
-    """Writes and parity-checks the graph; returns the JSON's `onnx` and `parity` fields."""
-    stored = export_onnx(model, onnx_path, weights)
+def write_dance_graph(model: DanceLSTM, onnx_path: Path, weights: str, clips: list[DanceClip] | None = None,
+                      normalisation: tuple | None = None) -> tuple[dict, dict]:
+    """Writes and parity-checks the graph; returns the JSON's `onnx` and `parity` fields. int4 weights are rounded
+    to keep the layers' outputs on the training `clips` (calibration.py), which then must be given with the
+    model's (mean, std) `normalisation`."""
+    hessians = None
+    if weights == "int4":
+        try:
+            hessians = input_moments(model, clips, *normalisation)
+        except ValueError as e:
+            raise SystemExit(f"error: int4 weights: {e}")
+    stored = export_onnx(model, onnx_path, weights, hessians)
     parity = {**check_parity(stored, onnx_path), "reference": f"torch with the weights as stored ({weights})"}
     print(f"parity ok: max |torch - onnxruntime| = {parity['max_abs_diff']:.2e}")
     fields = {"inputs": graph_inputs(model), "outputs": graph_outputs(model), "opset": 17, "layers": model.layers, "hidden": model.hidden,
               "dim": model.dim, "styles": model.styles, "head": model.head, "weights": weight_format(onnx.load(str(onnx_path))),
+              **({"weights_rounding": "GPTQ on the inputs of the training clips, teacher-forced and free-running "
+                                      "(training/aclstm/calibration.py)"} if hessians else {}),
               "style_input": "one-hot over `styles`; x and ys are normalised features",
               "steps_input": "int64 (1,): steps run in the call, each output frame fed back as the next input; "
                              "ys is (steps, batch, dim)"}
@@ -160,8 +173,8 @@ def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | 
     model, meta, state = load_dance_model(checkpoint)
     out.mkdir(parents=True, exist_ok=True)
     onnx_path = out / f"{model_id}.onnx"
-    onnx_fields, parity = write_dance_graph(model, onnx_path, weights)
     _, clips = load_clips(mocap)
+    onnx_fields, parity = write_dance_graph(model, onnx_path, weights, clips, (meta["mean"], meta["std"]))
     vanilla = meta["args"]["condition"] == 0
     info = {
         "id": model_id, "kind": "aclstm", "fps": meta["fps"], "file": onnx_path.name,
@@ -194,15 +207,18 @@ def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | 
     return onnx_path
 
 
-def rewrite_dance_model(source: Path, model_id: str, out: Path, weights: str) -> Path:
+def rewrite_dance_model(source: Path, model_id: str, out: Path, weights: str, mocap: str | None = None) -> Path:
     """The exported model `source`/<model_id>.{json,onnx} written again with this graph and weight format, without
-    its checkpoint: the network is read back from the ONNX file, everything else of the JSON is kept."""
+    its checkpoint: the network is read back from the ONNX file, everything else of the JSON is kept. (int4 reads
+    the training clips, from `mocap`, to round by.)"""
     info = json.loads((source / f"{model_id}.json").read_text())
     o = info["onnx"]
     model = dance_model_from_onnx(source / info["file"], o["dim"], o["styles"], o["hidden"], o["layers"])
     out.mkdir(parents=True, exist_ok=True)
     onnx_path = out / f"{model_id}.onnx"
-    info["onnx"], info["parity"] = write_dance_graph(model, onnx_path, weights)
+    clips = load_clips(mocap)[1] if weights == "int4" else None
+    norm = (info["normalisation"]["mean"], info["normalisation"]["std"])
+    info["onnx"], info["parity"] = write_dance_graph(model, onnx_path, weights, clips, norm)
     info["file"] = onnx_path.name
     _publish(info, onnx_path, model_id, out)
     return onnx_path

@@ -1,9 +1,15 @@
-"""Lighter model files: large float32 weights stored as float16 or int8 and turned back into float32 inside the graph.
+"""Lighter model files: large float32 weights stored as float16, int8 or int4 and turned back into float32 inside the
+graph.
 
 Each stored weight keeps its graph name; a small node chain right at the start of the graph makes it again:
 
 - float16: `NAME.f16` --Cast(float)--> NAME
 - int8: `NAME.i8` --Cast(float)--> * `NAME.scale` --> NAME, one scale per output channel (symmetric, max |w| / 127)
+- int4 (2-D weights whose output channels are the last axis, e.g. a Gemm's (in, out) right-hand side): blocks of
+  INT4_BLOCK input rows share one float16 scale per output channel (symmetric, max |w| / 7), levels -7..7 stored
+  as 1..15. Two levels share a byte: row r in the low four bits and row r + P/2 in the high four (P: the rows padded
+  to whole blocks), so the chain only needs arithmetic that every runtime has: `NAME.i4` --Cast, /16, Floor--> the
+  high rows, the rest the low rows, Concat, -8, * `NAME.i4scale` per block, Slice back to the real rows --> NAME.
 
 Both chains depend on initialisers only, so onnxruntime (and onnxruntime-web) folds them into float32 constants
 when the session is created: the arithmetic stays float32 and a call costs what it did; only the download shrinks.
@@ -19,7 +25,8 @@ import onnx
 from onnx import TensorProto, helper, numpy_helper
 
 MIN_ELEMENTS = 4096
-FORMATS = ("float32", "float16", "int8")
+FORMATS = ("float32", "float16", "int8", "int4")
+INT4_BLOCK = 32
 
 
 def _channel_axis(model: onnx.ModelProto, name: str, rank: int) -> int:
@@ -55,9 +62,72 @@ def quantise_int8(w: np.ndarray, axis: int) -> tuple[np.ndarray, np.ndarray]:
     return np.clip(np.rint(w / scale), -127, 127).astype(np.int8), scale
 
 
-def compact_weights(model: onnx.ModelProto, fmt: str, overrides: dict[str, str] | None = None) -> onnx.ModelProto:
+def quantise_int4(w: np.ndarray, hessian: np.ndarray | None = None, damping: float = 0.01) -> tuple[np.ndarray, np.ndarray]:
+    """(in, out) float32 -> packed uint8 (P/2, out) and float16 scales (P/INT4_BLOCK, 1, out); see the module docstring.
+
+    With `hessian` (in, in), the mean of x x^T over inputs x that the weight multiplies (x @ w), the rounding is
+    GPTQ's (Frantar et al. 2023): rows are rounded in order and each row's rounding error is pushed onto the rows
+    not yet rounded, weighted by the inverse Hessian, so that x @ w changes as little as possible on such inputs
+    rather than w itself. Without it, each weight is rounded to its nearest level."""
+    rows, cols = w.shape
+    padded = -(-rows // INT4_BLOCK) * INT4_BLOCK
+    work = np.zeros((padded, cols), np.float64)
+    work[:rows] = w
+    inverse = None
+    if hessian is not None:
+        h = hessian.astype(np.float64) + damping * np.mean(np.diag(hessian)) * np.eye(rows)
+        # Upper Cholesky factor of H^-1: row i holds how row i's error spreads onto the rows after it.
+        inverse = np.linalg.cholesky(np.linalg.inv(h)).T
+    levels = np.zeros((padded, cols), np.int64)
+    scale = np.ones((padded // INT4_BLOCK, 1, cols), np.float16)
+    for i in range(padded):
+        block = i // INT4_BLOCK
+        if i % INT4_BLOCK == 0:  # the block's scales from its rows as they stand now (updated by earlier errors)
+            top = np.abs(work[i:i + INT4_BLOCK]).max(axis=0) / 7.0
+            scale[block, 0] = np.where(top > 0, top, 1.0).astype(np.float16)
+        s = scale[block, 0].astype(np.float64)
+        levels[i] = np.clip(np.rint(work[i] / s), -7, 7)
+        if inverse is not None and i < rows - 1:
+            error = (work[i] - levels[i] * s) / inverse[i, i]
+            work[i + 1:rows] -= np.outer(inverse[i, i + 1:rows], error)
+    stored = (levels + 8).astype(np.uint8)
+    return stored[:padded // 2] | (stored[padded // 2:] << 4), scale
+
+
+def dequantise_int4(packed: np.ndarray, scale: np.ndarray, rows: int) -> np.ndarray:
+    """The float32 (rows, out) weight that the int4 chain computes (numpy's twin of _int4_nodes)."""
+    levels = np.concatenate([packed & 15, packed >> 4]).astype(np.float32) - 8.0
+    blocks = levels.reshape(scale.shape[0], INT4_BLOCK, -1) * scale.astype(np.float32)
+    return blocks.reshape(-1, blocks.shape[-1])[:rows]
+
+
+def _int4_nodes(name: str, rows: int, padded: int, cols: int) -> tuple[list, list]:
+    """The node chain (and its small constants) that makes NAME from NAME.i4 and NAME.i4scale."""
+    c = lambda value, suffix, dtype=np.float32: numpy_helper.from_array(np.array(value, dtype), f"{name}.i4_{suffix}")
+    consts = [c(16.0, "sixteen"), c(8.0, "eight"), c([padded // INT4_BLOCK, INT4_BLOCK, cols], "blocks", np.int64),
+              c([padded, cols], "padded", np.int64), c([0], "start", np.int64), c([rows], "rows", np.int64),
+              c([0], "axis", np.int64)]
+    n = lambda op, inputs, output, **kw: helper.make_node(op, inputs, [f"{name}.i4_{output}"], **kw)
+    nodes = [n("Cast", [f"{name}.i4"], "byte", to=TensorProto.FLOAT),
+             n("Div", [f"{name}.i4_byte", f"{name}.i4_sixteen"], "div"),
+             n("Floor", [f"{name}.i4_div"], "high"),
+             n("Mul", [f"{name}.i4_high", f"{name}.i4_sixteen"], "high16"),
+             n("Sub", [f"{name}.i4_byte", f"{name}.i4_high16"], "low"),
+             n("Concat", [f"{name}.i4_low", f"{name}.i4_high"], "stored", axis=0),
+             n("Sub", [f"{name}.i4_stored", f"{name}.i4_eight"], "levels"),
+             n("Reshape", [f"{name}.i4_levels", f"{name}.i4_blocks"], "blocked"),
+             n("Cast", [f"{name}.i4scale"], "scale", to=TensorProto.FLOAT),
+             n("Mul", [f"{name}.i4_blocked", f"{name}.i4_scale"], "scaled"),
+             n("Reshape", [f"{name}.i4_scaled", f"{name}.i4_padded"], "full"),
+             helper.make_node("Slice", [f"{name}.i4_full", f"{name}.i4_start", f"{name}.i4_rows", f"{name}.i4_axis"], [name])]
+    return nodes, consts
+
+
+def compact_weights(model: onnx.ModelProto, fmt: str, overrides: dict[str, str] | None = None,
+                    hessians: dict[str, np.ndarray] | None = None) -> onnx.ModelProto:
     """A copy of `model` with every float32 initialiser of MIN_ELEMENTS or more stored as `fmt`, or as
-    `overrides[name]` for the weights it names (a layer the coarser format measurably hurts)."""
+    `overrides[name]` for the weights it names (a layer the coarser format measurably hurts). `hessians`: for int4,
+    the input second moments of the weights it names (quantise_int4's GPTQ rounding)."""
     overrides = overrides or {}
     for f in {fmt, *overrides.values()}:
         if f not in FORMATS:
@@ -75,6 +145,13 @@ def compact_weights(model: onnx.ModelProto, fmt: str, overrides: dict[str, str] 
         if stored == "float16":
             kept.append(numpy_helper.from_array(w.astype(np.float16), f"{init.name}.f16"))
             nodes.append(helper.make_node("Cast", [f"{init.name}.f16"], [init.name], to=TensorProto.FLOAT))
+        elif stored == "int4":
+            if w.ndim != 2 or _channel_axis(model, init.name, w.ndim) != 1:
+                raise ValueError(f"int4 stores 2-D weights with output channels last; {init.name} is {w.shape}")
+            packed, scale = quantise_int4(w, (hessians or {}).get(init.name))
+            chain, consts = _int4_nodes(init.name, w.shape[0], 2 * packed.shape[0], w.shape[1])
+            kept += [numpy_helper.from_array(packed, f"{init.name}.i4"), numpy_helper.from_array(scale, f"{init.name}.i4scale"), *consts]
+            nodes += chain
         else:
             q, scale = quantise_int8(w, _channel_axis(model, init.name, w.ndim))
             kept += [numpy_helper.from_array(q, f"{init.name}.i8"), numpy_helper.from_array(scale, f"{init.name}.scale")]
@@ -98,6 +175,8 @@ def stored_float_weights(model: onnx.ModelProto) -> dict[str, np.ndarray]:
             out[name[:-4]] = value.astype(np.float32)
         elif name.endswith(".i8"):
             out[name[:-3]] = value.astype(np.float32) * inits[f"{name[:-3]}.scale"]
+        elif name.endswith(".i4"):
+            out[name[:-3]] = dequantise_int4(value, inits[f"{name}scale"], int(inits[f"{name}_rows"][0]))
     return out
 
 
@@ -105,14 +184,15 @@ def float_initializers(model: onnx.ModelProto) -> dict[str, np.ndarray]:
     """Every initialiser by its graph name as float32, the stored ones (see module docstring) turned back into the
     values the graph computes with: what reading the weights of any export needs, whatever its format."""
     inits = {t.name: numpy_helper.to_array(t) for t in model.graph.initializer}
-    out = {n: v.astype(np.float32) for n, v in inits.items() if not n.endswith((".f16", ".i8", ".scale"))}
+    out = {n: v.astype(np.float32) for n, v in inits.items()
+           if not n.endswith((".f16", ".i8", ".scale", ".i4", ".i4scale")) and ".i4_" not in n}
     return out | stored_float_weights(model)
 
 
 def weight_format(model: onnx.ModelProto) -> str:
-    """How the file stores its large weights: 'int8', 'float16', 'float32', or for a mix e.g. 'int8+float16'."""
+    """How the file stores its large weights: 'int4', 'int8', 'float16', 'float32', or for a mix e.g. 'int8+float16'."""
     names = [t.name for t in model.graph.initializer]
-    formats = [f for f, suffix in (("int8", ".i8"), ("float16", ".f16")) if any(n.endswith(suffix) for n in names)]
+    formats = [f for f, suffix in (("int4", ".i4"), ("int8", ".i8"), ("float16", ".f16")) if any(n.endswith(suffix) for n in names)]
     return "+".join(formats) or "float32"
 
 
