@@ -1,5 +1,5 @@
-// End-to-end tests of the dance models in the page: playground.generate with acLSTM and its vanilla
-// baseline, onnxruntime-web parity in the browser, argument errors, and the Dance mode (streaming, the
+// End-to-end tests of the dance models in the page: playground.generate with the acLSTM models (deterministic and
+// sampled), onnxruntime-web parity in the browser, argument errors, and the Dance mode (streaming, the
 // pose-change plot, switching style and model, Export BVH). Run with `npm run test:e2e`.
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
@@ -82,7 +82,7 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
 
   test('models() lists both dance models with their styles', async () => {
     const models = await suite.page.evaluate(() => window.playground.models());
-    for (const id of ['aclstm', 'aclstm-vanilla']) {
+    for (const id of ['aclstm-mdn', 'aclstm']) {
       const m = models.find((x) => x.id === id);
       assert.ok(m, `${id} is listed`);
       assert.equal(m.kind, 'aclstm');
@@ -117,18 +117,11 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
     const b = await digest(suite.page, { model: 'aclstm', style: 'indian', frames: 90, seed: 1 });
     const wrapped = await digest(suite.page, { model: 'aclstm', style: 'indian', frames: 90, seed: 1 + count });
     const other = await digest(suite.page, { model: 'aclstm', style: 'indian', frames: 90, seed: 2 });
-    const vanilla = await digest(suite.page, { model: 'aclstm-vanilla', style: 'indian', frames: 90, seed: 1 });
+    const sampled = await digest(suite.page, { model: 'aclstm-mdn', style: 'indian', frames: 90, seed: 1 });
     assert.deepEqual(a, b, 'the same arguments give byte-identical positions');
     assert.deepEqual(wrapped, a, `seed ${1 + count} is seed 1 again (${count} indian seed motions)`);
     assert.notDeepEqual(other, a, 'another seed motion gives another dance');
-    assert.notDeepEqual(vanilla, a, 'the vanilla baseline dances differently');
-  });
-
-  test('the vanilla baseline generates at exact bone lengths too', async () => {
-    const m = await summarise(suite.page, { model: 'aclstm-vanilla', style: 'martial', frames: 120, seed: 0 });
-    assert.equal(m.length, 120 * 57 * 3);
-    assert.ok(m.finite);
-    assert.ok(m.worstBone < 1e-4, `worst bone error ${m.worstBone}`);
+    assert.notDeepEqual(sampled, a, 'the sampled model dances differently from the same seed motion');
   });
 
   test('ONNX parity in the browser: one step and a many-step call match the Python reference within 1e-4', async () => {
@@ -173,7 +166,7 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
       { model: 'aclstm', style: 'salsa', frames: 10 },
       { model: 'aclstm', style: 'salsa', frames: 10, seed: 0, temperature: 0.5 },
       { model: 'aclstm', style: 'salsa', frames: 10, seed: 0, refine: false },
-      { model: 'aclstm-vanilla', style: 'salsa', frames: 10, seed: 0, tempo: 2 },
+      { model: 'aclstm-mdn', style: 'salsa', frames: 10, seed: 0, tempo: 2 },
       { model: 'generator', style: 'salsa', frames: 10, seed: 0 },
       { model: 'aclstm-plus', style: 'salsa', frames: 10, seed: 0 },
     ];
@@ -197,7 +190,7 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
     assert.match(m[8], /seed must be an integer .* got undefined/);
     assert.match(m[9], /^generate: temperature is not meaningful for acLSTM models/);
     assert.match(m[10], /^generate: refine is not available for acLSTM models/);
-    assert.match(m[11], /^generate: unknown option "tempo" for model "aclstm-vanilla" \(known: model, style, frames, seed, signal\)/);
+    assert.match(m[11], /^generate: unknown option "tempo" for model "aclstm-mdn" \(known: model, style, frames, seed, signal\)/);
     assert.match(m[12], /^generate: style is not an option of model "generator": it has no styles; leave it out$/);
     assert.match(m[13], /^generate: unknown model "aclstm-plus" \(available: .*\baclstm\b.*\)/);
     assert.equal(results.same, true, 'current() is unchanged');
@@ -289,16 +282,16 @@ describe('dance models in the page', { timeout: 300_000 }, () => {
     assert.ok(restarted.seconds <= restarted.frame / INFO.fps + 1, `the plot restarted (${restarted.seconds} s plotted at frame ${restarted.frame})`);
     await waitUntil(suite.page, () => Number($ui('dance-plot').dataset.seconds) >= 1, null, { timeout: 30_000, message: 'the new plot gains a second' });
 
-    // The vanilla baseline runs in the same mode.
-    await suite.page.selectOption('#dance-model', 'aclstm-vanilla');
-    await waitUntil(suite.page, () => $ui('clip-meta').textContent.includes('vanilla'), null, { timeout: 60_000, message: 'the baseline is shown' });
-    // The switch shows at once; the baseline's stream starts once its model has loaded (no fixed deadline).
+    // The deterministic acLSTM runs in the same mode.
+    await suite.page.selectOption('#dance-model', 'aclstm');
+    await waitUntil(suite.page, () => $ui('clip-meta').textContent.includes('deterministic'), null, { timeout: 60_000, message: 'the deterministic model is shown' });
+    // The switch shows at once; its stream starts once its model has loaded (no fixed deadline).
     const g1 = await status(suite.page);
     await waitUntil(suite.page, (from) => Number($ui('dance-status').dataset.frame) > from + 30, g1, {
       timeout: 60_000,
-      message: `the baseline's dance advances 30 frames from frame ${g1}`,
+      message: `the deterministic model's dance advances 30 frames from frame ${g1}`,
     });
-    assert.match(await suite.page.locator('#clip-meta').textContent(), /vanilla/, 'the baseline dances too');
+    assert.match(await suite.page.locator('#clip-meta').textContent(), /deterministic/, 'the deterministic model dances too');
 
     await suite.page.click('#mode-clip');
     const back = await suite.page.evaluate(() => ({ frames: window.playground.current()?.frames, dance: $uiFrame().classList.contains('dance-mode') }));

@@ -89,8 +89,8 @@ describe('the model registry', () => {
 
   it('offers each shipped model where its descriptor says, in manifest order', () => {
     const registry = new Registry(MANIFEST);
-    expect(registry.ids('generate')).toEqual(['aclstm-mdn', 'aclstm', 'aclstm-vanilla', 'generator', 'style-generator', 'latent-erd', 'vae-lstm']);
-    expect(registry.ids('dance')).toEqual(['aclstm-mdn', 'aclstm', 'aclstm-vanilla']);
+    expect(registry.ids('generate')).toEqual(['aclstm-mdn', 'aclstm', 'generator', 'style-generator', 'latent-erd', 'vae-lstm']);
+    expect(registry.ids('dance')).toEqual(['aclstm-mdn', 'aclstm']);
     expect(registry.defaultFor('dance')?.info.id).toBe('aclstm-mdn'); // issue 42: Dance starts with the sampled model
     expect(registry.ids('followPath')).toEqual(['generator', 'style-generator', 'latent-erd', 'vae-lstm']);
     expect(registry.ids('liveControl')).toEqual(['generator', 'style-generator', 'latent-erd']);
@@ -100,7 +100,7 @@ describe('the model registry', () => {
     // The refiner and the autoencoder are parts of other models: listed in the manifest, offered nowhere.
     expect(registry.find('refiner')).toBeUndefined();
     expect(registry.shortName('latent-erd')).toBe('latent ERD');
-    expect(registry.label('aclstm-vanilla')).toBe('vanilla LSTM (baseline)');
+    expect(registry.label('aclstm')).toBe('acLSTM (deterministic)');
   });
 
   it('says what each shipped model was trained on and under what licence; a non-commercial model is labelled so', () => {
@@ -132,8 +132,8 @@ describe('the model registry', () => {
     const kinds = descriptorsByKind({ './test_dancer/descriptor.ts': { descriptor: dancer }, ...Object.fromEntries([...descriptorsByKind()].map(([k, d]) => [`./${k}/descriptor.ts`, { descriptor: d }])) });
     const entry: ModelInfo = { id: 'my-dancer', kind: 'test-dancer', skeleton: 'aclstm-standard', fps: 30, styles: ['salsa'], bytes: 1 };
     const registry = new Registry([...MANIFEST, entry], kinds);
-    expect(registry.ids('dance')).toEqual(['aclstm-mdn', 'aclstm', 'aclstm-vanilla', 'my-dancer']);
-    expect(new Registry(MANIFEST, kinds).ids('dance')).toEqual(['aclstm-mdn', 'aclstm', 'aclstm-vanilla']); // not listed: not offered
+    expect(registry.ids('dance')).toEqual(['aclstm-mdn', 'aclstm', 'my-dancer']);
+    expect(new Registry(MANIFEST, kinds).ids('dance')).toEqual(['aclstm-mdn', 'aclstm']); // not listed: not offered
     expect(() => descriptorsByKind({ './a/descriptor.ts': { descriptor: dancer }, './b/descriptor.ts': { descriptor: dancer } })).toThrow(/two descriptors of kind "test-dancer"/);
   });
 });

@@ -42,10 +42,14 @@ describe('view state (attributes and links)', () => {
   test('a model the mode does not have is refused (the shipped models, by what their descriptors say they do)', () => {
     const manifest = parseManifest(JSON.parse(readFileSync(resolve(__dirname, '../../public/models/index.json'), 'utf8')));
     const models = modeModels(new Registry(manifest));
-    expect(models).toEqual({ clip: [], walk: ['generator', 'style-generator'], dance: ['aclstm-mdn', 'aclstm', 'aclstm-vanilla'], path: ['generator', 'style-generator', 'latent-erd', 'vae-lstm'], steer: ['generator', 'style-generator', 'latent-erd'] });
+    expect(models).toEqual({ clip: [], walk: ['generator', 'style-generator'], dance: ['aclstm-mdn', 'aclstm'], path: ['generator', 'style-generator', 'latent-erd', 'vae-lstm'], steer: ['generator', 'style-generator', 'latent-erd'] });
     const { view, errors } = parseView((k) => ({ mode: 'steer', model: 'vae-lstm' })[k as 'mode'] ?? null, models);
     expect(view).toEqual({ mode: 'steer' });
     expect(errors).toEqual(['model="vae-lstm": steer mode shows generator, style-generator, latent-erd']);
+    // A link made before 2026-12-05 may name the vanilla baseline, no longer shipped: said, and Dance opens its default.
+    const old = parseView((k) => ({ mode: 'dance', model: 'aclstm-vanilla', style: 'salsa' })[k as 'mode'] ?? null, models);
+    expect(old.view).toEqual({ mode: 'dance', style: 'salsa' });
+    expect(old.errors).toEqual(['model="aclstm-vanilla": dance mode shows aclstm-mdn, aclstm']);
   });
 
   test('a path too short or too far is refused by the path rules', () => {

@@ -54,7 +54,7 @@ export interface CancellableOptions {
 }
 
 export interface GenerateOptions extends CancellableOptions {
-  /** A model id from `models()` that generates: of kind "lstm-gmm" ("generator"), "aclstm" ("aclstm", "aclstm-vanilla"), "latent-erd" ("latent-erd") or "vae-lstm" ("vae-lstm"). */
+  /** A model id from `models()` that generates: of kind "lstm-gmm" ("generator"), "aclstm" ("aclstm-mdn", "aclstm"), "latent-erd" ("latent-erd") or "vae-lstm" ("vae-lstm"). */
   model: string;
   /** Number of frames, an integer 1…100000. */
   frames: number;

@@ -1,5 +1,5 @@
 /// <reference lib="webworker" />
-// Runs a dance model (acLSTM or its vanilla baseline) off the main thread with onnxruntime-web's wasm
+// Runs a dance model (an acLSTM, or a dropped dance pack) off the main thread with onnxruntime-web's wasm
 // execution provider (setup and the requests are shared with the generator worker: ortWorker.ts).
 import { DanceCore } from './danceCore';
 import { loadDanceInfo } from './danceModel';

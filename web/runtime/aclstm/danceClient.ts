@@ -1,4 +1,4 @@
-// Main-thread handle on a dance model's worker (acLSTM or the vanilla baseline): promise methods
+// Main-thread handle on a dance model's worker (an acLSTM, or a dropped dance pack): promise methods
 // (ModelClient; requests matched to replies by id: WorkerClient).
 import type { Motion } from '../../motion/types';
 import type { DanceChunk, DanceInitResult, DanceParityResult, DanceStepInputs, DanceStreamInfo, DanceStreamParams } from './danceProtocol';

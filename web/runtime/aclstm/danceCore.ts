@@ -1,4 +1,4 @@
-// The dance models' step loop (acLSTM and its vanilla baseline), independent of where it runs: an
+// The dance models' step loop (the acLSTM models and dance packs), independent of where it runs: an
 // onnxruntime session, the feature decoder and the skeleton fit. dance.worker.ts wraps it in messages;
 // unit tests drive it directly with onnxruntime-web's Node build. The loop is training/aclstm/shipped.py's:
 // h = c = 0, the seed motion's frames are fed one by one (normalised), then each output is one new

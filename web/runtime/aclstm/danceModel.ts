@@ -1,4 +1,4 @@
-// The dance models' description files (public/models/aclstm.json and aclstm-vanilla.json, written by
+// The dance models' description files (public/models/aclstm.json and aclstm-mdn.json, written by
 // python -m training.aclstm.export): skeleton, ONNX step signature, feature layout, normalisation, the seed
 // motions per style and the real pose change per style. `parseDanceInfo` checks everything the runtime
 // relies on and names the first bad field. A sampled model (issue 42: `head: "mdn"`, a mixture-density head with

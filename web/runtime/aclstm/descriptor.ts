@@ -1,5 +1,5 @@
-// The acLSTM (Zhou et al.: an auto-conditioned LSTM for endless dance) and its vanilla-LSTM baseline as
-// the page offers them: generate in a style, and Dance mode's endless stream. Deterministic models: the seed picks
+// The acLSTM (Zhou et al.: an auto-conditioned LSTM for endless dance) as the page offers it (and any dance model
+// of this kind, e.g. a dropped dance pack): generate in a style, and Dance mode's endless stream. Deterministic models: the seed picks
 // the seed motion; a sampled one (head "mdn", issue 42) also seeds its random draws with it.
 
 import { describeValue } from '../../motion/describe';
@@ -9,7 +9,7 @@ import { DanceClient } from './danceClient';
 export const descriptor: ModelDescriptor<DanceClient> = {
   kind: 'aclstm',
   shortName: 'acLSTM',
-  labels: { 'aclstm-mdn': 'acLSTM, phrase sampling', aclstm: 'acLSTM (deterministic)', 'aclstm-vanilla': 'vanilla LSTM (baseline)' },
+  labels: { 'aclstm-mdn': 'acLSTM, phrase sampling', aclstm: 'acLSTM (deterministic)' },
   capabilities: ['generate', 'dance'],
   createClient: (entry, threads) => new DanceClient({ ...clientFiles(entry, threads), model: entry.id }),
 

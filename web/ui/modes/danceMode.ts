@@ -1,6 +1,6 @@
-// Dance mode: a dance model (acLSTM, or the vanilla LSTM baseline for comparison) dances endlessly in
+// Dance mode: a dance model (the sampled acLSTM, the deterministic one for comparison, or a dropped dance pack) dances endlessly in
 // its worker (LiveMode) at the model's 30 fps, shown at the display's rate; the viewer shows the last ~20 s of the fitted skeleton, and a small
-// plot shows the pose change per second against real dance (the baseline's curve falls to the freeze
+// plot shows the pose change per second against real dance (a frozen dance's curve falls to the freeze
 // line within seconds: it stops moving).
 
 import { PoseChangeMeter } from '../../motion/poseChange';
