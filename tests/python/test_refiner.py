@@ -367,3 +367,32 @@ def test_training_streams_hold_their_normals_as_the_page_does():
     torch.multinomial(torch.full((b, m), 0.5), 1, generator=gen)
     fresh = torch.randn(b, d, generator=gen)
     assert torch.allclose(z1, 0.8 * z0 + 0.6 * fresh, atol=1e-6)
+
+
+def test_a_style_model_s_training_streams_come_in_every_style_from_that_style_s_clips(tmp_path, monkeypatch):
+    """Issue 39: a refiner for the style generator learns from streams in every style, an equal share each, each warmed
+    up on real frames of its own style and drawn in that style."""
+    from types import SimpleNamespace
+
+    import training.refiner.streams as streams
+    from training.models.generator import MixtureLSTM
+
+    monkeypatch.setattr(streams, "DEFAULT_CACHE", tmp_path)
+    dim, warmup = 6, 4
+    # Two styles whose real frames differ by their level: style 0 near -3, style 1 near +3 (normalised units).
+    train = [np.full((12, dim), -3.0 if k % 2 == 0 else 3.0, np.float32) for k in range(6)]
+    corpus = SimpleNamespace(train=train, train_styles=np.array([0, 1] * 3), weights=np.full(6, 1 / 6),
+                             mean=np.zeros(dim), std=np.ones(dim))
+    torch.manual_seed(0)
+    model = MixtureLSTM(dim, 16, 2, styles=2, style_dim=3).eval()
+    args = SimpleNamespace(streams=8, window=5, long_streams=2, warmup=warmup)
+    short, long = streams.generated_cache(model, corpus, args, "train", styles=2, tag="_test")
+    assert short.shape == (8, args.window + 30 + 1, dim) and long.shape == (2, 1201, dim)
+    # Frame 0 is the last real warm-up frame: the first half of each set from style 0's clips, the rest from style 1's.
+    assert np.all(short[:4, 0, :-2] == -3.0) and np.all(short[4:, 0, :-2] == 3.0)
+    assert long[0, 0, 0] == -3.0 and long[1, 0, 0] == 3.0
+    # Each share is drawn in its own style: the same warm-up under the other style's embedding gives other frames.
+    other = streams.generate_streams(streams.StyledGenerator(model, 1), corpus, 4, 35, warmup, streams.TEMPERATURE, 1,
+                                     pool=[0, 2, 4])
+    assert np.all(other[:, 0, :-2] == -3.0) and np.abs(other[:, 1:] - short[:4, 1:]).max() > 1e-3
+    assert any(p.name.startswith("refiner_generated_test_") for p in tmp_path.iterdir())

@@ -24,10 +24,12 @@ NOISE_SIGMA = 0.05
 
 
 def load_generator(checkpoint: Path) -> tuple[MixtureLSTM, dict, dict]:
-    """The model (eval mode), its meta and the whole checkpoint dictionary."""
+    """The model (eval mode), its meta and the whole checkpoint dictionary; a style generator's checkpoint (issue 39,
+    meta with `styles`) gives the model with its style input."""
     state = torch.load(checkpoint, weights_only=False)
     meta = state["meta"]
-    model = MixtureLSTM(meta["dim"], meta["hidden"], meta["mixtures"])
+    styles = len(meta.get("styles", ()))
+    model = MixtureLSTM(meta["dim"], meta["hidden"], meta["mixtures"], styles=styles, style_dim=meta.get("style_dim", 8))
     model.load_state_dict(state["model"])
     return model.eval(), meta, state
 

@@ -10,7 +10,7 @@ from tqdm import tqdm
 
 from ..data.locomotion import Corpus
 from ..generator.sampling import NOISE_CORRELATION
-from ..models.generator import MixtureLSTM
+from ..models.generator import MixtureLSTM, StyledGenerator
 from ..paths import DEFAULT_CACHE
 
 TEMPERATURE = 0.5
@@ -32,17 +32,18 @@ def sample_torch(logits, mu, log_sigma, temperature: float, gen: torch.Generator
 
 @torch.no_grad()
 def generate_streams(model: MixtureLSTM, corpus: Corpus, streams: int, frames: int, warmup: int,
-                     temperature: float, seed: int, batch: int = 512, correlation: float = NOISE_CORRELATION) -> np.ndarray:
+                     temperature: float, seed: int, batch: int = 512, correlation: float = NOISE_CORRELATION,
+                     pool: list[int] | None = None) -> np.ndarray:
     """(streams, frames + 1, D) normalised: frame 0 is the last real warm-up frame, then `frames` sampled ones.
-    Each stream is teacher-forced on `warmup` real frames of a random training window, then runs free with
-    the contact bits snapped to clean 0/1 and its normals held over frames with `correlation`, as
-    generator/shipped.ShippedGenerator (and the page) sample."""
+    Each stream is teacher-forced on `warmup` real frames of a random training window (of the sequences `pool`
+    names, default all), then runs free with the contact bits snapped to clean 0/1 and its normals held over frames
+    with `correlation`, as generator/shipped.ShippedGenerator (and the page) sample."""
     rng = np.random.default_rng(seed)
     gen = torch.Generator().manual_seed(seed)
     mean, std = torch.tensor(corpus.mean, dtype=torch.float32), torch.tensor(corpus.std, dtype=torch.float32)
     lo, hi = (0 - mean[-2:]) / std[-2:], (1 - mean[-2:]) / std[-2:]
     out = np.zeros((streams, frames + 1, len(mean)), np.float32)
-    long_enough = [k for k, s in enumerate(corpus.train) if len(s) > warmup]
+    long_enough = [k for k in (range(len(corpus.train)) if pool is None else pool) if len(corpus.train[k]) > warmup]
     p = corpus.weights[long_enough] / corpus.weights[long_enough].sum()
     for a in tqdm(range(0, streams, batch), desc="generating", unit="batch"):
         b = min(batch, streams - a)
@@ -64,8 +65,11 @@ def generate_streams(model: MixtureLSTM, corpus: Corpus, streams: int, frames: i
     return out
 
 
-def generated_cache(model: MixtureLSTM, corpus: Corpus, args: argparse.Namespace, kind: str) -> list[np.ndarray]:
-    """Cached generated streams: 'train' (many short streams plus some long ones) or 'valid' (own seed)."""
+def generated_cache(model: MixtureLSTM, corpus: Corpus, args: argparse.Namespace, kind: str,
+                    styles: int = 0, tag: str = "") -> list[np.ndarray]:
+    """Cached generated streams: 'train' (many short streams plus some long ones) or 'valid' (own seed). A style
+    model (`styles` > 0, its corpus a StyleCorpus) draws each style's equal share of the streams in that style, warmed
+    up on that style's training sequences; `tag` names the model in the cache file."""
     if kind == "train":
         specs = [(args.streams, args.window + 30, 1), (args.long_streams, 1200, 2)]
     else:
@@ -73,11 +77,17 @@ def generated_cache(model: MixtureLSTM, corpus: Corpus, args: argparse.Namespace
     arrays = []
     for streams, frames, seed in specs:
         rho = f"_rho{NOISE_CORRELATION}" if NOISE_CORRELATION else ""  # the streams before held normals had no suffix
-        path = DEFAULT_CACHE / f"refiner_generated_t{TEMPERATURE}{rho}_{streams}x{frames}_w{args.warmup}_s{seed}.npz"
+        path = DEFAULT_CACHE / f"refiner_generated{tag}_t{TEMPERATURE}{rho}_{streams}x{frames}_w{args.warmup}_s{seed}.npz"
         if path.exists():
             arrays.append(np.load(path)["x"])
             continue
-        x = generate_streams(model, corpus, streams, frames, args.warmup, TEMPERATURE, seed)
+        if styles:
+            x = np.concatenate([
+                generate_streams(StyledGenerator(model, s), corpus, len(share), frames, args.warmup, TEMPERATURE, seed + 1000 * s,
+                                 pool=[k for k, style in enumerate(corpus.train_styles) if style == s])
+                for s, share in enumerate(np.array_split(np.arange(streams), styles))])
+        else:
+            x = generate_streams(model, corpus, streams, frames, args.warmup, TEMPERATURE, seed)
         DEFAULT_CACHE.mkdir(parents=True, exist_ok=True)
         np.savez_compressed(path, x=x)
         arrays.append(x)

@@ -19,6 +19,9 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_run_arguments(parser, run="refiner", minutes=50.0)
     parser.add_argument("--generator", type=Path, default=RUNS_DIR / "generator" / "best.pt")
+    parser.add_argument("--style-generator", type=Path, default=None, metavar="CHECKPOINT",
+                        help="train against a style generator's motion instead (issue 39, e.g. runs/style-pilot/best.pt): "
+                             "streams in every style, an equal share each, against real windows of every style")
     parser.add_argument("--hidden", type=int, default=96, help="refiner width (FC1 and LSTM)")
     parser.add_argument("--d-hidden", type=int, default=64, help="discriminator width (FC1 and each LSTM direction)")
     parser.add_argument("--window", type=int, default=90, help="frames per refiner window (from a zero state)")

@@ -52,6 +52,7 @@ import torch
 import torch.nn.functional as F
 
 from ..data.locomotion import Corpus, load_clips
+from ..data.style_locomotion import StyleCorpus, load_styled_clips
 from ..generator.training import load_generator
 from ..models.refiner import ConvDiscriminator, Discriminator, FeatureGeometry, JointFeatures, Refiner, discriminator_input, discriminator_inputs
 from ..runs import TrainingLoop
@@ -145,8 +146,16 @@ class RefinerTraining:
         # Threads, run directory, seed and clock; the refiner keeps its own checkpoints (two networks, D's buffer).
         self.loop = TrainingLoop(args)
         self.run = self.loop.run
-        generator, gmeta, _ = load_generator(args.generator)
-        corpus = Corpus(load_clips(args.mocap))
+        styles, tag = 0, ""
+        if args.style_generator:  # issue 39: R learns from the style model's motion in every style, against real
+            # windows of every style drawn as its training drew them (each style an equal share)
+            generator, gmeta, _ = load_generator(args.style_generator)
+            corpus = StyleCorpus(load_styled_clips(args.mocap), np.array(gmeta["references"]),
+                                 cmu_share=gmeta["args"].get("cmu_share"))
+            styles, tag = len(gmeta["styles"]), f"_{Path(args.style_generator).parent.name}"
+        else:
+            generator, gmeta, _ = load_generator(args.generator)
+            corpus = Corpus(load_clips(args.mocap))
         if np.abs(corpus.mean - np.array(gmeta["mean"])).max() > 1e-5:
             raise SystemExit("error: the corpus's normalisation differs from the generator's; was the cache rebuilt?")
         mean, std, refs = np.array(gmeta["mean"]), np.array(gmeta["std"]), np.array(gmeta["references"])
@@ -155,8 +164,8 @@ class RefinerTraining:
         self.rng = self.loop.seed()
         self.real = WindowSampler(corpus.train, args.window, corpus.weights)
         self.real_crop = WindowSampler(corpus.train, args.crop, corpus.weights)
-        self.fake = WindowSampler(streams_to_seqs(generated_cache(generator, corpus, args, "train")), args.window)
-        valid_fake = generated_cache(generator, corpus, args, "valid")[0]
+        self.fake = WindowSampler(streams_to_seqs(generated_cache(generator, corpus, args, "train", styles, tag)), args.window)
+        valid_fake = generated_cache(generator, corpus, args, "valid", styles, tag)[0]
         valid_real = WindowSampler(corpus.valid, args.crop)
         self.vx, self.vxp = torch.from_numpy(valid_fake[:, 1:]), torch.from_numpy(valid_fake[:, 0])
         self.vr = valid_real(np.random.default_rng(7), 256)
@@ -178,7 +187,8 @@ class RefinerTraining:
         self.meta = {"dim": self.refiner.dim, "hidden": args.hidden, "d_hidden": args.d_hidden, "fps": gmeta["fps"],
                      "mean": mean.tolist(), "std": std.tolist(), "references": refs.tolist(),
                      "end_effectors": self.refiner.geometry.end_names, "end_mean": end_mean.tolist(),
-                     "end_std": end_std.tolist(), "temperature": TEMPERATURE, "generator": str(args.generator),
+                     "end_std": end_std.tolist(), "temperature": TEMPERATURE,
+                     "generator": str(args.style_generator or args.generator), **({"styles": gmeta["styles"]} if styles else {}),
                      "valid_files": corpus.valid_files,
                      "args": {k: (str(v) if isinstance(v, Path) else v) for k, v in vars(args).items()}}
         self.half = args.batch // 2

@@ -19,7 +19,7 @@ import torch
 from ..data.style_locomotion import load_styled_clips
 from ..onnx.compact import FORMATS
 from .exporting import export_style_generator
-from .training import load_style_generator
+from ..generator.training import load_generator
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -35,7 +35,7 @@ def main(argv: list[str] | None = None) -> None:
     torch.set_num_threads(args.threads)
     if not args.checkpoint.exists():
         raise SystemExit(f"error: no checkpoint at {args.checkpoint}; train first with python -m training.style_generator.train")
-    model, meta, state = load_style_generator(args.checkpoint)
+    model, meta, state = load_generator(args.checkpoint)
     onnx_path, info = export_style_generator(model, meta, state, load_styled_clips(args.mocap), args.out, args.id, args.weights)
     print(f"wrote {onnx_path} ({onnx_path.stat().st_size / 1e6:.2f} MB) and {args.id}.json: styles {', '.join(info['styles'])}, "
           f"{len(info['seeds'])} seeds")

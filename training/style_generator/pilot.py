@@ -2,6 +2,8 @@
 the numbers to docs/models/style-generator-pilot.json.
 
     python -m training.style_generator.pilot --checkpoint runs/style-pilot/best.pt [--frames 1500] [--steps 1500]
+    python -m training.style_generator.pilot --checkpoint runs/style-pilot/best.pt --refiner runs/style-refiner-joints/best.pt \
+        --out docs/models/style-refiner-pilot.json     # also the style model's motion locked, refined, refined + locked
 
 What is measured, and how both models are sampled alike, is in training/style_generator/pilots.py: held-out NLL per
 style, the refiner report's two-sample test cut down (one classifier seed, --frames per seed), the hip-bob spectrum,
@@ -17,6 +19,7 @@ import torch
 
 from ..data.style_locomotion import STYLES
 from ..paths import REPORTS_DIR
+from ..refiner.pilots import CheckpointRefiner
 from .pilots import PILOT_FRAMES, TEMPERATURE, measure, shipped_candidate, style_candidate
 
 
@@ -28,6 +31,9 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--classifier-seeds", type=int, default=1, help="classifiers per test (the report uses 3)")
     parser.add_argument("--temperature", type=float, default=TEMPERATURE, help="sampling temperature of both models (the page's 0.5)")
     parser.add_argument("--styles", default=",".join(STYLES), help="styles the style generator is sampled in")
+    parser.add_argument("--refiner", type=Path, default=None,
+                        help="a refiner training checkpoint (python -m training.refiner.train --style-generator ...): the style "
+                             "model's streams are also measured with the foot lock, refined, and refined with the lock")
     parser.add_argument("--out", type=Path, default=REPORTS_DIR / "style-generator-pilot.json")
     parser.add_argument("--mocap", default=None)
     parser.add_argument("--threads", type=int, default=1, help="torch CPU threads (more than the free cores slows it badly)")
@@ -40,9 +46,15 @@ def main(argv: list[str] | None = None) -> None:
             raise SystemExit(f"error: no checkpoint at {args.checkpoint}")
         cands.append(style_candidate(args.checkpoint))
         styles[cands[1].name] = [s for s in args.styles.split(",") if s]
+    refiner = None
+    if args.refiner is not None:
+        if args.checkpoint is None or not args.refiner.exists():
+            raise SystemExit(f"error: --refiner needs --checkpoint and an existing refiner checkpoint ({args.refiner})")
+        refiner = CheckpointRefiner(args.refiner)
     result = measure(cands, styles, args.frames, steps=args.steps, mocap=args.mocap,
-                     classifier_seeds=args.classifier_seeds, temperature=args.temperature)
+                     classifier_seeds=args.classifier_seeds, temperature=args.temperature, refiner=refiner)
     result["checkpoint"] = str(args.checkpoint) if args.checkpoint else None
+    result["refiner"] = str(args.refiner) if args.refiner else None
     args.out.write_text(json.dumps(result, indent=1) + "\n")
     print(f"wrote {args.out} ({result['minutes']:.1f} min)")
 

@@ -34,13 +34,15 @@ from ..data.style_locomotion import STYLES, StyledClip, load_styled_clips
 from ..generator.exporting import estimate_initial_state, pick_seeds
 from ..generator.recovery import model_from_onnx
 from ..generator.sampling import draw_mixture, held_normals, snap_contacts
+from ..footlock import plant_feet
 from ..generator.shipped import DecodedMotion
 from ..mocap.rotations import quat_to_matrix
 from ..mocap.skeleton import canonical_skeleton
 from ..models.generator import MixtureLSTM, StyledGenerator, mixture_nll
 from ..paths import MODELS_DIR
 from ..refiner.measures import WINDOW, classifier_frames, motion_windows, two_sample_accuracy, windows
-from .training import load_style_generator, nll_per_clip
+from ..generator.training import load_generator
+from .training import nll_per_clip
 
 TEMPERATURE = 0.5
 PILOT_FRAMES = 1500
@@ -77,7 +79,7 @@ def shipped_candidate(models_dir: Path = MODELS_DIR) -> Candidate:
 
 
 def style_candidate(checkpoint: Path) -> Candidate:
-    model, meta, _ = load_style_generator(checkpoint)
+    model, meta, _ = load_generator(checkpoint)
     if list(meta["styles"]) != list(STYLES):
         raise ValueError(f"{checkpoint}: styles {meta['styles']} are not {list(STYLES)}")
     refs = np.array(meta["references"], np.float64)
@@ -212,12 +214,29 @@ def physical_nll(cand: Candidate, clips: list[StyledClip], style: str) -> float:
     return total / count + float(np.log(cand.std).sum())
 
 
+def locked_variants(cand: Candidate, physical: np.ndarray, refined: np.ndarray | None) -> dict[str, list[DecodedMotion]]:
+    """'raw + foot lock' and, with `refined` features, 'refined' and 'refined + foot lock' of streams (B, frames, dim),
+    as the page shows them (footlock.plant_feet on the decoded frames, refiner/report.decode_variants' rule)."""
+    out = {"raw + foot lock": []} | ({"refined": [], "refined + foot lock": []} if refined is not None else {})
+    skel = canonical_skeleton()
+    for k in range(len(physical)):
+        for name, feats in (("raw", physical[k]),) + ((("refined", refined[k]),) if refined is not None else ()):
+            motion = decode(cand, feats)
+            if name == "refined":
+                out[name].append(motion)
+            locked, labels = plant_feet(motion.positions, motion.contacts, 30.0, skel)
+            out[f"{name} + foot lock"].append(DecodedMotion(motion.features, locked, labels))
+    return out
+
+
 def measure(cands: list[Candidate], styles_by_cand: dict[str, list[str]], frames: int = PILOT_FRAMES,
             classifier_seed: int = 0, steps: int | None = None, mocap: str | None = None, classifier_seeds: int = 1,
-            temperature: float = TEMPERATURE,
+            temperature: float = TEMPERATURE, refiner=None,
             log=lambda line: print(line, flush=True)) -> dict:
     """Every measure above, for each candidate on each of its styles (the shipped one: CMU only, since it has no
-    style input; its NLL on every style all the same)."""
+    style input; its NLL on every style all the same). `refiner` (anything with refiner/pilots.CheckpointRefiner's
+    refine): the style candidate's streams are also measured with the foot lock, refined, and refined with the lock
+    (two-sample test and sliding by both measures, `variants`)."""
     t0 = time.perf_counter()
     clips = load_styled_clips(mocap)
     fps = 30.0
@@ -230,7 +249,11 @@ def measure(cands: list[Candidate], styles_by_cand: dict[str, list[str]], frames
         real_test = motion_windows(real, fps)
         summ = motion_summary(real, fps)
         real_cache[style] = (real_test, summ)
-        out["real"][style] = {"held_out_clips": len(real), "held_out_windows": len(real_test), **summ, "hip_bob": hip_bob(real_test, fps)}
+        skel = canonical_skeleton()
+        out["real"][style] = {"held_out_clips": len(real), "held_out_windows": len(real_test), **summ, "hip_bob": hip_bob(real_test, fps),
+                              "low_foot_sliding": float(np.concatenate([metrics.low_foot_speeds(s.positions, fps, skel) for s in real]).mean()),
+                              "foot_skating_by_contacts": float(np.concatenate([metrics.planted_toe_speeds(s.positions, s.contacts, fps, skel)
+                                                                                for s in real]).mean())}
     for cand in cands:
         m = out["models"][cand.name] = {"nll": {s: physical_nll(cand, clips, s) for s in STYLES}, "styles": {}}
         log(f"{cand.name}: held-out NLL per frame (physical) " + ", ".join(f"{s} {v:.1f}" for s, v in m["nll"].items()))
@@ -243,6 +266,11 @@ def measure(cands: list[Candidate], styles_by_cand: dict[str, list[str]], frames
         start = initial_states(cand, seeds)
         streams = [sample(cand, start, frames, np.random.default_rng(s), temperature) for s in STREAM_SEEDS]
         log(f"{cand.name}: sampled {len(seeds)} streams x {frames} frames x 2 sets ({(time.perf_counter() - t0) / 60:.1f} min)")
+        variants = None
+        if refiner is not None and cand.styled:
+            seed_physical = start[0].numpy() * cand.std + cand.mean  # the frame before each stream's first
+            variants = [locked_variants(cand, s, refiner.refine(s, seed_physical)) for s in streams]
+            log(f"{cand.name}: refined and locked ({(time.perf_counter() - t0) / 60:.1f} min)")
         for style in measured:
             rows = [k for k, (s, _) in enumerate(names) if s == style]
             var_a = [decode(cand, streams[0][k]) for k in rows]
@@ -259,6 +287,22 @@ def measure(cands: list[Candidate], styles_by_cand: dict[str, list[str]], frames
                  "hip_bob": hip_bob(test_w, fps),
                  **motion_summary(var_a, fps, FREEZE_FRACTION * line if line else None),
                  "windows": {"real_train": len(real_train), "real_test": len(real_test), "generated": len(test_w)}}
+            if variants is not None:
+                r["variants"] = {}
+                for v in variants[0]:
+                    va, vb = [variants[0][v][k] for k in rows], [variants[1][v][k] for k in rows]
+                    tw, bw = motion_windows(va, fps), motion_windows(vb, fps)
+                    r["variants"][v] = {
+                        **{kind: float(np.mean([two_sample_accuracy(real_train, bw, real_test, tw, classifier_seed + k, steps=steps,
+                                                                    kind=kind)["balanced_accuracy"] for k in range(classifier_seeds)]))
+                           for kind in ("window", "frame")},
+                        "low_foot_sliding": float(np.concatenate([metrics.low_foot_speeds(s.positions, fps, canonical_skeleton())
+                                                                  for s in va]).mean()),
+                        "foot_skating_by_contacts": float(np.concatenate([metrics.planted_toe_speeds(s.positions, s.contacts, fps, canonical_skeleton())
+                                                                          for s in va]).mean()),
+                        "hip_bob": hip_bob(tw, fps)}
+                    log(f"{cand.name} [{style}] {v}: two-sample windows {100 * r['variants'][v]['window']:.1f}% "
+                        f"frames {100 * r['variants'][v]['frame']:.1f}%, lowest-foot sliding {r['variants'][v]['low_foot_sliding']:.3f} m/s")
             m["styles"][style] = r
             log(f"{cand.name} [{style}]: two-sample windows {100 * acc['window']:.1f}% frames {100 * acc['frame']:.1f}%, "
                 f"hip bob {r['hip_bob']}, root speed {r['root_speed_mean']:.2f} (real {real_summ['root_speed_mean']:.2f}) "

@@ -39,15 +39,6 @@ def shipped_references(models_dir: Path = MODELS_DIR) -> np.ndarray:
     return quat_to_matrix(np.array(info["features"]["references"], np.float64))
 
 
-def load_style_generator(checkpoint: Path) -> tuple[MixtureLSTM, dict, dict]:
-    """The model (eval mode), its meta and the whole checkpoint dictionary."""
-    state = torch.load(checkpoint, weights_only=False)
-    meta = state["meta"]
-    model = MixtureLSTM(meta["dim"], meta["hidden"], meta["mixtures"], styles=len(meta["styles"]), style_dim=meta["style_dim"])
-    model.load_state_dict(state["model"])
-    return model.eval(), meta, state
-
-
 def nll_per_clip(model, seqs: list[np.ndarray], styles: np.ndarray | None) -> list[tuple[float, int]]:
     """(summed NLL, frames) of each held-out sequence under `model` (teacher forcing, no noise); `styles` None for a
     model without a style input."""
