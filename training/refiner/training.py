@@ -36,6 +36,11 @@ The generated streams are drawn as the page draws them, normals held over frames
 NOISE_CORRELATION); streams drawn with fresh normals every frame (the refiner of 2026-11 was trained on those) are
 cached under names without the _rho suffix.
 
+With --style-generator (issue 39), R learns from the style generator's motion instead: the streams come in every
+style, an equal share each, each warmed up on real windows of its own style (streams.generated_cache), against real
+windows of every style drawn as the style model's training drew them (data/style_locomotion.StyleCorpus). R itself
+has no style input: one refiner for every style.
+
 Writes runs/refiner/{train.log, checkpoint.pt, best.pt, last.pt}; best.pt is the checkpoint with the lowest
 validation skating (contact share within 0.1 of the generator's). Longer training lowers that measure but makes
 the motion easier to tell from real motion (docs/models/refiner.md), so the shipped model is an early best.pt,
