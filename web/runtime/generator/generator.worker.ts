@@ -33,8 +33,9 @@ serveModel({
     // A user's pack (blob: URLs) has no refiner beside it: refine is refused when asked.
     const refinerInfoUrl = URL.canParse('refiner.json', generatorInfoUrl) ? new URL('refiner.json', generatorInfoUrl).href : null;
     const loadPackRefiner = () => Promise.reject(new Error("refine is not available for your own model (a pack has no refiner)"));
-    // The refiner beside a style generator learnt from the CMU-only generator's output: none is trained for it yet (issue 39).
-    if (info.styles) return new GeneratorCore(session, info, ort.Tensor, threads, { loadRefiner: () => Promise.reject(new Error(`refine is not available for the style generator "${info.id}" yet (no refiner was trained on its output)`)) });
+    // The refiner beside a style generator learnt from the CMU-only generator's output. One trained on the style model's
+    // output made it no harder to tell from capture, so none is shipped (issue 39; docs/models/style-generator.md).
+    if (info.styles) return new GeneratorCore(session, info, ort.Tensor, threads, { loadRefiner: () => Promise.reject(new Error(`refine is not available for the style generator "${info.id}" (no refiner for it is shipped)`)) });
     return new GeneratorCore(session, info, ort.Tensor, threads, { loadRefiner: (core) => (refinerInfoUrl ? loadRefiner(refinerInfoUrl, core.info, threads) : loadPackRefiner()) });
   },
   streamParams: (r: StreamParams): StreamParams => ({ seed: r.seed, temperature: r.temperature, seedIndex: r.seedIndex, ...(r.refine === undefined ? {} : { refine: r.refine }), ...(r.style === undefined ? {} : { style: r.style }) }),
