@@ -68,7 +68,11 @@ def test_int4_packs_two_levels_a_byte_and_the_graph_unpacks_them(tmp_path):
     stored = dequantise_int4(packed, scale, 171)
     step = np.repeat(scale[:, 0].astype(np.float32), INT4_BLOCK, axis=0)[:171]
     assert np.all(np.abs(stored - w) <= step / 2 + 1e-6)  # each weight at its nearest level of its block
-    assert np.allclose(stored[:, 5] / step[:, 5], np.rint(stored[:, 5] / step[:, 5]))
+    # One scale per block and output channel, max |w| / 7 of that block's rows: the loud channel keeps its own.
+    for b in range(blocks):
+        rows = w[b * INT4_BLOCK:(b + 1) * INT4_BLOCK]
+        assert np.allclose(scale[b, 0].astype(np.float32), np.abs(rows).max(axis=0) / 7, rtol=1e-3)
+    assert scale[:, 0, 5].min() > 10 * np.delete(scale[:, 0], 5, axis=1).max()
     compact = compact_weights(matmul_model(w), "int4")
     assert weight_format(compact) == "int4" and np.array_equal(stored_float_weights(compact)["w"], stored)
     path = tmp_path / "m.onnx"
@@ -88,6 +92,19 @@ def test_int4_gptq_keeps_the_output_on_the_given_inputs_closer_than_plain_roundi
     plain = dequantise_int4(*quantise_int4(w), 64)
     gptq = dequantise_int4(*quantise_int4(w, x.T @ x / len(x)), 64)
     assert error(gptq) < 0.85 * error(plain)
+    # The Cholesky form equals GPTQ's textbook form: after each row, its rounding error spread by the inverse Hessian
+    # and that row eliminated from the inverse (Schur complement).
+    h = x.T @ x / len(x)
+    inverse = np.linalg.inv(h + 0.01 * np.mean(np.diag(h)) * np.eye(64))
+    work, reference = w.astype(np.float64), np.zeros_like(w, dtype=np.float64)
+    for i in range(64):
+        if i % INT4_BLOCK == 0:
+            s = np.abs(work[i:i + INT4_BLOCK]).max(axis=0) / 7.0
+            s = np.where(s > 0, s, 1.0).astype(np.float16).astype(np.float64)
+        reference[i] = np.clip(np.rint(work[i] / s), -7, 7) * s
+        work[i + 1:] -= np.outer(inverse[i + 1:, i], (work[i] - reference[i]) / inverse[i, i])
+        inverse -= np.outer(inverse[:, i], inverse[i, :]) / inverse[i, i]
+    assert np.abs(gptq - reference).max() < 1e-6
     with pytest.raises(ValueError, match="int4 stores 2-D weights"):
         compact_weights(matmul_model(np.ones((1, 64, 64), np.float32)), "int4")
 
@@ -185,3 +202,14 @@ def test_dance_input_moments_cover_every_large_weight_of_the_step_graph():
     for name, m in moments.items():
         assert m.shape == (inits[name].dims[0],) * 2, name
         assert np.allclose(m, m.T) and np.linalg.eigvalsh(m).min() > -1e-9, name
+    # What each weight multiplies, teacher-forced: the top layer's h is nn.LSTM's output, and it is the top layer's
+    # previous h one frame later.
+    from training.aclstm.calibration import _layer_inputs
+    x = rng.normal(size=(2, 7, 171)).astype(np.float32)
+    style = np.eye(3, dtype=np.float32)[[0, 2]]
+    seen = _layer_inputs(model, x, style, None)
+    with torch.no_grad():
+        top, _ = model.lstm(torch.cat([torch.from_numpy(x), torch.from_numpy(style)[:, None].expand(-1, 7, -1)], -1))
+    assert np.allclose(np.stack(seen["decoder.weight_t"], 1), top.numpy(), atol=1e-5)
+    assert np.allclose(np.stack(seen["lstm2.w_hh_t"][1:], 1), top.numpy()[:, :-1], atol=1e-5)
+    assert np.allclose(np.stack(seen["lstm0.w_x_t"], 1), x)

@@ -396,3 +396,17 @@ def test_a_style_model_s_training_streams_come_in_every_style_from_that_style_s_
                                      pool=[0, 2, 4])
     assert np.all(other[:, 0, :-2] == -3.0) and np.abs(other[:, 1:] - short[:4, 1:]).max() > 1e-3
     assert any(p.name.startswith("refiner_generated_test_") for p in tmp_path.iterdir())
+
+
+def test_style_shares_follow_the_real_windows_style_mix():
+    """D must see the same mix of styles in generated as in real windows: a corpus that draws CMU (style 0) for 35% of
+    its windows gets 35% of the streams in CMU, the rest split as the other styles are drawn."""
+    from types import SimpleNamespace
+
+    from training.refiner.streams import style_shares
+
+    styles = np.array([0, 0, 1, 2, 2, 2])
+    weights = np.array([0.2, 0.15, 0.325, 0.1, 0.1, 0.125])
+    assert style_shares(SimpleNamespace(train_styles=styles, weights=weights), 100, 3) == [35, 33, 32]
+    assert style_shares(SimpleNamespace(train_styles=styles, weights=weights), 7, 3) == [3, 2, 2]
+    assert style_shares(SimpleNamespace(train_styles=np.array([0, 1]), weights=np.array([0.5, 0.5])), 2048, 2) == [1024, 1024]

@@ -17,6 +17,8 @@ from ..models.aclstm import DanceLSTM
 
 WINDOW = 240  # frames per calibration window (8 s at 30 fps)
 WINDOWS = 48  # per half (teacher-forced, free-running)
+REAL_START = 10  # real frames before the free-running half runs on its own: exporting.SEED_FRAMES, the page's seed
+# (not imported: exporting imports this module)
 
 
 def _windows(clips: list[DanceClip], mean: np.ndarray, std: np.ndarray, styles: list[str], rng: np.random.Generator):
@@ -69,13 +71,14 @@ def _layer_inputs(model: DanceLSTM, x: np.ndarray, style: np.ndarray, free_after
 
 def input_moments(model: DanceLSTM, clips: list[DanceClip], mean, std, styles: list[str] | None = None,
                   seed: int = 0) -> dict[str, np.ndarray]:
-    """Mean x x^T of each large weight's input (see the module docstring), by the step graph's weight names."""
+    """Mean x x^T of each large weight's input (see the module docstring), by the step graph's weight names. `styles`:
+    the model's style order (its JSON's `styles`; default data.dance.STYLES)."""
     if model.head != "mean":
         raise ValueError("input_moments follows the mean head's output; sample the other heads before calibrating them")
     rng = np.random.default_rng(seed)
     x, style = _windows(clips, np.asarray(mean), np.asarray(std), list(styles or STYLES), rng)
     moments = {}
-    for free_after in (None, 10):  # teacher-forced, then free-running after a 10-frame real start (the page's seed)
+    for free_after in (None, REAL_START):  # teacher-forced, then free-running after a real start
         for name, rows in _layer_inputs(model, x, style, free_after).items():
             a = np.concatenate(rows)
             moments[name] = moments.get(name, 0) + a.T @ a / len(a) / 2

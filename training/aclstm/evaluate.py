@@ -1,11 +1,14 @@
-"""Evaluate the shipped dance models, acLSTM against its vanilla baseline, and write docs/models/aclstm.{md,json,png}.
+"""Evaluate the shipped dance models (and the vanilla baseline, when its files are there) and write
+docs/models/aclstm.{md,json,png}.
 
     python -m training.aclstm.evaluate [--frames 20000] [--seeds 5] [--also LABEL=path/to/model.json]
     python -m training.aclstm.evaluate --from-json    # aclstm.md again from aclstm.json, measuring nothing
     python -m training.aclstm.evaluate --add "acLSTM mdn=public/models/aclstm-mdn.json"   # measure one model, keep the other rows
 
-The shipped models (report.MODELS: acLSTM, vanilla and, once exported into public/models, the mdn model `aclstm-mdn`)
-are measured on every run; --also adds a model that is not shipped. --add measures only the models it names and adds
+The models of report.MODELS whose files are in public/models (acLSTM and the mdn model `aclstm-mdn`; the vanilla
+baseline left the page on 2026-12-05) are measured on every run, and such a run writes only their rows: to keep the
+vanilla baseline's row, restore its files first (report.py says how) or measure it with --add; --also adds a model
+that is not shipped. --add measures only the models it names and adds
 them to the stored aclstm.json beside its other rows (same --frames and --seeds; aclstm.png is not redrawn, and each
 added model gets its own figure, aclstm-<id>.png: its runs against the real held-out seconds' band).
 

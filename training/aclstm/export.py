@@ -1,7 +1,7 @@
 """Export the dance models (acLSTM and its vanilla baseline) to ONNX plus JSON, parity checked.
 
     python -m training.aclstm.export [--run aclstm] [--id aclstm]
-    python -m training.aclstm.export --run aclstm-vanilla --id aclstm-vanilla
+    python -m training.aclstm.export --run aclstm-vanilla --id aclstm-vanilla --out /tmp/vanilla   # the baseline, not shipped since 2026-12-05
     python -m training.aclstm.export --id aclstm --from-shipped [--weights int8]   # no checkpoint: rewrite the shipped file
     python -m training.aclstm.export --checkpoint runs/aclstm-mdn-dt35-s1/last.pt --id aclstm-mdn [--out DIR] [--tune-frames 3000]
 
@@ -17,7 +17,7 @@ import argparse
 from pathlib import Path
 
 from ..runs import RUNS_DIR, add_export_arguments
-from ..onnx.compact import FORMATS
+from ..onnx.compact import ALL_FORMATS
 from .exporting import export_dance_model, rewrite_dance_model
 
 
@@ -31,7 +31,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--temperature", type=float, default=0.2, help="a Gaussian head's sampling temperature (kept in the JSON)")
     parser.add_argument("--tune-frames", type=int, default=1200,
                         help="an mdn head: frames of each tuning rollout choosing its phrase parameters per style")
-    add_export_arguments(parser, FORMATS, weights_help="how the file stores its large weights (int8 with a scale per output channel)",
+    add_export_arguments(parser, ALL_FORMATS, weights_help="how the file stores its large weights (int8 with a scale per output "
+                                                          "channel; int4 in blocks, rounded on the training clips: docs/models/weights.md)",
                          shipped_help="no checkpoint: read the network back from DIR/<id>.onnx (default the shipped one) and keep its JSON")
     args = parser.parse_args(argv)
     model_id = args.id or args.run

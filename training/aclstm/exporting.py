@@ -110,15 +110,16 @@ def training_minutes(checkpoint: Path, iteration: int | None) -> float | None:
     return None if minutes is None else round(minutes, 1)
 
 
-def write_dance_graph(model: DanceLSTM, onnx_path: Path, weights: str, clips: list[DanceClip] | None = None,
-                      normalisation: tuple | None = None) -> tuple[dict, dict]:
+def write_dance_graph(model: DanceLSTM, onnx_path: Path, weights: str, calibration: dict | None = None) -> tuple[dict, dict]:
     """Writes and parity-checks the graph; returns the JSON's `onnx` and `parity` fields. int4 weights are rounded
-    to keep the layers' outputs on the training `clips` (calibration.py), which then must be given with the
-    model's (mean, std) `normalisation`."""
+    to keep the layers' outputs on the training clips: `calibration` holds calibration.input_moments' clips, mean,
+    std and styles."""
     hessians = None
     if weights == "int4":
+        if calibration is None:
+            raise SystemExit("error: int4 weights need the training clips to round by (calibration.input_moments)")
         try:
-            hessians = input_moments(model, clips, *normalisation)
+            hessians = input_moments(model, **calibration)
         except ValueError as e:
             raise SystemExit(f"error: int4 weights: {e}")
     stored = export_onnx(model, onnx_path, weights, hessians)
@@ -174,7 +175,8 @@ def export_dance_model(checkpoint: Path, model_id: str, out: Path, mocap: str | 
     out.mkdir(parents=True, exist_ok=True)
     onnx_path = out / f"{model_id}.onnx"
     _, clips = load_clips(mocap)
-    onnx_fields, parity = write_dance_graph(model, onnx_path, weights, clips, (meta["mean"], meta["std"]))
+    onnx_fields, parity = write_dance_graph(model, onnx_path, weights,
+                                            {"clips": clips, "mean": meta["mean"], "std": meta["std"], "styles": meta["styles"]})
     vanilla = meta["args"]["condition"] == 0
     info = {
         "id": model_id, "kind": "aclstm", "fps": meta["fps"], "file": onnx_path.name,
@@ -216,9 +218,11 @@ def rewrite_dance_model(source: Path, model_id: str, out: Path, weights: str, mo
     model = dance_model_from_onnx(source / info["file"], o["dim"], o["styles"], o["hidden"], o["layers"])
     out.mkdir(parents=True, exist_ok=True)
     onnx_path = out / f"{model_id}.onnx"
-    clips = load_clips(mocap)[1] if weights == "int4" else None
-    norm = (info["normalisation"]["mean"], info["normalisation"]["std"])
-    info["onnx"], info["parity"] = write_dance_graph(model, onnx_path, weights, clips, norm)
+    calibration = None
+    if weights == "int4":
+        calibration = {"clips": load_clips(mocap)[1], "mean": info["normalisation"]["mean"],
+                       "std": info["normalisation"]["std"], "styles": info["styles"]}
+    info["onnx"], info["parity"] = write_dance_graph(model, onnx_path, weights, calibration)
     info["file"] = onnx_path.name
     _publish(info, onnx_path, model_id, out)
     return onnx_path

@@ -31,8 +31,9 @@ BONE_ERROR_LIMIT = 0.25
 HEIGHT_BAND = (0.2, 1.6)
 HORIZONS_MS = (80, 160, 240, 320, 400, 480, 560, 640)
 MDN_MODE = {"temperature": 0.0, "threshold": 2.0, "max_hold": 1, "min_hold": 0}  # an mdn head's deterministic prediction
-# A missing file is skipped: the vanilla baseline left public/models on 2026-12-05 (the 12 MB model budget); its
-# stored row stays, and its file as shipped is `git show 6fe1bd7:public/models/aclstm-vanilla.onnx` (and .json).
+# A missing file is skipped: the vanilla baseline left public/models on 2026-12-05 (the 12 MB model budget). Its row in
+# aclstm.json (marked `withdrawn` by hand) is kept by --add runs but not by a full run, which writes only what it
+# measured: restore its files first, `git show 6fe1bd7:public/models/aclstm-vanilla.onnx` (and .json), then remove them.
 MODELS = {"acLSTM": "aclstm", "vanilla": "aclstm-vanilla", "acLSTM mdn": "aclstm-mdn"}
 # Measured by hand on earlier models and intermediate checkpoints (3,000-frame runs of the same seeds);
 # those checkpoints are not kept, so this is a record, not something this script recomputes.

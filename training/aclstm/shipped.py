@@ -1,4 +1,4 @@
-"""Running an exported dance model (acLSTM or its vanilla baseline) with onnxruntime: the artefact the browser runs."""
+"""Running an exported dance model (an acLSTM, or its vanilla baseline from an --out folder) with onnxruntime: the artefact the browser runs."""
 from __future__ import annotations
 
 import json

@@ -68,8 +68,8 @@ def generate_streams(model: MixtureLSTM, corpus: Corpus, streams: int, frames: i
 def generated_cache(model: MixtureLSTM, corpus: Corpus, args: argparse.Namespace, kind: str,
                     styles: int = 0, tag: str = "") -> list[np.ndarray]:
     """Cached generated streams: 'train' (many short streams plus some long ones) or 'valid' (own seed). A style
-    model (`styles` > 0, its corpus a StyleCorpus) draws each style's equal share of the streams in that style, warmed
-    up on that style's training sequences; `tag` names the model in the cache file."""
+    model (`styles` > 0, its corpus a StyleCorpus) draws each style's share of the streams (style_shares) in that
+    style, warmed up on that style's training sequences; `tag` names the model in the cache file."""
     if kind == "train":
         specs = [(args.streams, args.window + 30, 1), (args.long_streams, 1200, 2)]
     else:
@@ -83,15 +83,26 @@ def generated_cache(model: MixtureLSTM, corpus: Corpus, args: argparse.Namespace
             continue
         if styles:
             x = np.concatenate([
-                generate_streams(StyledGenerator(model, s), corpus, len(share), frames, args.warmup, TEMPERATURE, seed + 1000 * s,
+                generate_streams(StyledGenerator(model, s), corpus, count, frames, args.warmup, TEMPERATURE, seed + 1000 * s,
                                  pool=[k for k, style in enumerate(corpus.train_styles) if style == s])
-                for s, share in enumerate(np.array_split(np.arange(streams), styles))])
+                for s, count in enumerate(style_shares(corpus, streams, styles)) if count])
         else:
             x = generate_streams(model, corpus, streams, frames, args.warmup, TEMPERATURE, seed)
         DEFAULT_CACHE.mkdir(parents=True, exist_ok=True)
         np.savez_compressed(path, x=x)
         arrays.append(x)
     return arrays
+
+
+def style_shares(corpus, streams: int, styles: int) -> list[int]:
+    """How many of `streams` each style draws: in proportion to the style's share of the real windows' sampling weight
+    (corpus.weights), so that D sees the same mix of styles in real and generated windows (equal shares for the shipped
+    style model; a checkpoint trained with --cmu-share gives CMU its share). Rounded by largest remainders."""
+    weight = np.bincount(corpus.train_styles, weights=corpus.weights, minlength=styles)
+    exact = streams * weight / weight.sum()
+    counts = np.floor(exact).astype(int)
+    counts[np.argsort(counts - exact)[:streams - counts.sum()]] += 1
+    return counts.tolist()
 
 
 class WindowSampler:

@@ -49,6 +49,7 @@ kept as runs/refiner/shipped.pt. Export with python -m training.refiner.export -
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 from pathlib import Path
 
@@ -153,11 +154,14 @@ class RefinerTraining:
         self.run = self.loop.run
         styles, tag = 0, ""
         if args.style_generator:  # issue 39: R learns from the style model's motion in every style, against real
-            # windows of every style drawn as its training drew them (each style an equal share)
+            # windows of every style drawn as its training drew them (streams.style_shares keeps the mix the same)
             generator, gmeta, _ = load_generator(args.style_generator)
             corpus = StyleCorpus(load_styled_clips(args.mocap), np.array(gmeta["references"]),
                                  cmu_share=gmeta["args"].get("cmu_share"))
-            styles, tag = len(gmeta["styles"]), f"_{Path(args.style_generator).parent.name}"
+            # The cache is named by the checkpoint's run, file and contents: streams of other weights are never reused.
+            path = Path(args.style_generator)
+            styles = len(gmeta["styles"])
+            tag = f"_{path.parent.name}-{path.stem}-{hashlib.sha1(path.read_bytes()).hexdigest()[:8]}"
         else:
             generator, gmeta, _ = load_generator(args.generator)
             corpus = Corpus(load_clips(args.mocap))

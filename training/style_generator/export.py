@@ -17,9 +17,9 @@ from pathlib import Path
 import torch
 
 from ..data.style_locomotion import load_styled_clips
+from ..generator.training import load_generator
 from ..onnx.compact import FORMATS
 from .exporting import export_style_generator
-from ..generator.training import load_generator
 
 
 def main(argv: list[str] | None = None) -> None:

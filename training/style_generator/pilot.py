@@ -3,7 +3,7 @@ the numbers to docs/models/style-generator-pilot.json.
 
     python -m training.style_generator.pilot --checkpoint runs/style-pilot/best.pt [--frames 1500] [--steps 1500]
     python -m training.style_generator.pilot --checkpoint runs/style-pilot/best.pt --refiner runs/style-refiner-joints/best.pt \
-        --out docs/models/style-refiner-pilot.json     # also the style model's motion locked, refined, refined + locked
+        --out docs/models/style-refiner-pilot-1250.json     # also the style model's motion locked, refined, refined + locked
 
 What is measured, and how both models are sampled alike, is in training/style_generator/pilots.py: held-out NLL per
 style, the refiner report's two-sample test cut down (one classifier seed, --frames per seed), the hip-bob spectrum,

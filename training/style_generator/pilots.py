@@ -31,17 +31,17 @@ from .. import metrics
 from ..data.features import FeatureCodec, mirror_clip
 from ..data.locomotion import SPEED_FACTORS, change_speed, is_validation
 from ..data.style_locomotion import STYLES, StyledClip, load_styled_clips
+from ..footlock import plant_feet
 from ..generator.exporting import estimate_initial_state, pick_seeds
 from ..generator.recovery import model_from_onnx
 from ..generator.sampling import draw_mixture, held_normals, snap_contacts
-from ..footlock import plant_feet
 from ..generator.shipped import DecodedMotion
+from ..generator.training import load_generator
 from ..mocap.rotations import quat_to_matrix
 from ..mocap.skeleton import canonical_skeleton
 from ..models.generator import MixtureLSTM, StyledGenerator, mixture_nll
 from ..paths import MODELS_DIR
 from ..refiner.measures import WINDOW, classifier_frames, motion_windows, two_sample_accuracy, windows
-from ..generator.training import load_generator
 from .training import nll_per_clip
 
 TEMPERATURE = 0.5
@@ -214,7 +214,7 @@ def physical_nll(cand: Candidate, clips: list[StyledClip], style: str) -> float:
     return total / count + float(np.log(cand.std).sum())
 
 
-def locked_variants(cand: Candidate, physical: np.ndarray, refined: np.ndarray | None) -> dict[str, list[DecodedMotion]]:
+def locked_variants(cand: Candidate, physical: np.ndarray, refined: np.ndarray | None, fps: float) -> dict[str, list[DecodedMotion]]:
     """'raw + foot lock' and, with `refined` features, 'refined' and 'refined + foot lock' of streams (B, frames, dim),
     as the page shows them (footlock.plant_feet on the decoded frames, refiner/report.decode_variants' rule)."""
     out = {"raw + foot lock": []} | ({"refined": [], "refined + foot lock": []} if refined is not None else {})
@@ -224,7 +224,7 @@ def locked_variants(cand: Candidate, physical: np.ndarray, refined: np.ndarray |
             motion = decode(cand, feats)
             if name == "refined":
                 out[name].append(motion)
-            locked, labels = plant_feet(motion.positions, motion.contacts, 30.0, skel)
+            locked, labels = plant_feet(motion.positions, motion.contacts, fps, skel)
             out[f"{name} + foot lock"].append(DecodedMotion(motion.features, locked, labels))
     return out
 
@@ -244,12 +244,12 @@ def measure(cands: list[Candidate], styles_by_cand: dict[str, list[str]], frames
            "classifier_seed": classifier_seed, "classifier_seeds": classifier_seeds, "classifier_steps": steps or 1500, "real": {}, "models": {}}
     codec = cands[0].codec  # both candidates encode with the shipped references: the real motion is the same
     real_cache = {}
+    skel = canonical_skeleton()
     for style in STYLES:
         real = held_out_motion(codec, clips, style)
         real_test = motion_windows(real, fps)
         summ = motion_summary(real, fps)
         real_cache[style] = (real_test, summ)
-        skel = canonical_skeleton()
         out["real"][style] = {"held_out_clips": len(real), "held_out_windows": len(real_test), **summ, "hip_bob": hip_bob(real_test, fps),
                               "low_foot_sliding": float(np.concatenate([metrics.low_foot_speeds(s.positions, fps, skel) for s in real]).mean()),
                               "foot_skating_by_contacts": float(np.concatenate([metrics.planted_toe_speeds(s.positions, s.contacts, fps, skel)
@@ -269,7 +269,7 @@ def measure(cands: list[Candidate], styles_by_cand: dict[str, list[str]], frames
         variants = None
         if refiner is not None and cand.styled:
             seed_physical = start[0].numpy() * cand.std + cand.mean  # the frame before each stream's first
-            variants = [locked_variants(cand, s, refiner.refine(s, seed_physical)) for s in streams]
+            variants = [locked_variants(cand, s, refiner.refine(s, seed_physical), fps) for s in streams]
             log(f"{cand.name}: refined and locked ({(time.perf_counter() - t0) / 60:.1f} min)")
         for style in measured:
             rows = [k for k, (s, _) in enumerate(names) if s == style]
@@ -296,9 +296,8 @@ def measure(cands: list[Candidate], styles_by_cand: dict[str, list[str]], frames
                         **{kind: float(np.mean([two_sample_accuracy(real_train, bw, real_test, tw, classifier_seed + k, steps=steps,
                                                                     kind=kind)["balanced_accuracy"] for k in range(classifier_seeds)]))
                            for kind in ("window", "frame")},
-                        "low_foot_sliding": float(np.concatenate([metrics.low_foot_speeds(s.positions, fps, canonical_skeleton())
-                                                                  for s in va]).mean()),
-                        "foot_skating_by_contacts": float(np.concatenate([metrics.planted_toe_speeds(s.positions, s.contacts, fps, canonical_skeleton())
+                        "low_foot_sliding": float(np.concatenate([metrics.low_foot_speeds(s.positions, fps, skel) for s in va]).mean()),
+                        "foot_skating_by_contacts": float(np.concatenate([metrics.planted_toe_speeds(s.positions, s.contacts, fps, skel)
                                                                           for s in va]).mean()),
                         "hip_bob": hip_bob(tw, fps)}
                     log(f"{cand.name} [{style}] {v}: two-sample windows {100 * r['variants'][v]['window']:.1f}% "
