@@ -13,7 +13,7 @@ import numpy as np
 import torch
 
 from ..data.dance import MODEL_FPS, STYLES, DanceClip, encode, resample_positions
-from ..models.aclstm import DanceLSTM
+from ..models.aclstm import DanceLSTM, DanceStep
 
 WINDOW = 240  # frames per calibration window (8 s at 30 fps)
 WINDOWS = 48  # per half (teacher-forced, free-running)
@@ -38,34 +38,26 @@ def _windows(clips: list[DanceClip], mean: np.ndarray, std: np.ndarray, styles: 
 
 @torch.no_grad()
 def _layer_inputs(model: DanceLSTM, x: np.ndarray, style: np.ndarray, free_after: int | None) -> dict[str, list]:
-    """Runs the network one frame at a time (teacher-forced, or from frame `free_after` on its own mean output)
-    and collects each layer's input and previous h, by the graph's weight names."""
-    sd = {k: v.numpy().astype(np.float64) for k, v in model.state_dict().items()}
-    H, L, D = model.hidden, model.layers, model.dim
-    batch = len(x)
-    h = [np.zeros((batch, H)) for _ in range(L)]
-    c = [np.zeros((batch, H)) for _ in range(L)]
+    """Runs the network one frame at a time (DanceStep: teacher-forced, or from frame `free_after` on its own mean
+    output) and collects what each large weight multiplies, by the graph's weight names: the frame, each layer's new
+    h (the next layer's input; the top one the decoder's) and each layer's previous h."""
+    step, L = DanceStep(model), model.layers
+    style_t = torch.from_numpy(style)
+    h, c = model.zero_state(len(x))
     seen = {name: [] for name in ["lstm0.w_x_t", *[f"lstm{l}.w_ih_t" for l in range(1, L)],
                                   *[f"lstm{l}.w_hh_t" for l in range(L)], "decoder.weight_t"]}
-    sigmoid = lambda a: 1 / (1 + np.exp(-a))
-    frame = x[:, 0].astype(np.float64)
+    frame = torch.from_numpy(x[:, 0])
     for t in range(x.shape[1]):
         if free_after is None or t < free_after:
-            frame = x[:, t].astype(np.float64)
-        inp = np.concatenate([frame, style], axis=1)
-        seen["lstm0.w_x_t"].append(frame)
+            frame = torch.from_numpy(x[:, t])
+        y, h_new, c = step(frame, style_t, h, c)
+        seen["lstm0.w_x_t"].append(frame.numpy())
         for l in range(L):
+            seen[f"lstm{l}.w_hh_t"].append(h[l].numpy())
             if l > 0:
-                seen[f"lstm{l}.w_ih_t"].append(inp)
-            seen[f"lstm{l}.w_hh_t"].append(h[l])
-            gates = inp @ sd[f"lstm.weight_ih_l{l}"].T + h[l] @ sd[f"lstm.weight_hh_l{l}"].T \
-                + sd[f"lstm.bias_ih_l{l}"] + sd[f"lstm.bias_hh_l{l}"]
-            i, f, g, o = np.split(gates, 4, axis=1)  # PyTorch's gate order
-            c[l] = sigmoid(f) * c[l] + sigmoid(i) * np.tanh(g)
-            h[l] = sigmoid(o) * np.tanh(c[l])
-            inp = h[l]
-        seen["decoder.weight_t"].append(h[-1])
-        frame = (h[-1] @ sd["decoder.weight"].T + sd["decoder.bias"])[:, :D]
+                seen[f"lstm{l}.w_ih_t"].append(h_new[l - 1].numpy())
+        seen["decoder.weight_t"].append(h_new[-1].numpy())
+        frame, h = y, h_new
     return seen
 
 
@@ -80,6 +72,6 @@ def input_moments(model: DanceLSTM, clips: list[DanceClip], mean, std, styles: l
     moments = {}
     for free_after in (None, REAL_START):  # teacher-forced, then free-running after a real start
         for name, rows in _layer_inputs(model, x, style, free_after).items():
-            a = np.concatenate(rows)
+            a = np.concatenate(rows).astype(np.float64)
             moments[name] = moments.get(name, 0) + a.T @ a / len(a) / 2
     return moments

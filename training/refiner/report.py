@@ -47,16 +47,22 @@ def decode_variants(gen: ShippedGenerator, ref, raw: np.ndarray,
     """Each variant's decoded streams, and the refined features. `ref` is anything with ShippedRefiner's refine (the
     pilots pass a training checkpoint's R), or None for the raw variants alone."""
     refined = ref.refine(raw, seeds_x) if ref is not None else None
-    out = {v: [] for v in (VARIANTS if ref is not None else VARIANTS[:2])}
+    return locked_variants(raw, refined, gen.codec, gen.info["fps"], gen.skel), refined
+
+
+def locked_variants(raw: np.ndarray, refined: np.ndarray | None, codec, fps: float, skel) -> dict[str, list[DecodedMotion]]:
+    """Physical feature streams (B, frames, dim) decoded by `codec` as the page shows them: 'raw', 'raw + foot lock'
+    and, with `refined`, 'refined' and 'refined + foot lock' (footlock.plant_feet on the decoded positions)."""
+    out = {v: [] for v in (VARIANTS if refined is not None else VARIANTS[:2])}
     for k in range(len(raw)):
-        for name, feats in (("raw", raw[k]),) + ((("refined", refined[k]),) if ref is not None else ()):
+        for name, feats in (("raw", raw[k]),) + ((("refined", refined[k]),) if refined is not None else ()):
             f = feats.astype(np.float64)
-            pos = gen.codec.positions(f)
+            pos = codec.positions(f)
             contacts = (f[:, -2:] > 0.5).astype(np.uint8)
             out[name].append(DecodedMotion(f, pos, contacts))
-            locked, labels = plant_feet(pos, contacts, gen.info["fps"], gen.skel)  # as the page shows it
+            locked, labels = plant_feet(pos, contacts, fps, skel)  # as the page shows it
             out[f"{name} + foot lock"].append(DecodedMotion(f, locked, labels))
-    return out, refined
+    return out
 
 
 def real_training_frames(gen: ShippedGenerator, clips) -> list[np.ndarray]:

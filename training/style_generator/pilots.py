@@ -31,7 +31,6 @@ from .. import metrics
 from ..data.features import FeatureCodec, mirror_clip
 from ..data.locomotion import SPEED_FACTORS, change_speed, is_validation
 from ..data.style_locomotion import STYLES, StyledClip, load_styled_clips
-from ..footlock import plant_feet
 from ..generator.exporting import estimate_initial_state, pick_seeds
 from ..generator.recovery import model_from_onnx
 from ..generator.sampling import draw_mixture, held_normals, snap_contacts
@@ -42,6 +41,7 @@ from ..mocap.skeleton import canonical_skeleton
 from ..models.generator import MixtureLSTM, StyledGenerator, mixture_nll
 from ..paths import MODELS_DIR
 from ..refiner.measures import WINDOW, classifier_frames, motion_windows, two_sample_accuracy, windows
+from ..refiner.report import locked_variants
 from .training import nll_per_clip
 
 TEMPERATURE = 0.5
@@ -214,19 +214,11 @@ def physical_nll(cand: Candidate, clips: list[StyledClip], style: str) -> float:
     return total / count + float(np.log(cand.std).sum())
 
 
-def locked_variants(cand: Candidate, physical: np.ndarray, refined: np.ndarray | None, fps: float) -> dict[str, list[DecodedMotion]]:
-    """'raw + foot lock' and, with `refined` features, 'refined' and 'refined + foot lock' of streams (B, frames, dim),
-    as the page shows them (footlock.plant_feet on the decoded frames, refiner/report.decode_variants' rule)."""
-    out = {"raw + foot lock": []} | ({"refined": [], "refined + foot lock": []} if refined is not None else {})
-    skel = canonical_skeleton()
-    for k in range(len(physical)):
-        for name, feats in (("raw", physical[k]),) + ((("refined", refined[k]),) if refined is not None else ()):
-            motion = decode(cand, feats)
-            if name == "refined":
-                out[name].append(motion)
-            locked, labels = plant_feet(motion.positions, motion.contacts, fps, skel)
-            out[f"{name} + foot lock"].append(DecodedMotion(motion.features, locked, labels))
-    return out
+def two_sample(real_train, train_w, real_test, test_w, seed: int, seeds: int, steps: int | None) -> dict[str, list[float]]:
+    """The refiner report's two-sample test, window and single-frame classifiers, with `seeds` classifier seeds from
+    `seed`: balanced accuracies per kind."""
+    return {kind: [two_sample_accuracy(real_train, train_w, real_test, test_w, seed + k, steps=steps, kind=kind)["balanced_accuracy"]
+                   for k in range(seeds)] for kind in ("window", "frame")}
 
 
 def measure(cands: list[Candidate], styles_by_cand: dict[str, list[str]], frames: int = PILOT_FRAMES,
@@ -266,36 +258,36 @@ def measure(cands: list[Candidate], styles_by_cand: dict[str, list[str]], frames
         start = initial_states(cand, seeds)
         streams = [sample(cand, start, frames, np.random.default_rng(s), temperature) for s in STREAM_SEEDS]
         log(f"{cand.name}: sampled {len(seeds)} streams x {frames} frames x 2 sets ({(time.perf_counter() - t0) / 60:.1f} min)")
-        variants = None
+        # Per stream set (A, B), each variant's decoded streams: raw only, or with a refiner also locked and refined.
         if refiner is not None and cand.styled:
             seed_physical = start[0].numpy() * cand.std + cand.mean  # the frame before each stream's first
-            variants = [locked_variants(cand, s, refiner.refine(s, seed_physical), fps) for s in streams]
+            decoded = [locked_variants(s, refiner.refine(s, seed_physical), cand.codec, fps, skel) for s in streams]
             log(f"{cand.name}: refined and locked ({(time.perf_counter() - t0) / 60:.1f} min)")
+        else:
+            decoded = [{"raw": [decode(cand, f) for f in s]} for s in streams]
+
         for style in measured:
             rows = [k for k, (s, _) in enumerate(names) if s == style]
-            var_a = [decode(cand, streams[0][k]) for k in rows]
-            var_b = [decode(cand, streams[1][k]) for k in rows]
+            var_a = [decoded[0]["raw"][k] for k in rows]
+            var_b = [decoded[1]["raw"][k] for k in rows]
             real_test, real_summ = real_cache[style]
             real_train = windows(training_frames(codec, clips, style, fps))
             test_w, train_w = motion_windows(var_a, fps), motion_windows(var_b, fps)
-            runs = {kind: [two_sample_accuracy(real_train, train_w, real_test, test_w, classifier_seed + k, steps=steps,
-                                               kind=kind)["balanced_accuracy"] for k in range(classifier_seeds)]
-                    for kind in ("window", "frame")}
+            runs = two_sample(real_train, train_w, real_test, test_w, classifier_seed, classifier_seeds, steps)
             acc = {kind: float(np.mean(v)) for kind, v in runs.items()}
             line = real_summ.get("pose_change_median")
             r = {"seeds": [n for s, n in names if s == style], "two_sample": acc, "two_sample_runs": runs,
                  "hip_bob": hip_bob(test_w, fps),
                  **motion_summary(var_a, fps, FREEZE_FRACTION * line if line else None),
                  "windows": {"real_train": len(real_train), "real_test": len(real_test), "generated": len(test_w)}}
-            if variants is not None:
+            if len(decoded[0]) > 1:
                 r["variants"] = {}
-                for v in variants[0]:
-                    va, vb = [variants[0][v][k] for k in rows], [variants[1][v][k] for k in rows]
+                for v in [v for v in decoded[0] if v != "raw"]:  # raw is measured above
+                    va, vb = [decoded[0][v][k] for k in rows], [decoded[1][v][k] for k in rows]
                     tw, bw = motion_windows(va, fps), motion_windows(vb, fps)
                     r["variants"][v] = {
-                        **{kind: float(np.mean([two_sample_accuracy(real_train, bw, real_test, tw, classifier_seed + k, steps=steps,
-                                                                    kind=kind)["balanced_accuracy"] for k in range(classifier_seeds)]))
-                           for kind in ("window", "frame")},
+                        **{kind: float(np.mean(accs)) for kind, accs in
+                           two_sample(real_train, bw, real_test, tw, classifier_seed, classifier_seeds, steps).items()},
                         "low_foot_sliding": float(np.concatenate([metrics.low_foot_speeds(s.positions, fps, skel) for s in va]).mean()),
                         "foot_skating_by_contacts": float(np.concatenate([metrics.planted_toe_speeds(s.positions, s.contacts, fps, skel)
                                                                           for s in va]).mean()),
