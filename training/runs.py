@@ -68,6 +68,11 @@ def rewrote_from_json(args: argparse.Namespace, report: str, rewrite_markdown) -
     return True
 
 
+def cpu_state(model: torch.nn.Module) -> dict:
+    """A model's weights on the CPU, so a checkpoint trained on a GPU loads anywhere."""
+    return {k: v.detach().cpu() for k, v in model.state_dict().items()}
+
+
 class Run:
     """A training run living in runs/<name>/: train.log, checkpoint.pt (latest), best.pt."""
 
@@ -99,7 +104,8 @@ class Run:
     def load(self) -> dict | None:
         if not self.checkpoint_path.exists():
             return None
-        return torch.load(self.checkpoint_path, weights_only=False)
+        # On the CPU first: load_state_dict then puts each part on its own device (a GPU run resumes on the GPU).
+        return torch.load(self.checkpoint_path, map_location="cpu", weights_only=False)
 
     def resume(self, rng, **parts) -> dict:
         """Restore each of `parts` (models, optimisers, schedules: anything with load_state_dict, saved under
@@ -199,7 +205,7 @@ class TrainingLoop:
         self.log.info("stopped: %s (%s)", self.stopped, self.position.format(iteration=iteration, **extra))
         self.save(iteration, **extra)
         if save_last:
-            self.run.save({"model": self.parts["model"].state_dict(), "iteration": iteration, "meta": self.meta},
+            self.run.save({"model": cpu_state(self.parts["model"]), "iteration": iteration, "meta": self.meta},
                           self.run.dir / "last.pt")
         summary = {**summary, "minutes": self.elapsed() / 60, "parameters": self.parameters}
         (self.run.dir / "summary.json").write_text(json.dumps(summary, indent=1))

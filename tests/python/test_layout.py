@@ -104,6 +104,7 @@ MAY_IMPORT = {
     "control": set(),
     "onnx": {"paths"},
     "data": {"mocap", "paths", "metrics", "control"},
+    "device": {"data", "paths"},
     "models": {"mocap", "data"},
     "generator": {"mocap", "data", "models"} | SHARED,
     "aclstm": {"mocap", "data", "models"} | SHARED,

@@ -39,6 +39,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--lr", type=float, default=1e-3)
     parser.add_argument("--decay", type=float, default=0.95, help="learning-rate factor per epoch")
     parser.add_argument("--iters-per-epoch", type=int, default=250)
+    parser.add_argument("--device", default="cpu", help="where to train: cpu, or cuda on a machine with a GPU "
+                                                        "(checkpoints are saved for the CPU either way)")
     parser.add_argument("--no-mirror", action="store_true", help="no left/right mirroring of training windows")
     parser.add_argument("--extra", action="store_true",
                         help="also train on ../shared/mocap/aclstm-extra (Indian 01, martial 02 on the standard skeleton: "

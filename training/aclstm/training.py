@@ -23,7 +23,7 @@ import torch
 from ..data.dance import MODEL_FPS, STYLES, DanceClip, DanceSkeleton, encode, load_clips, mirror, mirror_pairs, resample_positions, rotate_y
 from ..models.aclstm import DanceLSTM, mixture_nll
 from ..models.losses import energy_loss
-from ..runs import TrainingLoop
+from ..runs import TrainingLoop, cpu_state
 
 SPEEDS = (0.8, 1.2)
 
@@ -68,13 +68,13 @@ class DanceCorpus:
     def normalise(self, x):
         return ((x - self.mean) / self.std).astype(np.float32)
 
-    def one_hot(self, styles):
-        return torch.eye(len(self.styles))[[self.styles.index(s) for s in styles]]
+    def one_hot(self, styles, device: str | torch.device = "cpu"):
+        return torch.eye(len(self.styles), device=device)[[self.styles.index(s) for s in styles]]
 
-    def batch(self, rng, size):
+    def batch(self, rng, size, device: str | torch.device = "cpu"):
         styles = [self.styles[i] for i in rng.integers(0, len(self.styles), size)]
         x = np.stack([self.normalise(self._features(rng, s)[0]) for s in styles])
-        return torch.from_numpy(x), self.one_hot(styles)
+        return torch.from_numpy(x).to(device), self.one_hot(styles, device)
 
     def _validation_windows(self, clips, per_style=48):
         out = {}
@@ -94,12 +94,15 @@ def validation_losses(model: DanceLSTM, corpus: DanceCorpus, condition: int) -> 
     """Mean squared error per style on held-out windows: teacher-forced and auto-conditioned (u = v = 5)."""
     model.eval()
     out = {}
+    device = next(model.parameters()).device
     with torch.no_grad():
         for s, x in corpus.valid.items():
-            style = corpus.one_hot([s] * len(x))
+            x = x.to(device)
+            style = corpus.one_hot([s] * len(x), device)
             # Squared error of the mean, whatever the head (the Gaussian head's self-fed frames are draws).
             tf = ((model.auto_conditioned(x[:, :-1], style, 5, 0) - x[:, 1:]) ** 2).mean()
-            with torch.random.fork_rng():  # the same draws every validation, without resetting training's generator
+            # The same draws every validation, without resetting training's generators (the GPU's too).
+            with torch.random.fork_rng(devices=[device] if device.type == "cuda" else []):
                 torch.manual_seed(0)
                 ac = ((model.auto_conditioned(x[:, :-1], style, 5, 5) - x[:, 1:]) ** 2).mean()
             out[s] = {"teacher_forced": float(tf), "auto_conditioned": float(ac)}
@@ -132,7 +135,8 @@ def train_dance_model(args: argparse.Namespace,
     corpus = DanceCorpus(clips, args.window, np.random.default_rng(12345), skel.names, not args.no_mirror, styles)
     dim = corpus.mean.shape[0]
     components = getattr(args, "components", 10)
-    model = DanceLSTM(dim, len(styles), args.hidden, args.layers, args.head, components)
+    device = torch.device(getattr(args, "device", "cpu"))
+    model = DanceLSTM(dim, len(styles), args.hidden, args.layers, args.head, components).to(device)
     optimiser = torch.optim.Adam(model.parameters(), lr=args.lr)
     scheduler = torch.optim.lr_scheduler.ExponentialLR(optimiser, gamma=args.decay)
     meta = {"dim": dim, "styles": list(styles), "hidden": args.hidden, "layers": args.layers, "head": args.head,
@@ -146,13 +150,13 @@ def train_dance_model(args: argparse.Namespace,
     history = loop.resumed["history"] if loop.resumed else []  # validation results, kept in every checkpoint
     run.log.info("start: %s, u=%d v=%d, %d features, %d parameters, batch %d x %d frames", args.run,
                  args.ground_truth, args.condition, dim, loop.parameters, args.batch, args.window)
-    noise_rng = torch.Generator().manual_seed(args.seed + iteration)
+    noise_rng = torch.Generator(device=device).manual_seed(args.seed + iteration)
     bar = loop.progress_bar(args.run, args.iterations, iteration)
     losses = []
     interrupted = False
     try:
         while iteration < args.iterations:
-            x, style = corpus.batch(rng, args.batch)
+            x, style = corpus.batch(rng, args.batch, device)
             # Schedules over the time budget (so a resumed run continues them): the self-fed stretch grows from
             # v = condition to condition_max, and noise on the real input frames from noise[0] to noise[1]
             # (normalised units; the targets stay clean).
@@ -163,7 +167,7 @@ def train_dance_model(args: argparse.Namespace,
             inputs = x[:, :-1]
             sigma = args.input_noise[0] + (args.input_noise[1] - args.input_noise[0]) * progress
             if sigma > 0:
-                inputs = inputs + sigma * torch.randn(inputs.shape, generator=noise_rng)
+                inputs = inputs + sigma * torch.randn(inputs.shape, generator=noise_rng, device=device)
             if args.head == "mdn":  # mixture likelihood; the self-fed frames are held-component draws (models/aclstm.py)
                 logits, mus, log_sigmas = model.auto_conditioned_mixture(inputs, style, args.ground_truth, condition,
                                                                          getattr(args, "draw_temperature", 1.0), noise_rng)
@@ -194,7 +198,7 @@ def train_dance_model(args: argparse.Namespace,
                                 "valid": val})
                 if val["objective"] < loop.best:
                     loop.best = val["objective"]
-                    run.save({"model": model.state_dict(), "iteration": iteration, "valid": val, "meta": meta}, run.best_path)
+                    run.save({"model": cpu_state(model), "iteration": iteration, "valid": val, "meta": meta}, run.best_path)
                 run.log.info("iteration %d train %.4f valid %.4f (tf %s, ac %s) best %.4f lr %.2e minutes %.1f", iteration,
                              np.mean(losses), val["objective"],
                              "/".join(f"{val[s]['teacher_forced']:.3f}" for s in styles),
@@ -209,7 +213,7 @@ def train_dance_model(args: argparse.Namespace,
     if not run.best_path.exists():  # no validation yet (a short or interrupted run): the weights as they are
         val = validation_losses(model, corpus, args.condition)
         loop.best = val["objective"]
-        run.save({"model": model.state_dict(), "iteration": iteration, "valid": val, "meta": meta}, run.best_path)
+        run.save({"model": cpu_state(model), "iteration": iteration, "valid": val, "meta": meta}, run.best_path)
     # The last weights also count as a candidate: last.pt, for the evaluation to compare.
     loop.finish(iteration, {"best_valid": loop.best, "iterations": iteration, "stopped": loop.stopped},
                 save_last=True, history=history)

@@ -128,7 +128,7 @@ class DanceLSTM(nn.Module):
             logits, mu, log_sigma, _ = self.mixture(x, style)
             return logits, mu, log_sigma
         outs, state, t, total = [], None, 0, x.shape[1]
-        rows = torch.arange(x.shape[0])
+        rows = torch.arange(x.shape[0], device=x.device)
         while t < total:
             n = min(ground_truth, total - t)
             logits, mu, log_sigma, state = self.mixture(x[:, t:t + n], style, state)
@@ -138,7 +138,7 @@ class DanceLSTM(nn.Module):
             for _ in range(min(condition, total - t)):
                 if held is None:
                     held = torch.multinomial(torch.softmax(logits[:, -1].detach(), -1), 1, generator=generator)[:, 0]
-                normals = torch.randn(mu[:, -1, 0].shape, generator=generator)
+                normals = torch.randn(mu[:, -1, 0].shape, generator=generator, device=mu.device)
                 fed = mu[rows, -1, held] + temperature * torch.exp(log_sigma[rows, -1, held]) * normals
                 logits, mu, log_sigma, state = self.mixture(fed.unsqueeze(1), style, state)
                 outs.append((logits, mu, log_sigma))
