@@ -213,3 +213,25 @@ def test_raised_foot_share_counts_frames_with_the_higher_ankle_over_the_line(dan
     assert tuning_score([{**run, "raised_foot_share": 0.0, "limb_worst_second": 0.24}])[0] == 1
     # Energy: a median just over rule (c)'s floor in Python falls under it through the page's skeleton fit.
     assert tuning_score([{**run, "raised_foot_share": 0.0, "median_ratio": 0.52}])[0] == 1
+
+
+def test_temperature_sweep_rolls_out_one_style_in_grid_order(tmp_path, mocap, dance):
+    """The sweep beyond the export's grid (pilot --sweep): only the asked style is rolled out, each power share
+    keeps every setting in grid order, and hotter draws shake more (raw jitter rises with the temperature)."""
+    from training.aclstm.pilots import SWEEP_HOLDS, SWEEP_RHOS, SWEEP_SHARES, temperature_sweep
+    skel, clips = dance
+    torch.manual_seed(0)
+    model = DanceLSTM(3 * len(skel.names), 3, hidden=16, layers=1, head="mdn", components=3)
+    # Normalisation of real features, so the decoded frames are bodies of about the right size.
+    feats = np.concatenate([encode(resample_positions(c.positions, c.fps, 0, 60)) for c in clips[:6]])
+    meta = {"dim": feats.shape[1], "styles": list(STYLES), "hidden": 16, "layers": 1, "head": "mdn", "components": 3,
+            "mean": feats.mean(0).tolist(), "std": np.maximum(feats.std(0), 1e-3).tolist()}
+    torch.save({"model": model.state_dict(), "iteration": 1, "meta": meta}, tmp_path / "last.pt")
+    swept = temperature_sweep(tmp_path / "last.pt", "indian", (0.2, 1.4), frames=120, mocap=str(mocap))
+    assert swept["style"] == "indian" and list(swept["rows"]) == [f"{s:g}" for s in SWEEP_SHARES]
+    for rows in swept["rows"].values():
+        grid = [(t, h, r) for t in (0.2, 1.4) for h in SWEEP_HOLDS for r in SWEEP_RHOS]
+        assert [(r["params"]["temperature"], r["params"]["max_hold"], r["params"]["rho"]) for r in rows] == grid
+        assert all(r["runs"] == 3 for r in rows)
+        half = len(rows) // 2
+        assert all(hot["jitter_raw_vs_real"] > cold["jitter_raw_vs_real"] for cold, hot in zip(rows[:half], rows[half:]))

@@ -3,6 +3,7 @@
     python -m training.aclstm.pilot RUN [RUN ...] [--frames 3000] [--seeds 3] [--which best|last]
     python -m training.aclstm.pilot --feedback-noise 0.1 0.15 [--rho 0.9] [--pose-only] [--model aclstm] [--frames 20000]
     python -m training.aclstm.pilot RUN --phrase-tune     # an mdn head: phrase sampling, chosen per style on held-out windows
+    python -m training.aclstm.pilot RUN --which last --sweep indian --temperatures 0.7 1.0 1.4   # one style, hotter than the export's grid
 
 An mdn head's rollouts use the phrase sampler (training/aclstm/phrase_sampling.py): --temperature, --max-hold, --draw-rho
 and --threshold for every style, or --phrase-tune: each style's setting chosen from a grid on held-out seed windows
@@ -21,9 +22,10 @@ from ..data.dance import STYLES
 from ..paths import MODELS_DIR, REPORTS_DIR
 from ..runs import RUNS_DIR
 from .phrase_sampling import PhraseParams
-from .pilots import feedback_noise_runs, measure_run, pilot_markdown, summary_line, tune_phrase, tuning_grid
+from .pilots import feedback_noise_runs, measure_run, pilot_markdown, summary_line, temperature_sweep, tune_phrase, tuning_grid
 
 PILOTS = REPORTS_DIR / "aclstm-pilots.json"
+SWEEPS = REPORTS_DIR / "aclstm-temperature-sweeps.json"
 TUNING = REPORTS_DIR / "aclstm-phrase-tuning.json"
 
 
@@ -45,7 +47,28 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--threshold", type=float, default=0.05, help="an mdn head's phrase: redraw when the held component's weight falls below this")
     parser.add_argument("--phrase-tune", action="store_true", help="an mdn head: choose temperature, max hold and rho per style on held-out windows")
     parser.add_argument("--tune-frames", type=int, default=1200)
+    parser.add_argument("--sweep", choices=STYLES, default=None,
+                        help="an mdn head: this style's tuning runs at --temperatures (3,000 frames), into "
+                             "docs/models/aclstm-temperature-sweeps.json; nothing else is measured")
+    parser.add_argument("--temperatures", type=float, nargs="+", default=[0.7, 1.0, 1.4])
     args = parser.parse_args(argv)
+    if args.sweep:
+        if not args.runs:
+            parser.error("--sweep needs a RUN")
+        for name in args.runs:
+            swept = temperature_sweep(RUNS_DIR / name / f"{args.which}.pt", args.sweep, tuple(args.temperatures), mocap=args.mocap)
+            # Read just before writing: another sweep may have written meanwhile (sweeps run two at a time).
+            sweeps = json.loads(SWEEPS.read_text()) if SWEEPS.exists() else {}
+            sweeps[f"{name}:{args.which} {args.sweep}"] = swept
+            SWEEPS.write_text(json.dumps(sweeps, indent=1))
+            for share, rows in swept["rows"].items():
+                for r in rows:
+                    p = r["params"]
+                    print(f"{name} {args.sweep} cutoff share {share} τ {p['temperature']:g} hold {p['max_hold']} ρ {p['rho']:g}: "
+                          f"{r['passes']}/{r['runs']} pass, median {r['median_ratio']:.0%}, jitter {r['jitter_vs_real']:.2f}x "
+                          f"({r['jitter_raw_vs_real']:.2f}x raw), foot raised {r['raised_foot_share']:.0%}, limbs {r['limb_worst_second']:.1%}")
+        print(f"wrote {SWEEPS}")
+        return
     if not args.runs and not args.feedback_noise:
         parser.error("give RUN names or --feedback-noise")
     saved = json.loads(PILOTS.read_text()) if PILOTS.exists() else {}

@@ -189,13 +189,13 @@ def tune_phrase(checkpoint: Path, grid: list[PhraseParams], frames: int = 1200, 
 
 
 def tune_phrase_filtered(checkpoint: Path, grid: list[PhraseParams], filter_sets: list[dict | None], frames: int = 1200,
-                         per_style: int = 3, mocap: str | None = None) -> list[dict]:
+                         per_style: int = 3, mocap: str | None = None, styles: tuple[str, ...] = STYLES) -> list[dict]:
     """tune_phrase once per entry of `filter_sets` (None: unfiltered), on one set of rollouts: the filter is applied
-    after the rollout and never fed back, so the rollouts are the same whatever it is."""
+    after the rollout and never fed back, so the rollouts are the same whatever it is. `styles`: the styles rolled out."""
     skel, clips = load_clips(mocap)
     model, meta, _ = load_dance_model(checkpoint)
     ref, real_jitter, real_raised = real_reference(clips), real_jitter_cm(clips), real_raised_foot(clips, skel.names)
-    rows = [(style, p, seed) for style in STYLES for p in grid for seed in tuning_seeds(clips, style, per_style)]
+    rows = [(style, p, seed) for style in styles for p in grid for seed in tuning_seeds(clips, style, per_style)]
     drawn, _ = phrase_rollout(model, meta, np.array([r[2] for r in rows]), [r[0] for r in rows], frames, [r[1] for r in rows])
     raw_jitter = [jitter_cm(decode(f.astype(np.float64))) / real_jitter[st] for (st, _, _), f in zip(rows, drawn)]
     results = []
@@ -205,7 +205,7 @@ def tune_phrase_filtered(checkpoint: Path, grid: list[PhraseParams], filter_sets
             feats = lowpass_rows(drawn, np.array([filters[st][0] for st, _, _ in rows]), np.array([filters[st][1] for st, _, _ in rows]),
                                  np.array([seed[-1] for _, _, seed in rows]))
         out = {}
-        for style in STYLES:
+        for style in styles:
             table = []
             for p in grid:
                 mine = [k for k, (st, q, _) in enumerate(rows) if st == style and q == p]
@@ -224,6 +224,27 @@ def tune_phrase_filtered(checkpoint: Path, grid: list[PhraseParams], filter_sets
         results.append({"frames": frames, "seeds_per_style": per_style, "fractions": TUNING_FRACTIONS,
                         "filtered": bool(filters), "styles": out})
     return results
+
+
+SWEEP_HOLDS, SWEEP_RHOS, SWEEP_SHARES = (15, 30), (0.9, 0.95), (0.99, 0.97)
+
+
+def temperature_sweep(checkpoint: Path, style: str, temperatures: tuple[float, ...], frames: int = 3000,
+                      mocap: str | None = None) -> dict:
+    """One style's phrase settings at `temperatures` (also above the export's grid), each with holds SWEEP_HOLDS and
+    AR(1) coefficients SWEEP_RHOS, judged on the style's tuning runs through its filter at each of SWEEP_SHARES (the
+    export's judge, tune_phrase_filtered): per power share, the rows of every setting in grid order."""
+    from .jitter_filter import style_filters
+
+    clips = load_clips(mocap)[1]
+    grid = [PhraseParams(t, h, r, 0.05) for t in temperatures for h in SWEEP_HOLDS for r in SWEEP_RHOS]
+    filters = [{style: tuple(np.array(style_filters(clips, (style,), share)[style][k]) for k in ("b", "a"))}
+               for share in SWEEP_SHARES]
+    tuned = tune_phrase_filtered(checkpoint, grid, filters, frames, mocap=mocap, styles=(style,))
+    order = {json.dumps(p.to_json(), sort_keys=True): k for k, p in enumerate(grid)}
+    return {"style": style, "frames": frames, "power_shares": list(SWEEP_SHARES),
+            "rows": {f"{share:g}": sorted(t["styles"][style]["table"], key=lambda r: order[json.dumps(r["params"], sort_keys=True)])
+                     for share, t in zip(SWEEP_SHARES, tuned)}}
 
 
 def summary_line(name: str, m: dict) -> str:

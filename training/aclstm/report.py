@@ -14,6 +14,7 @@ by python -m training.aclstm.evaluate.
 from __future__ import annotations
 
 import json
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -211,7 +212,8 @@ def plot_against_real(model: dict, label: str, clips: list[DanceClip], path: Pat
         ax.axhline(FREEZE_FRACTION * mid, color="k", ls="--", lw=1, label="freeze line (20% of the median)")
         for k, run in enumerate(runs):
             ax.plot(run.get("pose_change_curve", []), lw=0.5, alpha=0.8, color=f"C{k}", label=f"seed {run['seed']}")
-        ax.set(title=f"{label}, {style}: pose change per second", xlabel="second of generation", ylabel="m/s",
+        # Long labels wrap, so the three panels' titles do not run into each other.
+        ax.set(title=textwrap.fill(f"{label}, {style}: pose change per second", 45), xlabel="second of generation", ylabel="m/s",
                ylim=(0, 1.5 * max(hi, max((max(r.get('pose_change_curve', [0])) for r in runs), default=hi))))
         ax.legend(fontsize=6, loc="upper right")
     fig.tight_layout()
