@@ -68,9 +68,18 @@ def rewrote_from_json(args: argparse.Namespace, report: str, rewrite_markdown) -
     return True
 
 
-def cpu_state(model: torch.nn.Module) -> dict:
-    """A model's weights on the CPU, so a checkpoint trained on a GPU loads anywhere."""
-    return {k: v.detach().cpu() for k, v in model.state_dict().items()}
+def on_cpu(state):
+    """`state` (nested dicts, lists and tuples of tensors and plain values) with every tensor on the CPU, so a
+    checkpoint written by a GPU run loads anywhere."""
+    if isinstance(state, torch.Tensor):
+        return state.detach().cpu()
+    if isinstance(state, dict):
+        return {k: on_cpu(v) for k, v in state.items()}
+    if isinstance(state, tuple) and hasattr(state, "_fields"):  # a named tuple
+        return type(state)(*(on_cpu(v) for v in state))
+    if isinstance(state, (list, tuple)):
+        return type(state)(on_cpu(v) for v in state)
+    return state
 
 
 class Run:
@@ -93,7 +102,7 @@ class Run:
     def save(self, state: dict, path: Path | None = None) -> None:
         path = path or self.checkpoint_path
         tmp = path.with_suffix(".tmp")
-        torch.save(state, tmp)
+        torch.save(on_cpu(state), tmp)  # on the CPU: load_state_dict puts each part back on its own device
         tmp.replace(path)  # never leave a half-written checkpoint behind
         if path == self.checkpoint_path:
             self.last_save = time.monotonic()
@@ -114,10 +123,16 @@ class Run:
         state = self.load()
         if state is None:
             raise SystemExit(f"error: --resume but no checkpoint at {self.checkpoint_path}")
+        missing = [key for key in (*parts, "rng", "torch_rng") if key not in state]
+        if missing:
+            raise SystemExit(f"error: --resume, but {self.checkpoint_path} lacks {', '.join(missing)}"
+                             + (f" ({state['note']})" if "note" in state else ""))
         for key, part in parts.items():
             part.load_state_dict(state[key])
         rng.bit_generator.state = state["rng"]
         torch.set_rng_state(state["torch_rng"])
+        if "cuda_rng" in state and torch.cuda.is_available():  # a GPU run's own generator (draws made on the GPU)
+            torch.cuda.set_rng_state_all(state["cuda_rng"])
         return state
 
 
@@ -185,7 +200,9 @@ class TrainingLoop:
 
     def checkpoint(self, iteration: int, **extra) -> dict:
         return {**{k: p.state_dict() for k, p in self.parts.items()}, "rng": self.rng.bit_generator.state,
-                "torch_rng": torch.get_rng_state(), "iteration": iteration, "best": self.best,
+                "torch_rng": torch.get_rng_state(),
+                **({"cuda_rng": torch.cuda.get_rng_state_all()} if torch.cuda.is_initialized() else {}),
+                "iteration": iteration, "best": self.best,
                 "elapsed": self.elapsed(), **extra, "meta": self.meta}
 
     def save(self, iteration: int, **extra) -> None:
@@ -205,7 +222,7 @@ class TrainingLoop:
         self.log.info("stopped: %s (%s)", self.stopped, self.position.format(iteration=iteration, **extra))
         self.save(iteration, **extra)
         if save_last:
-            self.run.save({"model": cpu_state(self.parts["model"]), "iteration": iteration, "meta": self.meta},
+            self.run.save({"model": self.parts["model"].state_dict(), "iteration": iteration, "meta": self.meta},
                           self.run.dir / "last.pt")
         summary = {**summary, "minutes": self.elapsed() / 60, "parameters": self.parameters}
         (self.run.dir / "summary.json").write_text(json.dumps(summary, indent=1))

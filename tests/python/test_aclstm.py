@@ -215,10 +215,19 @@ def test_raised_foot_share_counts_frames_with_the_higher_ankle_over_the_line(dan
     assert tuning_score([{**run, "raised_foot_share": 0.0, "median_ratio": 0.52}])[0] == 1
 
 
-def test_temperature_sweep_rolls_out_one_style_in_grid_order(tmp_path, mocap, dance):
+def test_temperature_sweep_rolls_out_one_style_in_grid_order(tmp_path, mocap, dance, monkeypatch):
     """The sweep beyond the export's grid (pilot --sweep): only the asked style is rolled out, each power share
     keeps every setting in grid order, and hotter draws shake more (raw jitter rises with the temperature)."""
+    import training.aclstm.pilots as pilots
     from training.aclstm.pilots import SWEEP_HOLDS, SWEEP_RHOS, SWEEP_SHARES, temperature_sweep
+    rolled_styles = []
+
+    def recording_rollout(model, meta, seeds, styles, *args, **kwargs):
+        rolled_styles.extend(styles)
+        return rollout(model, meta, seeds, styles, *args, **kwargs)
+
+    rollout = pilots.phrase_rollout
+    monkeypatch.setattr(pilots, "phrase_rollout", recording_rollout)
     skel, clips = dance
     torch.manual_seed(0)
     model = DanceLSTM(3 * len(skel.names), 3, hidden=16, layers=1, head="mdn", components=3)
@@ -228,6 +237,7 @@ def test_temperature_sweep_rolls_out_one_style_in_grid_order(tmp_path, mocap, da
             "mean": feats.mean(0).tolist(), "std": np.maximum(feats.std(0), 1e-3).tolist()}
     torch.save({"model": model.state_dict(), "iteration": 1, "meta": meta}, tmp_path / "last.pt")
     swept = temperature_sweep(tmp_path / "last.pt", "indian", (0.2, 1.4), frames=120, mocap=str(mocap))
+    assert set(rolled_styles) == {"indian"} and len(rolled_styles) == 3 * 2 * len(SWEEP_HOLDS) * len(SWEEP_RHOS)
     assert swept["style"] == "indian" and list(swept["rows"]) == [f"{s:g}" for s in SWEEP_SHARES]
     for rows in swept["rows"].values():
         grid = [(t, h, r) for t in (0.2, 1.4) for h in SWEEP_HOLDS for r in SWEEP_RHOS]

@@ -23,7 +23,7 @@ import torch
 from ..data.dance import MODEL_FPS, STYLES, DanceClip, DanceSkeleton, encode, load_clips, mirror, mirror_pairs, resample_positions, rotate_y
 from ..models.aclstm import DanceLSTM, mixture_nll
 from ..models.losses import energy_loss
-from ..runs import TrainingLoop, cpu_state
+from ..runs import TrainingLoop
 
 SPEEDS = (0.8, 1.2)
 
@@ -198,7 +198,7 @@ def train_dance_model(args: argparse.Namespace,
                                 "valid": val})
                 if val["objective"] < loop.best:
                     loop.best = val["objective"]
-                    run.save({"model": cpu_state(model), "iteration": iteration, "valid": val, "meta": meta}, run.best_path)
+                    run.save({"model": model.state_dict(), "iteration": iteration, "valid": val, "meta": meta}, run.best_path)
                 run.log.info("iteration %d train %.4f valid %.4f (tf %s, ac %s) best %.4f lr %.2e minutes %.1f", iteration,
                              np.mean(losses), val["objective"],
                              "/".join(f"{val[s]['teacher_forced']:.3f}" for s in styles),
@@ -213,7 +213,7 @@ def train_dance_model(args: argparse.Namespace,
     if not run.best_path.exists():  # no validation yet (a short or interrupted run): the weights as they are
         val = validation_losses(model, corpus, args.condition)
         loop.best = val["objective"]
-        run.save({"model": cpu_state(model), "iteration": iteration, "valid": val, "meta": meta}, run.best_path)
+        run.save({"model": model.state_dict(), "iteration": iteration, "valid": val, "meta": meta}, run.best_path)
     # The last weights also count as a candidate: last.pt, for the evaluation to compare.
     loop.finish(iteration, {"best_valid": loop.best, "iterations": iteration, "stopped": loop.stopped},
                 save_last=True, history=history)

@@ -59,6 +59,12 @@ def _unpacked_tensor(p: dict) -> torch.Tensor:
     return p["float16"].float() if "float16" in p else p["raw"]
 
 
+def _parts(stem: Path) -> list[Path]:
+    """stem.part0, stem.part1 … in numeric order (part10 after part9)."""
+    found = [(p, p.name[len(stem.name) + len(".part"):]) for p in stem.parent.glob(f"{stem.name}.part*")]
+    return [p for p, k in sorted(((p, k) for p, k in found if k.isdigit()), key=lambda pk: int(pk[1]))]
+
+
 def pack_checkpoint(checkpoint: Path, out_stem: Path, int8: bool = False, history_from: Path | None = None) -> list[Path]:
     """Writes out_stem.part0, .part1 … (each at most PART_BYTES); returns their paths. `history_from`: a checkpoint
     whose validation history to keep (the run's checkpoint.pt)."""
@@ -69,6 +75,8 @@ def pack_checkpoint(checkpoint: Path, out_stem: Path, int8: bool = False, histor
                 "valid": state.get("valid"), "meta": state["meta"], "history": history}, buffer)
     data = buffer.getvalue()
     out_stem.parent.mkdir(parents=True, exist_ok=True)
+    for stale in _parts(out_stem):  # an earlier pack's parts would be joined with these
+        stale.unlink()
     parts = []
     for k, start in enumerate(range(0, len(data), PART_BYTES)):
         path = out_stem.with_name(f"{out_stem.name}.part{k}")
@@ -81,7 +89,7 @@ def unpack_checkpoint(stem: Path, run_dir: Path, name: str) -> Path:
     """Joins stem.part0, .part1 … into run_dir/name (the model, iteration, validation and meta, as training writes
     best.pt and last.pt) and, when the pack kept a history, run_dir/checkpoint.pt with it (the export reads training
     minutes there)."""
-    parts = sorted(stem.parent.glob(f"{stem.name}.part*"), key=lambda p: int(p.name.rsplit("part", 1)[1]))
+    parts = _parts(stem)
     if not parts:
         raise SystemExit(f"error: no {stem.name}.part0 in {stem.parent}")
     state = torch.load(io.BytesIO(b"".join(p.read_bytes() for p in parts)), weights_only=False)
@@ -91,6 +99,6 @@ def unpack_checkpoint(stem: Path, run_dir: Path, name: str) -> Path:
                 **({"valid": state["valid"]} if state.get("valid") else {}), "meta": state["meta"]}, out)
     if state["history"]:
         torch.save({"history": state["history"], "iteration": state["history"][-1]["iteration"], "meta": state["meta"],
-                    "note": "unpacked from a lent GPU's run (training/carried.py): no optimiser, not resumable"},
+                    "note": "unpacked from a lent GPU's run (training/device/carried.py): no optimiser, not resumable"},
                    run_dir / "checkpoint.pt")
     return out
