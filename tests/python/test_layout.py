@@ -104,7 +104,7 @@ MAY_IMPORT = {
     "control": set(),
     "onnx": {"paths"},
     "data": {"mocap", "paths", "metrics", "control"},
-    "device": {"data", "paths"},
+    "device": {"data", "paths", "onnx"},
     "models": {"mocap", "data"},
     "generator": {"mocap", "data", "models"} | SHARED,
     "aclstm": {"mocap", "data", "models"} | SHARED,

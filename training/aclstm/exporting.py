@@ -240,12 +240,12 @@ def mdn_sampling(checkpoint: Path, clips: list[DanceClip], mocap: str | None, tu
     cutoff below which a share of the style's training clips' velocity power lies, the share one of `shares`) and the
     phrase parameters, chosen together by pilots.tune_phrase_filtered (one set of rollouts) on held-out tuning windows (never the judged seeds) from
     tuning_grid with the AR(1) coefficients EXPORT_RHOS, the rollouts judged through the filter as the page shows them."""
-    from .jitter_filter import style_filters
-    from .pilots import EXPORT_RHOS, EXPORT_TEMPERATURES, EXPORT_THRESHOLDS, tune_phrase_filtered, tuning_grid
+    from .jitter_filter import coefficients, style_filters
+    from .pilots import EXPORT_RHOS, EXPORT_TEMPERATURES, EXPORT_THRESHOLDS, tune_phrase_filtered, tuning_grid, tuning_row_text
 
     filters_by_share = [style_filters(clips, share=share) for share in shares]
     tunings = tune_phrase_filtered(checkpoint, tuning_grid(rhos=EXPORT_RHOS, thresholds=EXPORT_THRESHOLDS, temperatures=EXPORT_TEMPERATURES),
-                                   [{s: (np.array(f["b"]), np.array(f["a"])) for s, f in filters.items()} for filters in filters_by_share],
+                                   [{s: coefficients(f) for s, f in filters.items()} for filters in filters_by_share],
                                    tune_frames, mocap=mocap)
     chosen = {}  # style -> (share, filter, tuned style block)
     for share, filters, tuned in zip(shares, filters_by_share, tunings):
@@ -254,10 +254,7 @@ def mdn_sampling(checkpoint: Path, clips: list[DanceClip], mocap: str | None, tu
                 chosen[style] = (share, filters[style], v)
     for style, (share, f, v) in chosen.items():
         row = v["table"][0]
-        print(f"{style}: filter {f['cutoff_hz']:.2f} Hz ({share:.0%} of the power), phrase {v['best']} (tuning: {row['passes']}/"
-              f"{row['runs']} pass, median {row['median_ratio']:.0%}, jitter {row['jitter_vs_real']:.2f}x filtered, "
-              f"{row['jitter_raw_vs_real']:.2f}x raw, a foot raised in up to {row['raised_foot_share']:.0%} of frames, "
-              f"real {row['raised_foot_real']:.0%}, limbs {row['limb_worst_second']:.1%} off in the worst second)")
+        print(f"{style}: filter {f['cutoff_hz']:.2f} Hz ({share:.0%} of the power), phrase {v['best']} (tuning: {tuning_row_text(row)})")
     return {"rule": "phrase", "params": {s: v["best"] for s, (_, _, v) in chosen.items()},
             "filter": {s: {**f, "power_share": share} for s, (share, f, _) in chosen.items()},
             "tuning": {"frames": tuned["frames"], "seeds_per_style": tuned["seeds_per_style"], "fractions": list(tuned["fractions"]),

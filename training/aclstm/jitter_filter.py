@@ -118,6 +118,11 @@ def choose_cutoff(clips, style: str, share: float = CUTOFF_POWER_SHARE, fps: flo
     return power_share_frequency(*velocity_spectrum(clips, style, fps), share)
 
 
+def coefficients(block: dict) -> tuple[np.ndarray, np.ndarray]:
+    """(b, a) of one style's filter block (style_filters, the JSON's sampling.filter), as lowpass_rows takes them."""
+    return np.array(block["b"]), np.array(block["a"])
+
+
 def style_filters(clips, styles=STYLES, share: float = CUTOFF_POWER_SHARE, fps: float = MODEL_FPS) -> dict:
     """Per style {cutoff_hz, b, a}: the JSON's sampling.filter block."""
     out = {}

@@ -22,7 +22,8 @@ from ..data.dance import STYLES
 from ..paths import MODELS_DIR, REPORTS_DIR
 from ..runs import RUNS_DIR
 from .phrase_sampling import PhraseParams
-from .pilots import feedback_noise_runs, measure_run, pilot_markdown, summary_line, temperature_sweep, tune_phrase, tuning_grid
+from .pilots import (feedback_noise_runs, measure_run, pilot_markdown, summary_line, temperature_sweep, tune_phrase, tuning_grid,
+                     tuning_row_text)
 
 PILOTS = REPORTS_DIR / "aclstm-pilots.json"
 SWEEPS = REPORTS_DIR / "aclstm-temperature-sweeps.json"
@@ -65,8 +66,7 @@ def main(argv: list[str] | None = None) -> None:
                 for r in rows:
                     p = r["params"]
                     print(f"{name} {args.sweep} cutoff share {share} τ {p['temperature']:g} hold {p['max_hold']} ρ {p['rho']:g}: "
-                          f"{r['passes']}/{r['runs']} pass, median {r['median_ratio']:.0%}, jitter {r['jitter_vs_real']:.2f}x "
-                          f"({r['jitter_raw_vs_real']:.2f}x raw), foot raised {r['raised_foot_share']:.0%}, limbs {r['limb_worst_second']:.1%}")
+                          + tuning_row_text(r))
         print(f"wrote {SWEEPS}")
         return
     if not args.runs and not args.feedback_noise:

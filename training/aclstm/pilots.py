@@ -234,17 +234,22 @@ def temperature_sweep(checkpoint: Path, style: str, temperatures: tuple[float, .
     """One style's phrase settings at `temperatures` (also above the export's grid), each with holds SWEEP_HOLDS and
     AR(1) coefficients SWEEP_RHOS, judged on the style's tuning runs through its filter at each of SWEEP_SHARES (the
     export's judge, tune_phrase_filtered): per power share, the rows of every setting in grid order."""
-    from .jitter_filter import style_filters
+    from .jitter_filter import coefficients, style_filters
 
     clips = load_clips(mocap)[1]
     grid = [PhraseParams(t, h, r, 0.05) for t in temperatures for h in SWEEP_HOLDS for r in SWEEP_RHOS]
-    filters = [{style: tuple(np.array(style_filters(clips, (style,), share)[style][k]) for k in ("b", "a"))}
-               for share in SWEEP_SHARES]
+    filters = [{style: coefficients(style_filters(clips, (style,), share)[style])} for share in SWEEP_SHARES]
     tuned = tune_phrase_filtered(checkpoint, grid, filters, frames, mocap=mocap, styles=(style,))
-    order = {json.dumps(p.to_json(), sort_keys=True): k for k, p in enumerate(grid)}
+    in_grid_order = lambda table: sorted(table, key=lambda r: grid.index(PhraseParams(**r["params"])))  # not by score
     return {"style": style, "frames": frames, "power_shares": list(SWEEP_SHARES),
-            "rows": {f"{share:g}": sorted(t["styles"][style]["table"], key=lambda r: order[json.dumps(r["params"], sort_keys=True)])
-                     for share, t in zip(SWEEP_SHARES, tuned)}}
+            "rows": {f"{share:g}": in_grid_order(t["styles"][style]["table"]) for share, t in zip(SWEEP_SHARES, tuned)}}
+
+
+def tuning_row_text(row: dict) -> str:
+    """One row of a tuning table (tune_phrase_filtered) in words, as the export and the sweep print it."""
+    return (f"{row['passes']}/{row['runs']} pass, median {row['median_ratio']:.0%}, jitter {row['jitter_vs_real']:.2f}x filtered, "
+            f"{row['jitter_raw_vs_real']:.2f}x raw, a foot raised in up to {row['raised_foot_share']:.0%} of frames, "
+            f"real {row['raised_foot_real']:.0%}, limbs {row['limb_worst_second']:.1%} off in the worst second")
 
 
 def summary_line(name: str, m: dict) -> str:

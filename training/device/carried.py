@@ -5,7 +5,7 @@ in all (no ../shared), and gives back at most 8 files of 16 MiB (python -m train
   changes by), stored as frame-to-frame differences in integer units, compressed with xz: 62 MB of float32
   positions pack into 19 MB. Everything else in the cache travels as it is.
 - A checkpoint's weights, for the way back: float16, or int8 with a scale per output row (the shipped ONNX files'
-  own format, training/onnx/compact.py, so an export of the unpacked weights stores the same numbers), in parts of
+  own rounding, compact.quantise_int8, so an export of the unpacked weights stores the same numbers), in parts of
   at most PART_BYTES. The meta and validation history travel whole; the optimiser does not, so an unpacked run is
   for export and evaluation, not for --resume.
 """
@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 import torch
+
+from ..onnx.compact import quantise_int8
 
 UNITS_PER_METRE = 100_000  # 10 µm
 PART_BYTES = 15_000_000  # under the 16 MiB a file coming back may have
@@ -47,9 +49,9 @@ def unpack_positions(packed: Path, cache: Path) -> None:
 
 def _packed_tensor(t: torch.Tensor, int8: bool) -> dict:
     t = t.detach().float().cpu()
-    if int8 and t.dim() == 2:
-        scale = t.abs().amax(dim=1, keepdim=True).clamp_min(1e-12) / 127
-        return {"int8": torch.round(t / scale).to(torch.int8), "scale": scale}
+    if int8 and t.dim() == 2:  # a scale per output row: the rows of PyTorch's (out, in) weights
+        q, scale = quantise_int8(t.numpy(), axis=0)
+        return {"int8": torch.from_numpy(q), "scale": torch.from_numpy(scale)}
     return {"float16": t.half()} if t.is_floating_point() else {"raw": t}
 
 
